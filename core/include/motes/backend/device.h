@@ -1,0 +1,137 @@
+// The backend interface: a Device owns the simulation's buffers and implements each kernel family
+// with the same contract on every backend (docs/architecture.md). The core owns the step and calls
+// these in order; backends never see a Scene.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "motes/status.h"
+#include "shared/params.h"
+
+namespace motes {
+
+/// Every buffer a device holds. Element types and counts: see buffer_layout().
+enum class Buffer : std::uint32_t {
+  // Particles (N), in body order: body b owns particles [BodyFirst[b], BodyFirst[b+1]).
+  ParticlePos,       ///< vec4: world position xyz, w = radius
+  ParticleVel,       ///< vec4: world velocity xyz, w = inverse mass (0 for static bodies)
+  ParticleLocal,     ///< vec4: offset from the body's centre of mass in the body frame
+  ParticleBody,      ///< uint: body index
+  ParticleMaterial,  ///< uint: material index
+  ParticleForce,     ///< vec4: contact force (output of contacts_compute)
+  // Bodies (B).
+  BodyPos,         ///< vec4: centre of mass xyz, w = inverse mass (0 = static)
+  BodyQuat,        ///< vec4: orientation (x, y, z, w), body (principal) frame to world
+  BodyVel,         ///< vec4: linear velocity
+  BodyAngMom,      ///< vec4: angular momentum (world)
+  BodyAngVel,      ///< vec4: angular velocity (world)
+  BodyInvInertia,  ///< vec4: inverse principal moments of inertia (body frame)
+  BodyForce,       ///< vec4: summed contact force (output of bodies_reduce)
+  BodyTorque,      ///< vec4: summed torque about the centre of mass
+  BodyFirst,       ///< uint (B + 1): first particle of each body, then N
+  // Hashed grid (outputs of grid_build).
+  GridBucket,     ///< uint (N): bucket of particle i
+  GridOrder,      ///< uint (N): particle ids sorted stably by bucket
+  GridCellStart,  ///< uint (T + 1): sorted position of each bucket's first particle, then N
+  SortedPos,      ///< vec4 (N): ParticlePos in grid order
+  SortedVel,      ///< vec4 (N): ParticleVel in grid order
+  SortedBody,     ///< uint (N): ParticleBody in grid order
+  SortedMaterial, ///< uint (N): ParticleMaterial in grid order
+  // Tables.
+  ContactLaws,  ///< ContactLaw (M * M): law of material pair (a, b) at a * M + b
+  Planes,       ///< PlaneData (P)
+  Count
+};
+
+/// Kernel families, in the order a step runs them.
+enum class Kernel : std::uint32_t {
+  GridBuild,
+  ContactsCompute,
+  BodiesReduce,
+  BodiesIntegrate,
+  ParticlesUpdate,
+  Count
+};
+
+constexpr std::size_t kBufferCount = static_cast<std::size_t>(Buffer::Count);
+constexpr std::size_t kKernelCount = static_cast<std::size_t>(Kernel::Count);
+
+const char* buffer_name(Buffer b);
+const char* kernel_name(Kernel k);
+
+/// Element counts of a simulation.
+struct Sizes {
+  std::uint32_t particles = 0;  ///< N
+  std::uint32_t bodies = 0;     ///< B
+  std::uint32_t table = 0;      ///< T, a power of two >= 64
+  std::uint32_t materials = 0;  ///< M
+  std::uint32_t planes = 0;     ///< P
+};
+
+/// Bytes of one element and number of elements of a buffer.
+struct BufferLayout {
+  std::size_t element_bytes = 0;
+  std::size_t count = 0;
+  [[nodiscard]] std::size_t bytes() const { return element_bytes * count; }
+};
+BufferLayout buffer_layout(Buffer b, const Sizes& sizes);
+
+/// Hash-table size the core uses for n particles: the power of two >= 2n, at least 64.
+std::uint32_t grid_table_size(std::uint32_t particles);
+
+/// Time spent per kernel family since the last reset (seconds) and launch counts.
+struct KernelTimes {
+  std::array<double, kKernelCount> seconds{};
+  std::array<std::uint64_t, kKernelCount> launches{};
+};
+
+/// One device of one backend, as listed by `motes devices`.
+struct DeviceInfo {
+  std::string backend;  ///< "openmp", "cuda", "vulkan"
+  int index = 0;        ///< index within the backend
+  std::string name;     ///< e.g. CPU model, GPU name
+  std::string detail;   ///< threads, driver, memory, subgroup size...
+};
+
+/// A backend device. Kernels are enqueued in order; errors surface at synchronize().
+class Device {
+ public:
+  Device() = default;
+  Device(const Device&) = delete;
+  Device& operator=(const Device&) = delete;
+  virtual ~Device() = default;
+
+  [[nodiscard]] virtual const DeviceInfo& info() const = 0;
+
+  /// (Re)allocates every buffer for these sizes; contents are undefined afterwards.
+  virtual Status allocate(const Sizes& sizes) = 0;
+  /// Copies host memory into the start of a buffer; bytes <= buffer_layout(b).bytes().
+  virtual Status write(Buffer b, const void* src, std::size_t bytes) = 0;
+  /// Copies the start of a buffer to host memory (waits for queued kernels).
+  virtual Status read(Buffer b, void* dst, std::size_t bytes) = 0;
+
+  /// Buckets, stable sort by (bucket, particle id), bucket starts, sorted copies of particles.
+  virtual void grid_build(const shared::StepParams& p) = 0;
+  /// ParticleForce: each particle gathers its contacts over the 27 neighbouring cells in the
+  /// canonical order (docs/architecture.md), then the planes in order. Static particles get 0.
+  virtual void contacts_compute(const shared::StepParams& p) = 0;
+  /// BodyForce and BodyTorque: sums over each body's particles in particle order.
+  virtual void bodies_reduce(const shared::StepParams& p) = 0;
+  /// Semi-implicit Euler on every dynamic body (shared/body_math.h: body_integrate).
+  virtual void bodies_integrate(const shared::StepParams& p) = 0;
+  /// ParticlePos and ParticleVel xyz from their body's pose.
+  virtual void particles_update(const shared::StepParams& p) = 0;
+
+  /// Waits for queued work; reports any error it raised.
+  virtual Status synchronize() = 0;
+
+  /// Per-kernel timing (may cost a synchronization per kernel while on).
+  virtual void set_timing(bool on) = 0;
+  [[nodiscard]] virtual KernelTimes kernel_times() const = 0;
+  virtual void reset_kernel_times() = 0;
+};
+
+}  // namespace motes

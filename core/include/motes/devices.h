@@ -1,0 +1,28 @@
+// The backend registry: which backends were built, their devices, and opening one.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "motes/backend/device.h"
+#include "motes/status.h"
+
+namespace motes {
+
+/// What `motes devices` prints for one backend.
+struct BackendReport {
+  std::string backend;             ///< "openmp", "cuda", "vulkan"
+  bool compiled = false;           ///< built into this binary
+  std::vector<DeviceInfo> devices; ///< empty when unavailable
+  std::string unavailable_reason;  ///< why there are no devices (not built, no driver, ...)
+};
+
+/// Every backend motes knows, in preference order (cuda, vulkan, openmp).
+std::vector<BackendReport> list_backends();
+
+/// Opens device `index` (-1: the backend's default) of `backend`; "auto" picks the first backend
+/// in preference order that has a device.
+Result<std::unique_ptr<Device>> open_device(const std::string& backend, int index = -1);
+
+}  // namespace motes

@@ -1,0 +1,80 @@
+// Scenes: what a JSON scene file describes (docs/scene-format.md), after loading and validation.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "motes/shapes.h"
+#include "motes/status.h"
+
+namespace motes {
+
+/// A named material: density and the contact law of its particles.
+struct Material {
+  std::string name;
+  double density = 1000.0;   ///< kg/m^3
+  double stiffness = 0.0;    ///< k (N/m)
+  double damping = 0.0;      ///< gamma_n (1/s): normal dashpot force = gamma_n m* v_n
+  double tangential = 0.0;   ///< gamma_t (1/s): tangential force = gamma_t m* v_t
+  double friction = -1.0;    ///< Coulomb cap mu on the tangential force; < 0: no cap
+};
+
+/// Global settings of a scene.
+struct Settings {
+  double dt = 1.0e-4;                        ///< time of one step (s)
+  int substeps = 1;                          ///< physics substeps per step (each dt/substeps)
+  Eigen::Vector3d gravity{0.0, -9.81, 0.0};  ///< m/s^2
+  double particle_diameter = 0.01;           ///< default particle diameter for shapes (m)
+  bool clamp_attraction = false;             ///< forbid attractive (tensile) normal forces
+  double duration = 1.0;                     ///< default simulated time for `motes run` (s)
+  double output_interval = 1.0 / 60.0;       ///< simulated time between output frames (s)
+  Material contact;                          ///< defaults for materials' missing fields
+};
+
+enum class BodyKind { Dynamic, Static };
+
+/// One rigid body (a repeated body in the file becomes several BodySpecs).
+struct BodySpec {
+  std::string name;
+  BodyKind kind = BodyKind::Dynamic;
+  std::shared_ptr<const ParticleSet> shape;  ///< particles in the shape frame (shared by repeats)
+  int material = 0;                          ///< index into Scene::materials
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< where the centre of mass goes
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< rad/s, world frame
+};
+
+/// A static analytic half-space: solid below the plane (opposite to the normal).
+struct PlaneSpec {
+  std::string name;
+  Eigen::Vector3d normal{0.0, 1.0, 0.0};  ///< unit normal pointing into free space
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  int material = 0;
+};
+
+struct Scene {
+  std::string source;  ///< file it was loaded from (or "<built-in>")
+  Settings settings;
+  std::vector<Material> materials;
+  std::vector<BodySpec> bodies;
+  std::vector<PlaneSpec> planes;
+
+  [[nodiscard]] std::size_t particle_count() const;
+};
+
+/// Loads and validates a scene file. Errors read "FILE: /json/path: reason", or
+/// "FILE:LINE:COLUMN: reason" for JSON syntax errors.
+Result<Scene> load_scene_file(const std::string& path);
+/// Same, from text; `source` names it in messages; relative mesh paths resolve from base_dir.
+Result<Scene> load_scene_text(const std::string& text, const std::string& source,
+                              const std::string& base_dir);
+
+/// The scene `motes run` uses without arguments (examples/scenes/dominoes.json, built in).
+Result<Scene> builtin_default_scene();
+
+}  // namespace motes

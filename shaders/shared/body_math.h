@@ -1,0 +1,56 @@
+// Rigid-body integration and particle-from-body update (Harada, GPU Gems 3 ch. 29).
+// Body frame = principal axes, so the body-frame inverse inertia is diagonal.
+#ifndef MOTES_SHARED_BODY_MATH_H
+#define MOTES_SHARED_BODY_MATH_H
+
+#include "common.h"
+#include "quaternion.h"
+
+MOTES_SHARED_BEGIN
+
+/// World angular velocity w = R diag(inv_inertia) R^T L.
+MOTES_FN vec3 body_angular_velocity(vec4 q, vec4 inv_inertia, vec3 angular_momentum) {
+  vec3 lb = quat_rotate_inverse(q, angular_momentum);
+  return quat_rotate(q, vec3(lb.x * inv_inertia.x, lb.y * inv_inertia.y, lb.z * inv_inertia.z));
+}
+
+/// One semi-implicit Euler step of a dynamic body (pos_invm.w > 0):
+///   v += dt (F/m + g);  x += dt v;  L += dt tau;  q = exp(w(q, L) dt / 2) q;  w = w(q, L).
+/// Static bodies (pos_invm.w == 0) are left untouched.
+MOTES_FN void body_integrate(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
+                             MOTES_INOUT(vec4) vel, MOTES_INOUT(vec4) angmom,
+                             MOTES_OUT(vec4) angvel, vec4 inv_inertia, vec4 force, vec4 torque,
+                             vec4 gravity_dt) {
+  float inv_m = pos_invm.w;
+  if (inv_m == 0.0f) {
+    angvel = vec4(0.0f);
+    return;
+  }
+  float dt = gravity_dt.w;
+  vec3 v = xyz(vel) + (xyz(force) * inv_m + xyz(gravity_dt)) * dt;
+  vec3 x = xyz(pos_invm) + v * dt;
+  vec3 l = xyz(angmom) + xyz(torque) * dt;
+  vec3 w = body_angular_velocity(quat, inv_inertia, l);
+  vec4 q = quat_integrate(quat, w, dt);
+  w = body_angular_velocity(q, inv_inertia, l);
+  pos_invm = vec4(x, inv_m);
+  quat = q;
+  vel = vec4(v, 0.0f);
+  angmom = vec4(l, 0.0f);
+  angvel = vec4(w, 0.0f);
+}
+
+/// World position of a body's particle (local: body-frame offset from the centre of mass).
+MOTES_FN vec3 particle_position(vec4 body_pos, vec4 quat, vec4 local) {
+  return xyz(body_pos) + quat_rotate(quat, xyz(local));
+}
+
+/// World velocity of a body's particle: v + w x (R r).
+MOTES_FN vec3 particle_velocity(vec4 quat, vec4 body_vel, vec4 angvel, vec4 local) {
+  vec3 r = quat_rotate(quat, xyz(local));
+  return xyz(body_vel) + cross(xyz(angvel), r);
+}
+
+MOTES_SHARED_END
+
+#endif  // MOTES_SHARED_BODY_MATH_H

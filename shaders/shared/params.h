@@ -1,0 +1,54 @@
+// Parameter structs shared by the core, every backend and the shaders (std430 / push-constant
+// layout). Any change here must keep the static_asserts true on all three sides.
+#ifndef MOTES_SHARED_PARAMS_H
+#define MOTES_SHARED_PARAMS_H
+
+#include "common.h"
+
+MOTES_SHARED_BEGIN
+
+/// StepParams.flags: the normal force may not become attractive (clamped dashpot).
+#define MOTES_FLAG_CLAMP_ATTRACTION 1u
+
+/// Launch parameters of every kernel family; travels with the launch (push constants).
+struct StepParams {
+  vec4 gravity_dt;       // xyz: gravity (m/s^2), w: time step of this substep (s)
+  uint particle_count;   // N
+  uint body_count;       // B
+  uint table_mask;       // T - 1; the hashed grid has T = 2^k buckets
+  uint plane_count;      // P
+  float cell_size;       // grid cell edge (m) = largest particle diameter
+  float inv_cell_size;   // 1 / cell_size
+  uint material_count;   // M; pair table has M*M entries
+  uint flags;            // MOTES_FLAG_*
+};
+
+/// Contact law of one pair of materials (symmetric): F_n = k d - gamma_n m* v_n,
+/// F_t = gamma_t m* v_t, |F_t| <= mu |F_n| when friction >= 0.
+struct ContactLaw {
+  float stiffness;   // k (N/m)
+  float damping;     // gamma_n (1/s), multiplied by the effective mass m*
+  float tangential;  // gamma_t (1/s), multiplied by m*
+  float friction;    // Coulomb cap mu; negative: no cap (Harada's purely viscous force)
+};
+
+/// Static analytic half-space: solid where dot(normal, x) < offset.
+struct PlaneData {
+  vec4 normal_offset;  // xyz: unit normal pointing into free space, w: offset
+  uint material;
+  uint pad0;
+  uint pad1;
+  uint pad2;
+};
+
+MOTES_SHARED_END
+
+#ifdef __cplusplus
+static_assert(sizeof(motes::shared::StepParams) == 48, "StepParams layout");
+static_assert(offsetof(motes::shared::StepParams, particle_count) == 16, "StepParams layout");
+static_assert(offsetof(motes::shared::StepParams, flags) == 44, "StepParams layout");
+static_assert(sizeof(motes::shared::ContactLaw) == 16, "ContactLaw layout");
+static_assert(sizeof(motes::shared::PlaneData) == 32, "PlaneData layout");
+#endif
+
+#endif  // MOTES_SHARED_PARAMS_H
