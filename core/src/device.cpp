@@ -7,43 +7,74 @@ namespace motes {
 
 const char* buffer_name(Buffer b) {
   switch (b) {
-    case Buffer::ParticlePos: return "ParticlePos";
-    case Buffer::ParticleVel: return "ParticleVel";
-    case Buffer::ParticleLocal: return "ParticleLocal";
-    case Buffer::ParticleBody: return "ParticleBody";
-    case Buffer::ParticleMaterial: return "ParticleMaterial";
-    case Buffer::ParticleForce: return "ParticleForce";
-    case Buffer::BodyPos: return "BodyPos";
-    case Buffer::BodyQuat: return "BodyQuat";
-    case Buffer::BodyVel: return "BodyVel";
-    case Buffer::BodyAngMom: return "BodyAngMom";
-    case Buffer::BodyAngVel: return "BodyAngVel";
-    case Buffer::BodyInvInertia: return "BodyInvInertia";
-    case Buffer::BodyForce: return "BodyForce";
-    case Buffer::BodyTorque: return "BodyTorque";
-    case Buffer::BodyFirst: return "BodyFirst";
-    case Buffer::GridBucket: return "GridBucket";
-    case Buffer::GridOrder: return "GridOrder";
-    case Buffer::GridCellStart: return "GridCellStart";
-    case Buffer::SortedPos: return "SortedPos";
-    case Buffer::SortedVel: return "SortedVel";
-    case Buffer::SortedBody: return "SortedBody";
-    case Buffer::SortedMaterial: return "SortedMaterial";
-    case Buffer::ContactLaws: return "ContactLaws";
-    case Buffer::Planes: return "Planes";
-    case Buffer::Count: break;
+    case Buffer::ParticlePos:
+      return "ParticlePos";
+    case Buffer::ParticleVel:
+      return "ParticleVel";
+    case Buffer::ParticleLocal:
+      return "ParticleLocal";
+    case Buffer::ParticleBody:
+      return "ParticleBody";
+    case Buffer::ParticleMaterial:
+      return "ParticleMaterial";
+    case Buffer::ParticleForce:
+      return "ParticleForce";
+    case Buffer::BodyPos:
+      return "BodyPos";
+    case Buffer::BodyQuat:
+      return "BodyQuat";
+    case Buffer::BodyVel:
+      return "BodyVel";
+    case Buffer::BodyAngMom:
+      return "BodyAngMom";
+    case Buffer::BodyAngVel:
+      return "BodyAngVel";
+    case Buffer::BodyInvInertia:
+      return "BodyInvInertia";
+    case Buffer::BodyForce:
+      return "BodyForce";
+    case Buffer::BodyTorque:
+      return "BodyTorque";
+    case Buffer::BodyFirst:
+      return "BodyFirst";
+    case Buffer::GridBucket:
+      return "GridBucket";
+    case Buffer::GridOrder:
+      return "GridOrder";
+    case Buffer::GridCellStart:
+      return "GridCellStart";
+    case Buffer::SortedPos:
+      return "SortedPos";
+    case Buffer::SortedVel:
+      return "SortedVel";
+    case Buffer::SortedBody:
+      return "SortedBody";
+    case Buffer::SortedMaterial:
+      return "SortedMaterial";
+    case Buffer::ContactLaws:
+      return "ContactLaws";
+    case Buffer::Planes:
+      return "Planes";
+    case Buffer::Count:
+      break;
   }
   return "?";
 }
 
 const char* kernel_name(Kernel k) {
   switch (k) {
-    case Kernel::GridBuild: return "grid_build";
-    case Kernel::ContactsCompute: return "contacts_compute";
-    case Kernel::BodiesReduce: return "bodies_reduce";
-    case Kernel::BodiesIntegrate: return "bodies_integrate";
-    case Kernel::ParticlesUpdate: return "particles_update";
-    case Kernel::Count: break;
+    case Kernel::GridBuild:
+      return "grid_build";
+    case Kernel::ContactsCompute:
+      return "contacts_compute";
+    case Kernel::BodiesReduce:
+      return "bodies_reduce";
+    case Kernel::BodiesIntegrate:
+      return "bodies_integrate";
+    case Kernel::ParticlesUpdate:
+      return "particles_update";
+    case Kernel::Count:
+      break;
   }
   return "?";
 }
@@ -57,13 +88,15 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
     case Buffer::ParticleLocal:
     case Buffer::ParticleForce:
     case Buffer::SortedPos:
-    case Buffer::SortedVel: return {kVec4, s.particles};
+    case Buffer::SortedVel:
+      return {kVec4, s.particles};
     case Buffer::ParticleBody:
     case Buffer::ParticleMaterial:
     case Buffer::GridBucket:
     case Buffer::GridOrder:
     case Buffer::SortedBody:
-    case Buffer::SortedMaterial: return {kUint, s.particles};
+    case Buffer::SortedMaterial:
+      return {kUint, s.particles};
     case Buffer::BodyPos:
     case Buffer::BodyQuat:
     case Buffer::BodyVel:
@@ -71,19 +104,24 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
     case Buffer::BodyAngVel:
     case Buffer::BodyInvInertia:
     case Buffer::BodyForce:
-    case Buffer::BodyTorque: return {kVec4, s.bodies};
-    case Buffer::BodyFirst: return {kUint, std::size_t{s.bodies} + 1};
-    case Buffer::GridCellStart: return {kUint, std::size_t{s.table} + 1};
+    case Buffer::BodyTorque:
+      return {kVec4, s.bodies};
+    case Buffer::BodyFirst:
+      return {kUint, std::size_t{s.bodies} + 1};
+    case Buffer::GridCellStart:
+      return {kUint, std::size_t{s.table} + 1};
     case Buffer::ContactLaws:
       return {sizeof(shared::ContactLaw), std::size_t{s.materials} * s.materials};
-    case Buffer::Planes: return {sizeof(shared::PlaneData), s.planes};
-    case Buffer::Count: break;
+    case Buffer::Planes:
+      return {sizeof(shared::PlaneData), s.planes};
+    case Buffer::Count:
+      break;
   }
   return {};
 }
 
 std::uint32_t grid_table_size(std::uint32_t particles) {
-  const std::uint64_t want = std::uint64_t{particles} * 2;
+  const std::uint64_t want = std::uint64_t{particles} * 4;
   std::uint64_t t = std::bit_ceil(want < 64 ? std::uint64_t{64} : want);
   if (t > (std::uint64_t{1} << 31)) t = std::uint64_t{1} << 31;
   return static_cast<std::uint32_t>(t);

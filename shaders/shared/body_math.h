@@ -30,14 +30,23 @@ MOTES_FN void body_integrate(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
   vec3 v = xyz(vel) + (xyz(force) * inv_m + xyz(gravity_dt)) * dt;
   vec3 x = xyz(pos_invm) + v * dt;
   vec3 l = xyz(angmom) + xyz(torque) * dt;
-  vec3 w = body_angular_velocity(quat, inv_inertia, l);
-  vec4 q = quat_integrate(quat, w, dt);
-  w = body_angular_velocity(q, inv_inertia, l);
+  vec4 q = quat;
+  vec3 w = vec3(0.0f);
+  if (l.x != 0.0f || l.y != 0.0f || l.z != 0.0f) {  // a body at rest in rotation stays so
+    w = body_angular_velocity(quat, inv_inertia, l);
+    q = quat_integrate(quat, w, dt);
+    w = body_angular_velocity(q, inv_inertia, l);
+  }
   pos_invm = vec4(x, inv_m);
   quat = q;
   vel = vec4(v, 0.0f);
   angmom = vec4(l, 0.0f);
   angvel = vec4(w, 0.0f);
+}
+
+/// Torque about the centre of mass of a force applied at a particle centre.
+MOTES_FN vec3 particle_torque(vec4 particle_pos, vec4 body_pos, vec4 force) {
+  return cross(xyz(particle_pos) - xyz(body_pos), xyz(force));
 }
 
 /// World position of a body's particle (local: body-frame offset from the centre of mass).

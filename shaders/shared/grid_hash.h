@@ -17,7 +17,12 @@ MOTES_FN int grid_cell_coord(float x, float inv_cell_size) {
 
 /// Base bucket of the row of cells (., cy, cz), before the x index is added.
 MOTES_FN uint grid_row_hash(int cy, int cz) {
-  return (uint(cy) * 73856093u) ^ (uint(cz) * 19349663u);
+  // Two odd multipliers, then a xor-shift-multiply finalizer so that nearby rows land far apart.
+  uint h = uint(cy) * 0x9E3779B1u + uint(cz) * 0x85EBCA77u;
+  h = h ^ (h >> 15u);
+  h = h * 0x2C1B3C6Du;
+  h = h ^ (h >> 12u);
+  return h;
 }
 
 MOTES_FN uint grid_bucket(int cx, int cy, int cz, uint table_mask) {

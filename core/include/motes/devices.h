@@ -21,8 +21,16 @@ struct BackendReport {
 /// Every backend motes knows, in preference order (cuda, vulkan, openmp).
 std::vector<BackendReport> list_backends();
 
+/// Options for opening a device.
+struct DeviceOptions {
+  int cpu_threads = 0;  ///< OpenMP backend threads; 0 = OpenMP's default (OMP_NUM_THREADS or cores)
+  /// OpenMP backend: loops over fewer items run on one thread (-1: the backend's default, 2048).
+  int cpu_min_parallel = -1;
+};
+
 /// Opens device `index` (-1: the backend's default) of `backend`; "auto" picks the first backend
 /// in preference order that has a device.
-Result<std::unique_ptr<Device>> open_device(const std::string& backend, int index = -1);
+Result<std::unique_ptr<Device>> open_device(const std::string& backend, int index = -1,
+                                            const DeviceOptions& options = {});
 
 }  // namespace motes

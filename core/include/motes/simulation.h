@@ -52,6 +52,13 @@ class Simulation {
   /// Checks every body and particle for NaN or infinity; the error names step, body and particle.
   Status check_finite();
 
+  /// Writes the dynamic state (bodies, particles, step, time) to a checkpoint file.
+  Status save_state(const std::string& path);
+  /// Restores a checkpoint written by save_state for the same scene (same particle and body
+  /// counts). A missing, truncated or corrupt file, or one of another scene, is refused and the
+  /// running state is left untouched.
+  Status load_state(const std::string& path);
+
   [[nodiscard]] double time() const { return time_; }
   [[nodiscard]] std::uint64_t steps() const { return steps_; }
   [[nodiscard]] const Settings& settings() const { return settings_; }

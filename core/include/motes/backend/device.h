@@ -79,7 +79,7 @@ struct BufferLayout {
 };
 BufferLayout buffer_layout(Buffer b, const Sizes& sizes);
 
-/// Hash-table size the core uses for n particles: the power of two >= 2n, at least 64.
+/// Hash-table size the core uses for n particles: the power of two >= 4n, at least 64.
 std::uint32_t grid_table_size(std::uint32_t particles);
 
 /// Time spent per kernel family since the last reset (seconds) and launch counts.

@@ -1,0 +1,32 @@
+// bodies_integrate: one semi-implicit Euler step of every body (shared/body_math.h).
+#include <chrono>
+#include <cstdint>
+
+#include "openmp_device.h"
+#include "shared/body_math.h"
+
+namespace motes::openmp {
+
+using shared::vec4;
+
+void OpenMPDevice::bodies_integrate(const shared::StepParams& p) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto bodies = static_cast<std::int64_t>(p.body_count);
+  vec4* pos = buf<vec4>(Buffer::BodyPos);
+  vec4* quat = buf<vec4>(Buffer::BodyQuat);
+  vec4* vel = buf<vec4>(Buffer::BodyVel);
+  vec4* angmom = buf<vec4>(Buffer::BodyAngMom);
+  vec4* angvel = buf<vec4>(Buffer::BodyAngVel);
+  const vec4* inv_inertia = buf<vec4>(Buffer::BodyInvInertia);
+  const vec4* force = buf<vec4>(Buffer::BodyForce);
+  const vec4* torque = buf<vec4>(Buffer::BodyTorque);
+
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(bodies))
+  for (std::int64_t b = 0; b < bodies; ++b) {
+    shared::body_integrate(pos[b], quat[b], vel[b], angmom[b], angvel[b], inv_inertia[b], force[b],
+                           torque[b], p.gravity_dt);
+  }
+  record(Kernel::BodiesIntegrate, start);
+}
+
+}  // namespace motes::openmp

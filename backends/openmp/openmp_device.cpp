@@ -1,0 +1,123 @@
+// OpenMPDevice: buffers, host transfers and timing. Kernels live in one file per family.
+#include "openmp_device.h"
+
+#include <fmt/format.h>
+
+#include <cstring>
+#include <fstream>
+#include <string>
+
+#ifdef MOTES_HAVE_OPENMP
+#include <omp.h>
+#endif
+
+namespace motes::openmp {
+
+AlignedBuffer::AlignedBuffer(std::size_t bytes)
+    : data_(static_cast<std::byte*>(::operator new[](bytes == 0 ? 64 : bytes,
+                                                     std::align_val_t{64}))),
+      size_(bytes) {}
+
+namespace {
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      auto colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(line.find_first_not_of(' ', colon + 1));
+    }
+  }
+  return "CPU";
+}
+
+int default_threads() {
+#ifdef MOTES_HAVE_OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+
+}  // namespace
+
+DeviceInfo describe(int threads) {
+  DeviceInfo d;
+  d.backend = "openmp";
+  d.index = 0;
+  d.name = cpu_model();
+  const int t = threads > 0 ? threads : default_threads();
+#ifdef MOTES_HAVE_OPENMP
+  d.detail = fmt::format("{} thread{} (OpenMP {})", t, t == 1 ? "" : "s", _OPENMP);
+#else
+  d.detail = "1 thread (built without OpenMP)";
+#endif
+  return d;
+}
+
+OpenMPDevice::OpenMPDevice(int threads, int min_parallel)
+    : min_parallel_(min_parallel < 0 ? kDefaultMinParallel : min_parallel) {
+#ifdef MOTES_HAVE_OPENMP
+  threads_ = threads > 0 ? threads : default_threads();
+#else
+  threads_ = 1;
+#endif
+  info_ = describe(threads_);
+}
+
+Status OpenMPDevice::allocate(const Sizes& sizes) {
+  if (sizes.table < 64 || (sizes.table & (sizes.table - 1)) != 0) {
+    return Status::error(fmt::format("grid table size {} is not a power of two >= 64", sizes.table));
+  }
+  try {
+    std::vector<AlignedBuffer> fresh;
+    fresh.reserve(kBufferCount);
+    for (std::size_t i = 0; i < kBufferCount; ++i) {
+      fresh.emplace_back(buffer_layout(static_cast<Buffer>(i), sizes).bytes());
+    }
+    sorted_keys_.assign(sizes.particles, 0);
+    keys_tmp_.assign(sizes.particles, 0);
+    ids_tmp_.assign(sizes.particles, 0);
+    buffers_ = std::move(fresh);
+  } catch (const std::bad_alloc&) {
+    return Status::error(fmt::format(
+        "out of host memory allocating {} particles and {} bodies on the openmp device",
+        sizes.particles, sizes.bodies));
+  }
+  sizes_ = sizes;
+  // Outputs start defined (zero) so a read before the first kernel is deterministic.
+  for (auto& b : buffers_) std::memset(b.data(), 0, b.size());
+  return Status::ok();
+}
+
+Status OpenMPDevice::write(Buffer b, const void* src, std::size_t bytes) {
+  const auto i = static_cast<std::size_t>(b);
+  if (i >= buffers_.size()) return Status::error("openmp: write before allocate");
+  if (bytes > buffers_[i].size()) {
+    return Status::error(fmt::format("openmp: writing {} bytes into {} of {} bytes", bytes,
+                                     buffer_name(b), buffers_[i].size()));
+  }
+  if (bytes > 0) std::memcpy(buffers_[i].data(), src, bytes);
+  return Status::ok();
+}
+
+Status OpenMPDevice::read(Buffer b, void* dst, std::size_t bytes) {
+  const auto i = static_cast<std::size_t>(b);
+  if (i >= buffers_.size()) return Status::error("openmp: read before allocate");
+  if (bytes > buffers_[i].size()) {
+    return Status::error(fmt::format("openmp: reading {} bytes from {} of {} bytes", bytes,
+                                     buffer_name(b), buffers_[i].size()));
+  }
+  if (bytes > 0) std::memcpy(dst, buffers_[i].data(), bytes);
+  return Status::ok();
+}
+
+void OpenMPDevice::record(Kernel k, std::chrono::steady_clock::time_point start) {
+  if (!timing_) return;
+  const auto i = static_cast<std::size_t>(k);
+  times_.seconds[i] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  times_.launches[i] += 1;
+}
+
+}  // namespace motes::openmp

@@ -1,0 +1,85 @@
+// The CPU backend: every kernel family as OpenMP loops over the shared physics headers.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <new>
+#include <vector>
+
+#include "motes/backend/device.h"
+
+namespace motes::openmp {
+
+/// Heap memory aligned for vec4 and cache lines; contents uninitialised.
+class AlignedBuffer {
+ public:
+  AlignedBuffer() = default;
+  explicit AlignedBuffer(std::size_t bytes);
+  [[nodiscard]] std::byte* data() { return data_.get(); }
+  [[nodiscard]] std::size_t size() const { return size_; }
+
+ private:
+  struct Free {
+    void operator()(std::byte* p) const { ::operator delete[](p, std::align_val_t{64}); }
+  };
+  std::unique_ptr<std::byte[], Free> data_;
+  std::size_t size_ = 0;
+};
+
+class OpenMPDevice final : public Device {
+ public:
+  /// threads = 0: OpenMP's default (OMP_NUM_THREADS or the number of cores). Loops over fewer
+  /// than min_parallel items run on one thread (< 0: kDefaultMinParallel).
+  explicit OpenMPDevice(int threads, int min_parallel = -1);
+
+  /// Below about this many items, starting and joining threads costs more than it saves.
+  static constexpr int kDefaultMinParallel = 2048;
+
+  [[nodiscard]] const DeviceInfo& info() const override { return info_; }
+  Status allocate(const Sizes& sizes) override;
+  Status write(Buffer b, const void* src, std::size_t bytes) override;
+  Status read(Buffer b, void* dst, std::size_t bytes) override;
+
+  void grid_build(const shared::StepParams& p) override;
+  void contacts_compute(const shared::StepParams& p) override;
+  void bodies_reduce(const shared::StepParams& p) override;
+  void bodies_integrate(const shared::StepParams& p) override;
+  void particles_update(const shared::StepParams& p) override;
+
+  Status synchronize() override { return Status::ok(); }
+  void set_timing(bool on) override { timing_ = on; }
+  [[nodiscard]] KernelTimes kernel_times() const override { return times_; }
+  void reset_kernel_times() override { times_ = {}; }
+
+  [[nodiscard]] int threads() const { return threads_; }
+
+ private:
+  [[nodiscard]] bool parallel(std::int64_t items) const {
+    return threads_ > 1 && items >= min_parallel_;
+  }
+  template <typename T>
+  T* buf(Buffer b) {
+    return reinterpret_cast<T*>(buffers_[static_cast<std::size_t>(b)].data());
+  }
+  /// Stable LSD radix sort of (GridBucket[i], i) into (sorted_keys_, GridOrder).
+  void sort_by_bucket(std::uint32_t n, std::uint32_t key_bits);
+
+  /// Adds the time since `start` to kernel k when timing is on.
+  void record(Kernel k, std::chrono::steady_clock::time_point start);
+
+  DeviceInfo info_;
+  int threads_ = 1;
+  std::int64_t min_parallel_ = kDefaultMinParallel;
+  Sizes sizes_;
+  std::vector<AlignedBuffer> buffers_;
+  std::vector<std::uint32_t> sorted_keys_, keys_tmp_, ids_tmp_, histograms_;
+  bool timing_ = false;
+  KernelTimes times_;
+};
+
+/// Describes the CPU device without opening it (for `motes devices`).
+DeviceInfo describe(int threads);
+
+}  // namespace motes::openmp

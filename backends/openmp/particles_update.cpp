@@ -1,0 +1,34 @@
+// particles_update: particle positions and velocities follow their body's pose.
+#include <chrono>
+#include <cstdint>
+
+#include "openmp_device.h"
+#include "shared/body_math.h"
+
+namespace motes::openmp {
+
+using shared::uint;
+using shared::vec4;
+
+void OpenMPDevice::particles_update(const shared::StepParams& p) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto n = static_cast<std::int64_t>(p.particle_count);
+  const uint* body = buf<uint>(Buffer::ParticleBody);
+  const vec4* local = buf<vec4>(Buffer::ParticleLocal);
+  const vec4* body_pos = buf<vec4>(Buffer::BodyPos);
+  const vec4* quat = buf<vec4>(Buffer::BodyQuat);
+  const vec4* body_vel = buf<vec4>(Buffer::BodyVel);
+  const vec4* angvel = buf<vec4>(Buffer::BodyAngVel);
+  vec4* pos = buf<vec4>(Buffer::ParticlePos);
+  vec4* vel = buf<vec4>(Buffer::ParticleVel);
+
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
+  for (std::int64_t i = 0; i < n; ++i) {
+    const uint b = body[i];
+    pos[i] = vec4(shared::particle_position(body_pos[b], quat[b], local[i]), pos[i].w);
+    vel[i] = vec4(shared::particle_velocity(quat[b], body_vel[b], angvel[b], local[i]), vel[i].w);
+  }
+  record(Kernel::ParticlesUpdate, start);
+}
+
+}  // namespace motes::openmp

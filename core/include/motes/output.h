@@ -1,0 +1,71 @@
+// Output files: per-frame VTU files with a .pvd series (ParaView), and CSV (scripts).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "motes/simulation.h"
+#include "motes/status.h"
+
+namespace motes {
+
+/// What `motes run --format` writes.
+enum class OutputFormat { Vtu, Csv, None };
+
+/// "vtu", "csv" or "none"; anything else is an error naming the value.
+Result<OutputFormat> parse_output_format(const std::string& name);
+/// The name parse_output_format() accepts for `format`.
+const char* output_format_name(OutputFormat format);
+
+/// Receives the frames of a run, one Snapshot each. Frames are numbered 0, 1, 2... in call order.
+/// Every error is a Status whose message names the file or directory involved.
+class FrameWriter {
+ public:
+  FrameWriter() = default;
+  FrameWriter(const FrameWriter&) = delete;
+  FrameWriter& operator=(const FrameWriter&) = delete;
+  virtual ~FrameWriter() = default;
+
+  /// Writes the next frame. After it returns ok, the frame is complete on disk.
+  virtual Status write_frame(const Snapshot& snapshot) = 0;
+  /// Closes the files; reports any error that closing revealed. Idempotent.
+  virtual Status finish() = 0;
+  /// Frames written so far.
+  [[nodiscard]] virtual std::size_t frames() const = 0;
+  /// The file a user opens to see the run: the .pvd series or the .csv file.
+  [[nodiscard]] virtual const std::string& main_path() const = 0;
+};
+
+/// VTU series in `dir` (created if missing): particles_000000.vtu, particles_000001.vtu, ... and
+/// particles.pvd listing every frame with its simulated time. The .pvd is rewritten (atomically,
+/// by rename) after each frame, so an interrupted run still opens in ParaView.
+///
+/// Each .vtu is an UnstructuredGrid of VTK_VERTEX cells, one per particle, in binary appended raw
+/// encoding (header_type UInt64, the machine's byte order). Points are Float32 particle centres;
+/// point data: "velocity" (Float32 x 3), "radius" (Float32), "body" (UInt32 body index) and
+/// "speed" (Float32: the length of the velocity, computed in double and rounded to float). Field
+/// data "TimeValue" (Float64) holds the simulated time.
+Result<std::unique_ptr<FrameWriter>> open_vtu_writer(const std::string& dir);
+
+/// CSV file `dir`/particles.csv (dir created if missing), one row per particle per frame, with
+/// the header line `frame,time,particle,body,x,y,z,vx,vy,vz`. Floats are printed with the fewest
+/// digits that read back to the same float32 (time: the same double). Flushed after each frame.
+Result<std::unique_ptr<FrameWriter>> open_csv_writer(const std::string& dir);
+
+/// open_vtu_writer or open_csv_writer; OutputFormat::None is an error (write nothing instead).
+Result<std::unique_ptr<FrameWriter>> open_frame_writer(OutputFormat format, const std::string& dir);
+
+/// Writes one snapshot as a single .vtu file (same layout as the series), not listed in any .pvd.
+Status write_vtu_file(const std::string& path, const Snapshot& snapshot);
+
+/// Writes points as CSV with the header `x,y,z` (shortest round-trip float32 values).
+Status write_points_csv(const std::string& path, const std::vector<Eigen::Vector3f>& points);
+
+/// A snapshot at time 0 of one body made of `points` (radius = diameter / 2, velocity zero),
+/// for writing a particle set with write_vtu_file.
+Snapshot particle_set_snapshot(const std::vector<Eigen::Vector3f>& points, double diameter);
+
+}  // namespace motes

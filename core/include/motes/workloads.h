@@ -1,0 +1,24 @@
+// The fixed benchmark workloads of docs/benchmarks.md, built as scenes.
+#pragma once
+
+#include <cstdint>
+
+#include "motes/scene.h"
+
+namespace motes {
+
+/// W1 "settle": NX x NY x NZ free spheres (d = 0.01 m, density 2500 kg/m^3) on a simple-cubic
+/// lattice of spacing 1.1 d with a seeded random offset in [-0.01 d, 0.01 d] per coordinate,
+/// falling into a box open at the top (floor y = 0, walls x = 0, x = (NX+1) s, z = 0,
+/// z = (NZ+1) s); k = 2000 N/m, gamma_n = 50/s, gamma_t = 25/s, mu = 0.5 (LAMMPS gran/hooke);
+/// dt = 2e-5 s. Sphere mass = density * pi/6 d^3, as in LAMMPS.
+Scene settle_workload(int nx, int ny, int nz, std::uint64_t seed = 12345);
+
+/// NX x NY x NZ for a W1 size in docs/benchmarks.md (16,384 ... 16,777,216); false if not one.
+bool settle_dimensions(std::uint64_t particles, int& nx, int& ny, int& nz);
+
+/// W2 "dominoes": `count` dominoes of 1 x 3 x 5 particles (d = 0.01 m) in `rows` parallel rows
+/// on a floor, pitch 0.6 x domino height along a row; the first of each row is tipped.
+Scene dominoes_workload(int count, int rows);
+
+}  // namespace motes

@@ -1,0 +1,53 @@
+// Helpers shared by the output writers: files whose errors become Status messages naming the path.
+#pragma once
+
+#include <cstddef>
+#include <cstdio>
+#include <string>
+
+#include "motes/simulation.h"
+#include "motes/status.h"
+
+namespace motes::output {
+
+/// A file opened for binary writing; every failure names the path and the system's reason.
+class OutputFile {
+ public:
+  OutputFile() = default;
+  OutputFile(OutputFile&& other) noexcept;
+  OutputFile& operator=(OutputFile&& other) noexcept;
+  OutputFile(const OutputFile&) = delete;
+  OutputFile& operator=(const OutputFile&) = delete;
+  /// Closes the file if still open, ignoring errors (call close() to see them).
+  ~OutputFile();
+
+  /// Creates or truncates `path`.
+  static Result<OutputFile> create(const std::string& path);
+
+  Status write(const void* data, std::size_t bytes);
+  Status write(const std::string& text) { return write(text.data(), text.size()); }
+  /// Pushes buffered bytes to the operating system.
+  Status flush();
+  /// Flushes and closes; the file is closed afterwards even on error.
+  Status close();
+
+  [[nodiscard]] bool is_open() const { return file_ != nullptr; }
+  [[nodiscard]] const std::string& path() const { return path_; }
+
+ private:
+  Status fail(const char* what, int error);
+
+  std::FILE* file_ = nullptr;
+  std::string path_;
+};
+
+/// Creates `dir` and its parents if missing; an error if it cannot, or if it is not a directory.
+Status create_directory(const std::string& dir);
+
+/// Renames `from` to `to`, replacing `to` atomically.
+Status replace_file(const std::string& from, const std::string& to);
+
+/// Checks that a snapshot's particle arrays have one entry per particle.
+Status check_snapshot(const Snapshot& snapshot);
+
+}  // namespace motes::output

@@ -1,0 +1,150 @@
+// Scene bodies: the "bodies" array, with repeats expanded into named copies sharing one shape.
+#include <fmt/format.h>
+
+#include <limits>
+#include <map>
+
+#include "scene_parts.h"
+
+namespace motes::scene_detail {
+
+namespace {
+
+/// Positions and orientations of the copies of a repeated body.
+struct Repeat {
+  Eigen::Matrix<std::int64_t, 3, 1> grid{1, 1, 1};  ///< copies along x, y, z
+  Eigen::Vector3d offset_x = Eigen::Vector3d::Zero();
+  Eigen::Vector3d offset_y = Eigen::Vector3d::Zero();
+  Eigen::Vector3d offset_z = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond step = Eigen::Quaterniond::Identity();  ///< extra rotation per copy
+  bool repeated = false;
+
+  [[nodiscard]] std::int64_t copies() const { return grid[0] * grid[1] * grid[2]; }
+};
+
+Repeat read_repeat(const Node& node, std::int64_t max_copies) {
+  node.expect_object({"count", "offset", "grid", "spacing", "rotation"});
+  Repeat r;
+  r.repeated = true;
+  if (node.has("count") == node.has("grid")) {
+    node.fail("give either \"count\" with \"offset\", or \"grid\" with \"spacing\"");
+  }
+  if (auto count = node.find("count")) {
+    if (node.has("spacing"))
+      node.at("spacing").fail("\"spacing\" goes with \"grid\", not \"count\"");
+    r.grid[0] = count->integer(1, max_copies);
+    r.offset_x = node.at("offset").vec3();
+  } else {
+    if (node.has("offset")) node.at("offset").fail("\"offset\" goes with \"count\", not \"grid\"");
+    const Node grid = node.at("grid");
+    r.grid = grid.int3(1, max_copies);
+    const double total = static_cast<double>(r.grid[0]) * static_cast<double>(r.grid[1]) *
+                         static_cast<double>(r.grid[2]);
+    if (total > static_cast<double>(max_copies)) {
+      grid.fail(
+          fmt::format("{} copies is more than settings.max_particles ({})", total, max_copies));
+    }
+    const Eigen::Vector3d spacing = node.at("spacing").vec3();
+    r.offset_x = Eigen::Vector3d(spacing.x(), 0.0, 0.0);
+    r.offset_y = Eigen::Vector3d(0.0, spacing.y(), 0.0);
+    r.offset_z = Eigen::Vector3d(0.0, 0.0, spacing.z());
+  }
+  if (auto rot = node.find("rotation")) r.step = read_rotation(*rot);
+  return r;
+}
+
+Eigen::Vector3d read_vector_or_zero(const Node& body, std::string_view key) {
+  if (auto v = body.find(key)) return v->vec3();
+  return Eigen::Vector3d::Zero();
+}
+
+}  // namespace
+
+int find_material(const Node& where, const std::vector<Material>& materials) {
+  const std::string name = where.string();
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < materials.size(); ++i) {
+    if (materials[i].name == name) return static_cast<int>(i);
+    names.push_back(materials[i].name);
+  }
+  where.fail(fmt::format("unknown material \"{}\" (defined: {})", name, fmt::join(names, ", ")));
+}
+
+void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
+                 std::vector<BodyEntry>& entries) {
+  bodies.expect_array();
+  if (bodies.size() == 0) bodies.fail("a scene needs at least one body");
+  std::map<std::string, std::string> names;  // body name -> JSON path that made it
+  std::uint64_t particles = 0;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const Node body = bodies.at(i);
+    body.expect_object({"name", "kind", "shape", "material", "position", "rotation", "velocity",
+                        "angular_velocity", "repeat"});
+    BodySpec spec;
+    spec.name = body.has("name") ? body.at("name").string() : fmt::format("body{}", i);
+    if (auto kind = body.find("kind")) {
+      const std::string k = kind->string();
+      if (k == "static") {
+        spec.kind = BodyKind::Static;
+      } else if (k != "dynamic") {
+        kind->fail(fmt::format("must be \"dynamic\" or \"static\", got \"{}\"", k));
+      }
+    }
+    spec.material = body.has("material") ? find_material(body.at("material"), scene.materials) : 0;
+    spec.position = read_vector_or_zero(body, "position");
+    if (auto rot = body.find("rotation")) spec.rotation = read_rotation(*rot);
+    spec.velocity = read_vector_or_zero(body, "velocity");
+    spec.angular_velocity = read_vector_or_zero(body, "angular_velocity");
+    if (spec.kind == BodyKind::Static) {
+      for (const char* key : {"velocity", "angular_velocity"}) {
+        if (body.has(key) && !body.at(key).vec3().isZero(0.0)) {
+          body.at(key).fail("a static body cannot move (make it \"dynamic\" or remove this)");
+        }
+      }
+    }
+    const std::int64_t max_copies = cache.max_particles;
+    const Repeat repeat =
+        body.has("repeat") ? read_repeat(body.at("repeat"), max_copies) : Repeat{};
+    spec.shape = read_shape(body.at("shape"), cache);
+
+    // Count before expanding, so an oversized scene is refused before it is built.
+    const std::uint64_t copies = static_cast<std::uint64_t>(repeat.copies());
+    particles += copies * spec.shape->points.size();
+    if (particles > static_cast<std::uint64_t>(cache.max_particles)) {
+      body.fail(
+          fmt::format("the scene would have {} particles, more than settings.max_particles "
+                      "({})",
+                      particles, cache.max_particles));
+    }
+
+    entries.push_back(BodyEntry{scene.bodies.size(), copies, body.path()});
+    Eigen::Quaterniond step_rotation = Eigen::Quaterniond::Identity();
+    std::int64_t index = 0;
+    for (std::int64_t z = 0; z < repeat.grid[2]; ++z) {
+      for (std::int64_t y = 0; y < repeat.grid[1]; ++y) {
+        for (std::int64_t x = 0; x < repeat.grid[0]; ++x, ++index) {
+          BodySpec copy = spec;
+          if (repeat.repeated) copy.name = fmt::format("{}[{}]", spec.name, index);
+          copy.position = spec.position + static_cast<double>(x) * repeat.offset_x +
+                          static_cast<double>(y) * repeat.offset_y +
+                          static_cast<double>(z) * repeat.offset_z;
+          if (!(copy.position.cwiseAbs().maxCoeff() <=
+                static_cast<double>(std::numeric_limits<float>::max()))) {
+            body.at("repeat").fail(fmt::format("copy {} lands outside the float range", index));
+          }
+          copy.rotation = (step_rotation * spec.rotation).normalized();
+          step_rotation = (repeat.step * step_rotation).normalized();
+          const std::string where = repeat.repeated ? body.path() + "/repeat" : body.path();
+          if (auto [it, added] = names.emplace(copy.name, where); !added) {
+            const Node name_node = body.has("name") ? body.at("name") : body;
+            name_node.fail(
+                fmt::format("duplicate body name \"{}\" (also made by {})", copy.name, it->second));
+          }
+          scene.bodies.push_back(std::move(copy));
+        }
+      }
+    }
+  }
+}
+
+}  // namespace motes::scene_detail

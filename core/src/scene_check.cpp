@@ -1,0 +1,113 @@
+// Scene checks on the whole scene: the explicit stability limit of the contact law.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <utility>
+
+#include "contact_laws.h"
+#include "scene_parts.h"
+
+namespace motes::scene_detail {
+
+namespace {
+
+/// Dynamic bodies that behave alike in a contact: same material and particle mass.
+struct BodyClass {
+  int material = 0;
+  double particle_mass = 0.0;
+  std::size_t copies = 0;
+  std::string name;  ///< first body of the class, for messages
+};
+
+/// The worst contact found so far.
+struct Limit {
+  double h = std::numeric_limits<double>::infinity();
+  std::string what;
+};
+
+/// Largest stable step of semi-implicit Euler on a contact of effective mass m_eff:
+/// x'' = -w0^2 x - gamma_n x' is stable iff (w0 h)^2 + 2 gamma_n h < 4, and the tangential
+/// dashpot v' = -gamma_t v iff gamma_t h < 2.
+double stable_step(const shared::ContactLaw& law, double m_eff) {
+  const double k = static_cast<double>(law.stiffness);
+  const double gn = static_cast<double>(law.damping);
+  const double gt = static_cast<double>(law.tangential);
+  const double w2 = k / m_eff;
+  double h = (-gn + std::sqrt(gn * gn + 4.0 * w2)) / w2;
+  if (gt > 0.0) h = std::min(h, 2.0 / gt);
+  return h;
+}
+
+}  // namespace
+
+void check_stability(const Scene& scene, const std::vector<BodyEntry>& entries) {
+  std::map<std::pair<int, double>, BodyClass> dynamic;
+  std::map<int, std::string> partners;  // material of static bodies and planes -> first user
+  for (const BodyEntry& e : entries) {
+    const BodySpec& b = scene.bodies[e.first];
+    const Material& mat = scene.materials[static_cast<std::size_t>(b.material)];
+    if (b.kind == BodyKind::Static) {
+      partners.emplace(b.material, fmt::format("static body \"{}\"", b.name));
+      continue;
+    }
+    const double d = b.shape->diameter;
+    const double m = mat.density * d * d * d;
+    BodyClass& c = dynamic[{b.material, m}];
+    if (c.copies == 0) c = BodyClass{b.material, m, 0, b.name};
+    c.copies += e.copies;
+  }
+  for (const PlaneSpec& p : scene.planes) {
+    partners.emplace(p.material, fmt::format("plane \"{}\"", p.name));
+  }
+
+  const std::vector<shared::ContactLaw> laws = contact_law_table(scene.materials);
+  const std::size_t count = scene.materials.size();
+  const auto law = [&](int a, int b) {
+    return laws[static_cast<std::size_t>(a) * count + static_cast<std::size_t>(b)];
+  };
+  Limit worst;
+  const auto consider = [&](const BodyClass& a, int other_material, double m_eff,
+                            const std::string& other) {
+    const shared::ContactLaw l = law(a.material, other_material);
+    const double h = stable_step(l, m_eff);
+    if (h < worst.h) {
+      worst.h = h;
+      worst.what = fmt::format(
+          "body \"{}\" (material \"{}\", particle mass {:.4g} kg) against {} (material \"{}\"): "
+          "k = {:.4g} N/m, damping = {:.4g} 1/s, tangential = {:.4g} 1/s, m* = {:.4g} kg, "
+          "w0 = {:.4g} rad/s",
+          a.name, scene.materials[static_cast<std::size_t>(a.material)].name, a.particle_mass,
+          other, scene.materials[static_cast<std::size_t>(other_material)].name,
+          static_cast<double>(l.stiffness), static_cast<double>(l.damping),
+          static_cast<double>(l.tangential), m_eff,
+          std::sqrt(static_cast<double>(l.stiffness) / m_eff));
+    }
+  };
+  for (const auto& [key_a, a] : dynamic) {
+    for (const auto& [material, name] : partners) consider(a, material, a.particle_mass, name);
+    for (const auto& [key_b, b] : dynamic) {
+      // A body does not touch itself: a class meets itself only through a second copy.
+      if (key_a == key_b && a.copies < 2) continue;
+      const double m_eff = a.particle_mass * b.particle_mass / (a.particle_mass + b.particle_mass);
+      consider(a, b.material, m_eff, fmt::format("body \"{}\"", b.name));
+    }
+  }
+
+  const Settings& s = scene.settings;
+  const double h = s.dt / s.substeps;
+  if (h < worst.h) return;
+  const double largest_dt = worst.h * s.substeps;
+  const double needed_substeps = std::floor(s.dt / worst.h) + 1.0;
+  static const Json none;
+  Node(none, "/settings/dt", scene.source)
+      .fail(fmt::format(
+          "unstable: a substep of {:.4g} s (dt {:.4g} s / substeps {}) is not below the explicit "
+          "stability limit {:.4g} s of the contact of {}; the largest stable dt is just under "
+          "{:.4g} s at "
+          "substeps {} (or keep dt and use substeps >= {:.0f})",
+          h, s.dt, s.substeps, worst.h, worst.what, largest_dt, s.substeps, needed_substeps));
+}
+
+}  // namespace motes::scene_detail

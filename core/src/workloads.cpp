@@ -1,0 +1,153 @@
+// Benchmark workloads W1 "settle" and W2 "dominoes" (docs/benchmarks.md).
+#include "motes/workloads.h"
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+
+#include <fmt/format.h>
+
+namespace motes {
+
+namespace {
+
+/// SplitMix64: a small, fully specified generator (identical on every platform).
+double uniform01(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  return static_cast<double>(z >> 11) * 0x1.0p-53;
+}
+
+PlaneSpec plane(const char* name, Eigen::Vector3d normal, Eigen::Vector3d point) {
+  PlaneSpec p;
+  p.name = name;
+  p.normal = normal;
+  p.point = point;
+  p.material = 0;
+  return p;
+}
+
+}  // namespace
+
+Scene settle_workload(int nx, int ny, int nz, std::uint64_t seed) {
+  constexpr double d = 0.01;
+  const double s = 1.1 * d;
+  Scene scene;
+  scene.source = fmt::format("<W1 settle {}x{}x{}>", nx, ny, nz);
+  scene.settings.dt = 2e-5;
+  scene.settings.substeps = 1;
+  scene.settings.gravity = {0.0, -9.81, 0.0};
+  scene.settings.particle_diameter = d;
+  scene.settings.duration = 1.2;
+  Material m;
+  m.name = "glass";
+  // The lattice-cell mass density * d^3 is scaled so each sphere weighs density * pi/6 d^3.
+  m.density = 2500.0 * std::numbers::pi / 6.0;
+  m.stiffness = 2000.0;
+  m.damping = 50.0;
+  m.tangential = 25.0;
+  m.friction = 0.5;
+  scene.materials.push_back(m);
+  scene.settings.contact = m;
+
+  auto sphere = std::make_shared<ParticleSet>();
+  sphere->points.emplace_back(0.0f, 0.0f, 0.0f);
+  sphere->diameter = d;
+
+  scene.bodies.reserve(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) *
+                       static_cast<std::size_t>(nz));
+  std::uint64_t state = seed;
+  // Order i fastest, then k, then j (bottom layer first), matching LAMMPS's lattice fill.
+  for (int j = 1; j <= ny; ++j) {
+    for (int k = 1; k <= nz; ++k) {
+      for (int i = 1; i <= nx; ++i) {
+        BodySpec b;
+        b.kind = BodyKind::Dynamic;
+        b.shape = sphere;
+        b.material = 0;
+        const double ox = (2.0 * uniform01(state) - 1.0) * 0.01 * d;
+        const double oy = (2.0 * uniform01(state) - 1.0) * 0.01 * d;
+        const double oz = (2.0 * uniform01(state) - 1.0) * 0.01 * d;
+        b.position = {i * s + ox, j * s + oy, k * s + oz};
+        scene.bodies.push_back(std::move(b));
+      }
+    }
+  }
+  const double lx = (nx + 1) * s;
+  const double lz = (nz + 1) * s;
+  scene.planes.push_back(plane("floor", {0, 1, 0}, {0, 0, 0}));
+  scene.planes.push_back(plane("x0", {1, 0, 0}, {0, 0, 0}));
+  scene.planes.push_back(plane("x1", {-1, 0, 0}, {lx, 0, 0}));
+  scene.planes.push_back(plane("z0", {0, 0, 1}, {0, 0, 0}));
+  scene.planes.push_back(plane("z1", {0, 0, -1}, {0, 0, lz}));
+  return scene;
+}
+
+bool settle_dimensions(std::uint64_t particles, int& nx, int& ny, int& nz) {
+  struct Dims {
+    std::uint64_t n;
+    int x, y, z;
+  };
+  static constexpr Dims kSizes[] = {{16384, 32, 16, 32},     {65536, 64, 32, 32},
+                                    {262144, 64, 64, 64},    {1048576, 128, 64, 128},
+                                    {4194304, 256, 64, 256}, {16777216, 256, 256, 256}};
+  for (const Dims& s : kSizes) {
+    if (s.n == particles) {
+      nx = s.x;
+      ny = s.y;
+      nz = s.z;
+      return true;
+    }
+  }
+  return false;
+}
+
+Scene dominoes_workload(int count, int rows) {
+  constexpr double d = 0.01;
+  const double height = 5 * d;
+  const double pitch = 0.6 * height;
+  const double row_pitch = 3 * d + 2 * d;
+  Scene scene;
+  scene.source = fmt::format("<W2 dominoes {} in {} rows>", count, rows);
+  scene.settings.dt = 2e-5;
+  scene.settings.particle_diameter = d;
+  scene.settings.duration = 1.0;
+  Material m;
+  m.name = "wood";
+  m.density = 700.0;
+  m.stiffness = 2000.0;
+  m.damping = 1000.0;
+  m.tangential = 500.0;
+  m.friction = 0.5;
+  scene.materials.push_back(m);
+  scene.settings.contact = m;
+
+  auto domino = std::make_shared<ParticleSet>();
+  domino->diameter = d;
+  // 1 particle thick along the chain (x), 3 wide (z), 5 tall (y), centred at the origin.
+  for (int y = 0; y < 5; ++y) {
+    for (int z = 0; z < 3; ++z) {
+      domino->points.emplace_back(0.0f, static_cast<float>((y - 2) * d),
+                                  static_cast<float>((z - 1) * d));
+    }
+  }
+  const int per_row = (count + rows - 1) / rows;
+  scene.bodies.reserve(static_cast<std::size_t>(count));
+  for (int n = 0; n < count; ++n) {
+    const int row = n / per_row;
+    const int col = n % per_row;
+    BodySpec b;
+    b.name = fmt::format("domino[{}]", n);
+    b.shape = domino;
+    b.material = 0;
+    b.position = {col * pitch, 0.5 * height + 1e-4, row * row_pitch};
+    if (col == 0) b.angular_velocity = {0.0, 0.0, -8.0};  // tips towards +x
+    scene.bodies.push_back(std::move(b));
+  }
+  scene.planes.push_back(plane("floor", {0, 1, 0}, {0, 0, 0}));
+  return scene;
+}
+
+}  // namespace motes

@@ -1,0 +1,62 @@
+// Helpers shared by the subcommands.
+#include "cli_util.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace motes::cli {
+
+void fail(const std::string& message) {
+  fmt::print(stderr, "motes: error: {}\n", message);
+  // CLI::App::exit() returns a RuntimeError's code without printing anything more.
+  throw CLI::RuntimeError(kErrorExit);
+}
+
+std::string format_seconds(double seconds) {
+  if (!std::isfinite(seconds)) return "?";
+  if (seconds < 1.0) return fmt::format("{:.0f} ms", seconds * 1e3);
+  if (seconds < 60.0) return fmt::format("{:.1f} s", seconds);
+  const auto total = static_cast<long long>(std::llround(seconds));
+  if (total < 3600) return fmt::format("{} min {:02} s", total / 60, total % 60);
+  return fmt::format("{} h {:02} min", total / 3600, (total % 3600) / 60);
+}
+
+std::string format_si(double value) {
+  if (!std::isfinite(value)) return "?";
+  const char* suffixes[] = {"", " k", " M", " G", " T"};
+  std::size_t i = 0;
+  while (std::fabs(value) >= 999.5 && i + 1 < std::size(suffixes)) {
+    value /= 1000.0;
+    ++i;
+  }
+  const int decimals = std::fabs(value) >= 99.95 ? 0 : (std::fabs(value) >= 9.995 ? 1 : 2);
+  return fmt::format("{:.{}f}{}", value, i == 0 && value == std::floor(value) ? 0 : decimals,
+                     suffixes[i]);
+}
+
+namespace {
+
+CLI::Validator finite_number(bool allow_zero) {
+  const char* description = allow_zero ? "NUMBER >= 0" : "NUMBER > 0";
+  return CLI::Validator(
+      [allow_zero](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0') return fmt::format("'{}' is not a number", text);
+        if (!std::isfinite(v) || v < 0.0 || (!allow_zero && v == 0.0)) {
+          return fmt::format("'{}' must be a finite number {}", text, allow_zero ? ">= 0" : "> 0");
+        }
+        return {};
+      },
+      description);
+}
+
+}  // namespace
+
+CLI::Validator finite_non_negative() { return finite_number(true); }
+CLI::Validator finite_positive() { return finite_number(false); }
+
+}  // namespace motes::cli

@@ -1,0 +1,26 @@
+// Small helpers shared by the subcommands: error exits and number formatting.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace motes::cli {
+
+/// Exit code of scene, mesh, device and output errors.
+constexpr int kErrorExit = 2;
+
+/// Prints "motes: error: MESSAGE" on stderr and ends the command with exit code 2.
+[[noreturn]] void fail(const std::string& message);
+
+/// A duration for people: "850 ms", "12.3 s", "4 min 05 s", "2 h 03 min".
+std::string format_seconds(double seconds);
+
+/// A rate or count with three significant digits and an SI suffix: "1.23e+07" -> "12.3 M".
+std::string format_si(double value);
+
+/// Validator for a finite number >= 0 (CLI11's own checks let NaN and infinity through).
+CLI::Validator finite_non_negative();
+/// Validator for a finite number > 0.
+CLI::Validator finite_positive();
+
+}  // namespace motes::cli

@@ -1,0 +1,300 @@
+// `motes bench`: the fixed workloads of docs/benchmarks.md on any backend; a table and JSON.
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "cli_util.h"
+#include "commands.h"
+#include "motes/devices.h"
+#include "motes/simulation.h"
+#include "motes/workloads.h"
+
+namespace motes::cli {
+namespace {
+
+struct BenchOptions {
+  std::string workload = "all";
+  std::vector<std::uint64_t> sizes = {16384, 65536, 262144, 1048576};
+  std::string phase = "both";
+  std::string backend = "auto";
+  int device = -1;
+  int threads = 0;
+  int repeats = 3;
+  std::uint64_t falling_steps = 2000;
+  std::uint64_t dense_steps = 5000;
+  std::uint64_t settle_steps = 60000;
+  int dominoes = 1000;
+  int domino_rows = 10;
+  std::uint64_t domino_steps = 2000;
+  std::string cache = "bench-cache";
+  std::string json_path;
+};
+
+struct Measurement {
+  std::string workload, phase;
+  std::uint32_t particles = 0, bodies = 0;
+  std::uint64_t steps = 0;
+  std::vector<double> seconds;  // per repeat
+  motes::KernelTimes kernels;   // of the median repeat
+  std::string backend, device, detail;
+};
+
+template <typename T>
+T must(motes::Result<T> r) {
+  if (!r) fail(r.message());
+  return std::move(r).value();
+}
+
+void must(const motes::Status& s) {
+  if (!s) fail(s.message());
+}
+
+std::unique_ptr<motes::Simulation> make_sim(const motes::Scene& scene, const BenchOptions& o) {
+  motes::DeviceOptions dopt;
+  dopt.cpu_threads = o.threads;
+  auto device = must(motes::open_device(o.backend, o.device, dopt));
+  return must(motes::Simulation::create(scene, std::move(device)));
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// Runs `steps` steps `repeats` times, each from a fresh simulation prepared by `prepare`.
+template <typename Prepare>
+Measurement measure(const motes::Scene& scene, const BenchOptions& o, std::uint64_t steps,
+                    Prepare prepare) {
+  Measurement m;
+  {  // Warm-up: first touch of memory, thread pool start.
+    auto sim = make_sim(scene, o);
+    prepare(*sim);
+    must(sim->step(std::min<std::uint64_t>(steps, 50)));
+  }
+  std::vector<motes::KernelTimes> kernels;
+  for (int r = 0; r < o.repeats; ++r) {
+    auto sim = make_sim(scene, o);
+    prepare(*sim);
+    sim->device().set_timing(true);
+    sim->device().reset_kernel_times();
+    const auto t0 = std::chrono::steady_clock::now();
+    must(sim->step(steps));
+    const auto t1 = std::chrono::steady_clock::now();
+    m.seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
+    kernels.push_back(sim->device().kernel_times());
+    if (r == 0) {
+      m.particles = sim->particle_count();
+      m.bodies = sim->body_count();
+      m.backend = sim->device().info().backend;
+      m.device = sim->device().info().name;
+      m.detail = sim->device().info().detail;
+    }
+  }
+  const double med = median(m.seconds);
+  for (std::size_t r = 0; r < m.seconds.size(); ++r) {
+    if (m.seconds[r] == med || r + 1 == m.seconds.size()) {
+      m.kernels = kernels[r];
+      break;
+    }
+  }
+  m.steps = steps;
+  return m;
+}
+
+std::string settle_cache_path(const BenchOptions& o, std::uint64_t n) {
+  return (std::filesystem::path(o.cache) /
+          fmt::format("w1-{}-settled-{}-steps.motesck", n, o.settle_steps))
+      .string();
+}
+
+/// The W1 dense-phase start state: settled once, then reloaded for every run.
+std::string ensure_settled(const motes::Scene& scene, const BenchOptions& o, std::uint64_t n) {
+  const std::string path = settle_cache_path(o, n);
+  if (std::filesystem::exists(path)) return path;
+  std::error_code ec;
+  std::filesystem::create_directories(o.cache, ec);
+  if (ec) fail(fmt::format("{}: cannot create cache directory: {}", o.cache, ec.message()));
+  fmt::print(stderr, "settling W1 N={} for {} steps (once; cached in {})\n", n, o.settle_steps,
+             path);
+  auto sim = make_sim(scene, o);
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::uint64_t chunk = std::max<std::uint64_t>(1, o.settle_steps / 20);
+  for (std::uint64_t done = 0; done < o.settle_steps;) {
+    const std::uint64_t k = std::min(chunk, o.settle_steps - done);
+    must(sim->step(k));
+    done += k;
+    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    fmt::print(stderr, "  settle {:>3.0f}%  step {}/{}  {:.0f} s elapsed, ~{:.0f} s left\n",
+               100.0 * static_cast<double>(done) / static_cast<double>(o.settle_steps), done,
+               o.settle_steps, el,
+               el * static_cast<double>(o.settle_steps - done) / static_cast<double>(done));
+  }
+  must(sim->check_finite());
+  must(sim->save_state(path));
+  return path;
+}
+
+nlohmann::json to_json(const Measurement& m) {
+  const double med = median(m.seconds);
+  nlohmann::json kernels = nlohmann::json::object();
+  for (std::size_t k = 0; k < motes::kKernelCount; ++k) {
+    kernels[motes::kernel_name(static_cast<motes::Kernel>(k))] =
+        1e3 * m.kernels.seconds[k] / static_cast<double>(m.steps);
+  }
+  return {{"workload", m.workload},
+          {"phase", m.phase},
+          {"particles", m.particles},
+          {"bodies", m.bodies},
+          {"steps", m.steps},
+          {"repeat_seconds", m.seconds},
+          {"median_ms_per_step", 1e3 * med / static_cast<double>(m.steps)},
+          {"particle_steps_per_s",
+           static_cast<double>(m.particles) * static_cast<double>(m.steps) / med},
+          {"body_steps_per_s", static_cast<double>(m.bodies) * static_cast<double>(m.steps) / med},
+          {"kernel_ms_per_step", kernels},
+          {"backend", m.backend},
+          {"device", m.device},
+          {"detail", m.detail},
+          {"neighbour_search", "hashed grid rebuilt every step"},
+          {"contact_model",
+           "DEM: linear spring, mass-proportional dashpot, viscous tangential "
+           "force with Coulomb cap; no particle rotation"}};
+}
+
+void print_row(const Measurement& m) {
+  const double med = median(m.seconds);
+  const double per = 1e3 * med / static_cast<double>(m.steps);
+  std::string ks;
+  for (std::size_t k = 0; k < motes::kKernelCount; ++k) {
+    ks += fmt::format(" {:>8.3f}", 1e3 * m.kernels.seconds[k] / static_cast<double>(m.steps));
+  }
+  fmt::print("{:<9} {:<8} {:>9} {:>6} {:>9.3f} {:>10.3e}{}\n", m.workload, m.phase, m.particles,
+             m.steps, per, static_cast<double>(m.particles) * static_cast<double>(m.steps) / med,
+             ks);
+  std::fflush(stdout);
+}
+
+void run_bench(const BenchOptions& o) {
+  if (o.workload != "all" && o.workload != "settle" && o.workload != "dominoes") {
+    fail(fmt::format("--workload must be settle, dominoes or all, got '{}'", o.workload));
+  }
+  if (o.phase != "both" && o.phase != "falling" && o.phase != "dense") {
+    fail(fmt::format("--phase must be falling, dense or both, got '{}'", o.phase));
+  }
+  for (std::uint64_t n : o.sizes) {
+    int nx = 0, ny = 0, nz = 0;
+    if (!motes::settle_dimensions(n, nx, ny, nz)) {
+      fail(
+          fmt::format("--sizes: {} is not a W1 size (16384, 65536, 262144, 1048576, 4194304, "
+                      "16777216)",
+                      n));
+    }
+  }
+  {
+    auto probe = must(motes::open_device(o.backend, o.device, {o.threads}));
+    fmt::print("motes bench on {} device {}: {} ({}); median of {} repeats after a warm-up\n",
+               probe->info().backend, probe->info().index, probe->info().name, probe->info().detail,
+               o.repeats);
+  }
+  std::string ks;
+  for (std::size_t k = 0; k < motes::kKernelCount; ++k) {
+    std::string name = motes::kernel_name(static_cast<motes::Kernel>(k));
+    ks += fmt::format(" {:>8}", name.substr(0, 8));
+  }
+  fmt::print("{:<9} {:<8} {:>9} {:>6} {:>9} {:>10}{}   (kernel columns: ms/step)\n", "workload",
+             "phase", "particles", "steps", "ms/step", "p-steps/s", ks);
+
+  nlohmann::json results = nlohmann::json::array();
+  if (o.workload != "dominoes") {
+    for (std::uint64_t n : o.sizes) {
+      int nx = 0, ny = 0, nz = 0;
+      motes::settle_dimensions(n, nx, ny, nz);
+      const motes::Scene scene = motes::settle_workload(nx, ny, nz);
+      if (o.phase != "dense") {
+        Measurement m = measure(scene, o, o.falling_steps, [](motes::Simulation&) {});
+        m.workload = "settle";
+        m.phase = "falling";
+        print_row(m);
+        results.push_back(to_json(m));
+      }
+      if (o.phase != "falling") {
+        const std::string path = ensure_settled(scene, o, n);
+        Measurement m = measure(scene, o, o.dense_steps,
+                                [&](motes::Simulation& s) { must(s.load_state(path)); });
+        m.workload = "settle";
+        m.phase = "dense";
+        print_row(m);
+        results.push_back(to_json(m));
+      }
+    }
+  }
+  if (o.workload != "settle") {
+    const motes::Scene scene = motes::dominoes_workload(o.dominoes, o.domino_rows);
+    Measurement m = measure(scene, o, o.domino_steps, [](motes::Simulation&) {});
+    m.workload = "dominoes";
+    m.phase = "falling";
+    print_row(m);
+    results.push_back(to_json(m));
+  }
+  if (!o.json_path.empty()) {
+    std::ofstream out(o.json_path);
+    out << results.dump(2) << "\n";
+    if (!out) fail(fmt::format("{}: cannot write JSON results", o.json_path));
+    fmt::print("results written to {}\n", o.json_path);
+  }
+}
+
+}  // namespace
+
+void add_bench_command(CLI::App& app) {
+  auto opts = std::make_shared<BenchOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "Run the fixed benchmark workloads (docs/benchmarks.md): W1 settle, W2 dominoes");
+  cmd->add_option("--workload", opts->workload, "settle, dominoes or all")->capture_default_str();
+  cmd->add_option("--sizes", opts->sizes, "W1 particle counts")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--phase", opts->phase, "W1 phase: falling, dense or both")
+      ->capture_default_str();
+  cmd->add_option("--backend", opts->backend, "auto, openmp, cuda or vulkan")
+      ->capture_default_str();
+  cmd->add_option("--device", opts->device, "device index within the backend");
+  cmd->add_option("--threads", opts->threads, "OpenMP threads (0: OpenMP's default)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--repeats", opts->repeats, "timed repeats (the median is reported)")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  cmd->add_option("--falling-steps", opts->falling_steps, "steps of the W1 falling phase")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--dense-steps", opts->dense_steps, "steps of the W1 dense phase")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--settle-steps", opts->settle_steps,
+                  "steps run once to make the W1 dense-phase start state")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--dominoes", opts->dominoes, "W2: number of dominoes")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--domino-rows", opts->domino_rows, "W2: parallel rows")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--domino-steps", opts->domino_steps, "W2: steps timed")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--cache", opts->cache, "folder for settled W1 states")->capture_default_str();
+  cmd->add_option("--json", opts->json_path, "also write the results as JSON to this file");
+  cmd->callback([opts]() { run_bench(*opts); });
+}
+
+}  // namespace motes::cli

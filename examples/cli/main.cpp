@@ -1,0 +1,33 @@
+// The motes command: `motes run`, `motes devices`, `motes voxelize`, `motes bench`.
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <new>
+
+#include "cli_util.h"
+#include "commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app("motes: rigid bodies made of particles, on OpenMP, CUDA and Vulkan", "motes");
+  app.set_version_flag("--version", std::string("motes ") + MOTES_VERSION);
+  app.require_subcommand(1);
+  motes::cli::add_run_command(app);
+  motes::cli::add_devices_command(app);
+  motes::cli::add_voxelize_command(app);
+  motes::cli::add_bench_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    std::fflush(stdout);
+    return app.exit(e);
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr, "motes: error: out of memory\n");
+    return motes::cli::kErrorExit;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "motes: error: {}\n", e.what());
+    return motes::cli::kErrorExit;
+  }
+  return 0;
+}

@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# The quick start's test command: the same set-up as demo.sh (warnings are errors here), a format
+# check, then every test.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${MOTES_TEST_BUILD:-$root/build-test}
+"$root/scripts/setup.sh" "$build" -DMOTES_WERROR=ON
+"$root/scripts/check-format.sh"
+cd "$build"
+ctest --output-on-failure -j "${JOBS:-$(nproc)}" --timeout 900

@@ -1,0 +1,288 @@
+// The motes command, run as a user would: exit codes, messages and the files it writes.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kSmallScene = std::string(MOTES_TEST_DATA_DIR) + "/cli/small.json";
+const std::string kBunny = std::string(MOTES_SOURCE_DIR) + "/examples/assets/bunny.obj";
+
+/// A fresh directory under the system's temporary folder, removed afterwards.
+class TempDir {
+ public:
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    path_ = fs::temp_directory_path() /
+            ("motes_cli_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  [[nodiscard]] const fs::path& path() const { return path_; }
+  [[nodiscard]] std::string operator/(const std::string& name) const {
+    return (path_ / name).string();
+  }
+
+ private:
+  fs::path path_;
+};
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+struct Outcome {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+/// Runs `motes ARGS` with stdout and stderr captured; a run that hangs is killed after 120 s.
+Outcome run_motes(const TempDir& tmp, const std::vector<std::string>& args) {
+  std::string cmd = "timeout 120 ";
+  cmd += quote(MOTES_CLI_PATH);
+  for (const std::string& a : args) {
+    cmd += ' ';
+    cmd += quote(a);
+  }
+  const std::string out = tmp / "stdout.txt", err = tmp / "stderr.txt";
+  cmd.append(" >").append(quote(out)).append(" 2>").append(quote(err)).append(" </dev/null");
+  const int status = std::system(cmd.c_str());
+  Outcome o;
+  o.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  o.out = read_text(out);
+  o.err = read_text(err);
+  return o;
+}
+
+std::string describe(const Outcome& o) {
+  return "exit " + std::to_string(o.exit_code) + "\n--- stdout\n" + o.out + "--- stderr\n" + o.err;
+}
+
+bool contains(const std::string& haystack, const std::string& needle) {
+  return haystack.find(needle) != std::string::npos;
+}
+
+std::vector<std::string> files_with_extension(const fs::path& dir, const std::string& ext) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().extension() == ext) names.push_back(e.path().filename().string());
+  }
+  return names;
+}
+
+std::vector<std::string> lines_of(const fs::path& p) {
+  std::ifstream in(p);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST(Cli, DevicesListsOpenmp) {
+  TempDir tmp;
+  const Outcome o = run_motes(tmp, {"devices"});
+  EXPECT_EQ(o.exit_code, 0) << describe(o);
+  EXPECT_TRUE(std::regex_search(o.out, std::regex(R"(^openmp +0 +\S)", std::regex::multiline)))
+      << describe(o);
+  // Every backend appears, with its devices or the reason it has none.
+  for (const char* backend : {"cuda", "vulkan"}) {
+    EXPECT_TRUE(contains(o.out, backend)) << describe(o);
+  }
+}
+
+TEST(Cli, VersionAndUsage) {
+  TempDir tmp;
+  const Outcome v = run_motes(tmp, {"--version"});
+  EXPECT_EQ(v.exit_code, 0) << describe(v);
+  EXPECT_TRUE(contains(v.out, "motes ")) << describe(v);
+  const Outcome none = run_motes(tmp, {});
+  EXPECT_NE(none.exit_code, 0) << describe(none);
+  const Outcome both = run_motes(tmp, {"run", kSmallScene, "--steps", "5", "--duration", "1"});
+  EXPECT_NE(both.exit_code, 0) << describe(both);
+  EXPECT_NE(both.exit_code, 2) << "usage errors keep CLI11's exit codes\n" << describe(both);
+  EXPECT_TRUE(contains(both.err, "--duration")) << describe(both);
+  const Outcome every = run_motes(tmp, {"run", kSmallScene, "--every", "0"});
+  EXPECT_NE(every.exit_code, 0) << describe(every);
+  const Outcome nan = run_motes(tmp, {"run", kSmallScene, "--duration", "nan"});
+  EXPECT_NE(nan.exit_code, 0) << describe(nan);
+  EXPECT_TRUE(contains(nan.err, "finite")) << describe(nan);
+}
+
+TEST(Cli, RunWritesVtuFramesAndSeries) {
+  TempDir tmp;
+  const std::string out = tmp / "out";
+  const Outcome o =
+      run_motes(tmp, {"run", kSmallScene, "--steps", "20", "--every", "10", "--out", out});
+  ASSERT_EQ(o.exit_code, 0) << describe(o);
+  std::vector<std::string> vtus = files_with_extension(out, ".vtu");
+  std::sort(vtus.begin(), vtus.end());
+  EXPECT_EQ(vtus, (std::vector<std::string>{"particles_000000.vtu", "particles_000001.vtu",
+                                            "particles_000002.vtu"}));
+  const std::string pvd = read_text(fs::path(out) / "particles.pvd");
+  for (const std::string& name : vtus) EXPECT_TRUE(contains(pvd, name)) << pvd;
+  // The summary says what ran and where the frames are.
+  for (const char* word : {"openmp", "particles", "steps/s", "particle-steps/s", "particles.pvd"}) {
+    EXPECT_TRUE(contains(o.out, word)) << word << "\n" << describe(o);
+  }
+  EXPECT_TRUE(std::regex_search(o.out, std::regex(R"(steps +20 of 20)"))) << describe(o);
+}
+
+TEST(Cli, RunWritesCsvWithThreeFrames) {
+  TempDir tmp;
+  const std::string out = tmp / "csv";
+  const Outcome o = run_motes(tmp, {"run", kSmallScene, "--steps", "20", "--every", "10", "--out",
+                                    out, "--format", "csv", "--threads", "1"});
+  ASSERT_EQ(o.exit_code, 0) << describe(o);
+  const std::vector<std::string> lines = lines_of(fs::path(out) / "particles.csv");
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines[0], "frame,time,particle,body,x,y,z,vx,vy,vz");
+  std::map<int, int> rows_per_frame;
+  std::set<std::string> times;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    std::vector<std::string> fields;
+    std::stringstream ss(lines[i]);
+    for (std::string f; std::getline(ss, f, ',');) fields.push_back(f);
+    ASSERT_EQ(fields.size(), 10u) << lines[i];
+    ++rows_per_frame[std::stoi(fields[0])];
+    times.insert(fields[1]);
+  }
+  ASSERT_EQ(rows_per_frame.size(), 3u);
+  EXPECT_GT(rows_per_frame[0], 0);
+  EXPECT_EQ(rows_per_frame[1], rows_per_frame[0]);
+  EXPECT_EQ(rows_per_frame[2], rows_per_frame[0]);
+  EXPECT_EQ(times.size(), 3u);
+  EXPECT_TRUE(times.count("0")) << "frame 0 is the initial state";
+}
+
+TEST(Cli, RunWithoutSceneUsesTheBuiltInScene) {
+  TempDir tmp;
+  const Outcome o = run_motes(tmp, {"run", "--steps", "2", "--format", "none"});
+  ASSERT_EQ(o.exit_code, 0) << describe(o);
+  EXPECT_TRUE(contains(o.out, "built-in")) << describe(o);
+  EXPECT_FALSE(fs::exists(tmp / "out"));
+}
+
+TEST(Cli, MalformedSceneNamesFileAndJsonPath) {
+  TempDir tmp;
+  const std::string bad = tmp / "bad_scene.json";
+  std::string text = read_text(kSmallScene);
+  // The same scene with one unknown key in settings.
+  const auto at = text.find("\"settings\": {");
+  ASSERT_NE(at, std::string::npos) << "small.json must have a settings object";
+  text.insert(at + 13, "\"time_step_typo\": 1, ");
+  std::ofstream(bad) << text;
+  const Outcome o = run_motes(tmp, {"run", bad, "--steps", "1", "--out", tmp / "out"});
+  EXPECT_EQ(o.exit_code, 2) << describe(o);
+  EXPECT_TRUE(contains(o.err, "motes: error: ")) << describe(o);
+  EXPECT_TRUE(contains(o.err, bad)) << describe(o);
+  EXPECT_TRUE(contains(o.err, "/settings")) << describe(o);
+  EXPECT_TRUE(contains(o.err, "time_step_typo")) << describe(o);
+}
+
+TEST(Cli, NonFiniteStateEndsTheRunWithAnError) {
+  TempDir tmp;
+  // A body thrown from the edge of the float range: its position overflows to infinity within
+  // about 60 steps, and the check at the next frame must stop the run.
+  const std::string scene = tmp / "overflow.json";
+  std::ofstream(scene) << R"({
+    "settings": {"dt": 5e-5, "particle_diameter": 0.01,
+                 "contact": {"stiffness": 500, "damping": 50}},
+    "bodies": [{"shape": {"type": "box", "particles": [2, 2, 2]},
+                "position": [3.4e38, 0, 0], "velocity": [1e38, 0, 0]}]
+  })";
+  const std::string out = tmp / "out";
+  const Outcome o = run_motes(
+      tmp, {"run", scene, "--steps", "200", "--every", "10", "--out", out, "--threads", "1"});
+  EXPECT_EQ(o.exit_code, 2) << describe(o);
+  EXPECT_TRUE(contains(o.err, "motes: error: ")) << describe(o);
+  EXPECT_TRUE(contains(o.err, "inf")) << describe(o);
+  // The frames before the overflow are complete and listed.
+  const std::string pvd = read_text(fs::path(out) / "particles.pvd");
+  EXPECT_TRUE(contains(pvd, "particles_000001.vtu")) << pvd;
+  EXPECT_FALSE(contains(pvd, "particles_000019.vtu")) << pvd;
+}
+
+TEST(Cli, MissingFilesAreClearErrors) {
+  TempDir tmp;
+  const std::string missing = tmp / "no_such_scene.json";
+  const Outcome o = run_motes(tmp, {"run", missing});
+  EXPECT_EQ(o.exit_code, 2) << describe(o);
+  EXPECT_TRUE(contains(o.err, "motes: error: ")) << describe(o);
+  EXPECT_TRUE(contains(o.err, missing)) << describe(o);
+
+  const std::string mesh = tmp / "no_such_mesh.obj";
+  const Outcome v = run_motes(tmp, {"voxelize", mesh, "--count", "100"});
+  EXPECT_EQ(v.exit_code, 2) << describe(v);
+  EXPECT_TRUE(contains(v.err, mesh)) << describe(v);
+}
+
+TEST(Cli, UnwritableOutputAndUnknownBackendAreErrors) {
+  TempDir tmp;
+  std::ofstream(tmp / "file") << "x";
+  const std::string out = tmp / "file/out";  // a regular file where a directory should be
+  const Outcome o = run_motes(tmp, {"run", kSmallScene, "--steps", "1", "--out", out});
+  EXPECT_EQ(o.exit_code, 2) << describe(o);
+  EXPECT_TRUE(contains(o.err, out)) << describe(o);
+
+  const Outcome b = run_motes(tmp, {"run", kSmallScene, "--backend", "metal"});
+  EXPECT_NE(b.exit_code, 0) << describe(b);
+  const Outcome d = run_motes(tmp, {"run", kSmallScene, "--backend", "openmp", "--device", "7"});
+  EXPECT_EQ(d.exit_code, 2) << describe(d);
+  EXPECT_TRUE(contains(d.err, "motes: error: ")) << describe(d);
+}
+
+TEST(Cli, VoxelizeBunnyToCsv) {
+  TempDir tmp;
+  const std::string csv = tmp / "x.csv";
+  const Outcome o = run_motes(tmp, {"voxelize", kBunny, "--count", "1000", "--out", csv});
+  ASSERT_EQ(o.exit_code, 0) << describe(o);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(o.out, m, std::regex(R"(particles +(\d+))"))) << describe(o);
+  const int count = std::stoi(m[1]);
+  EXPECT_GT(count, 800) << describe(o);
+  EXPECT_LT(count, 1200) << describe(o);
+  EXPECT_TRUE(contains(o.out, "density 1000")) << describe(o);
+  const std::vector<std::string> lines = lines_of(csv);
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines[0], "x,y,z");
+  EXPECT_EQ(static_cast<int>(lines.size()) - 1, count);
+
+  const std::string vtu = tmp / "x.vtu";
+  const Outcome w = run_motes(tmp, {"voxelize", kBunny, "--count", "1000", "--out", vtu});
+  ASSERT_EQ(w.exit_code, 0) << describe(w);
+  EXPECT_TRUE(contains(read_text(vtu), "NumberOfPoints=\"" + std::to_string(count) + "\""));
+
+  const Outcome neither = run_motes(tmp, {"voxelize", kBunny});
+  EXPECT_NE(neither.exit_code, 0) << describe(neither);
+  const Outcome both = run_motes(tmp, {"voxelize", kBunny, "--count", "10", "--diameter", "0.1"});
+  EXPECT_NE(both.exit_code, 0) << describe(both);
+}
+
+}  // namespace

@@ -1,0 +1,332 @@
+// Output writers: VTU frames read back by meshio, the .pvd series, CSV parsed back, and errors.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "motes/output.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A fresh directory under the system's temporary folder, removed afterwards.
+class TempDir {
+ public:
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    path_ = fs::temp_directory_path() /
+            ("motes_output_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  [[nodiscard]] const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// Particles with values that need all nine digits, signs, tiny and huge magnitudes.
+motes::Snapshot sample_snapshot(std::uint64_t step, double time, float shift) {
+  const std::vector<float> values = {0.1f, -1.0f / 3.0f, 1.0e-30f, -3.0e38f, 123456.789f,
+                                     0.0f, 2.5f,         -0.75f,   1.0e-45f, 7.0f / 9.0f};
+  motes::Snapshot s;
+  s.step = step;
+  s.time = time;
+  for (std::size_t i = 0; i < 7; ++i) {
+    auto v = [&](std::size_t k) { return values[(i * 3 + k) % values.size()] + shift; };
+    s.particle_pos.emplace_back(v(0), v(1), v(2), 0.005f + 0.001f * static_cast<float>(i));
+    s.particle_vel.emplace_back(v(3), -v(4), v(5), 1.0f);
+    s.particle_body.push_back(static_cast<std::uint32_t>(i / 3 + (i == 6 ? 4000000000U : 0U)));
+  }
+  return s;
+}
+
+/// A Python interpreter that can import meshio, or "" if none.
+std::string meshio_python() {
+  for (const char* candidate : {"python3", "/usr/bin/python3"}) {
+    const std::string cmd = std::string(candidate) + " -c 'import meshio' >/dev/null 2>&1";
+    if (std::system(cmd.c_str()) == 0) return candidate;
+  }
+  return "";
+}
+
+/// Reads a .vtu with meshio; every array as JSON (Python floats print exactly).
+nlohmann::json read_with_meshio(const std::string& python, const fs::path& vtu,
+                                const fs::path& scratch) {
+  const fs::path script = scratch / "read_vtu.py";
+  const fs::path result = scratch / "vtu.json";
+  std::ofstream(script) << R"(import json, sys, meshio
+m = meshio.read(sys.argv[1])
+print(json.dumps({
+    "points": m.points.tolist(), "points_dtype": str(m.points.dtype),
+    "cells": [[c.type, c.data.tolist()] for c in m.cells],
+    "point_data": {k: v.tolist() for k, v in m.point_data.items()},
+    "dtypes": {k: str(v.dtype) for k, v in m.point_data.items()},
+    "field_data": {k: v.tolist() for k, v in m.field_data.items()},
+}))
+)";
+  const std::string cmd =
+      python + " '" + script.string() + "' '" + vtu.string() + "' > '" + result.string() + "'";
+  if (std::system(cmd.c_str()) != 0) return nullptr;
+  return nlohmann::json::parse(read_text(result));
+}
+
+void expect_vtu_matches(const nlohmann::json& m, const motes::Snapshot& s) {
+  ASSERT_FALSE(m.is_null()) << "meshio could not read the file";
+  const std::size_t n = s.particle_pos.size();
+  EXPECT_EQ(m["points_dtype"], "float32");
+  ASSERT_EQ(m["points"].size(), n);
+  ASSERT_EQ(m["cells"].size(), 1u);
+  EXPECT_EQ(m["cells"][0][0], "vertex");
+  ASSERT_EQ(m["cells"][0][1].size(), n);
+  EXPECT_EQ(m["dtypes"]["velocity"], "float32");
+  EXPECT_EQ(m["dtypes"]["radius"], "float32");
+  EXPECT_EQ(m["dtypes"]["body"], "uint32");
+  EXPECT_EQ(m["dtypes"]["speed"], "float32");
+  EXPECT_EQ(m["field_data"]["TimeValue"][0].get<double>(), s.time);
+  const auto& pd = m["point_data"];
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& p = s.particle_pos[i];
+    const auto& v = s.particle_vel[i];
+    EXPECT_EQ(m["cells"][0][1][i][0].get<std::size_t>(), i);
+    // float -> double is exact, so the doubles Python printed must equal the floats exactly.
+    EXPECT_EQ(m["points"][i][0].get<double>(), double{p.x}) << "particle " << i;
+    EXPECT_EQ(m["points"][i][1].get<double>(), double{p.y}) << "particle " << i;
+    EXPECT_EQ(m["points"][i][2].get<double>(), double{p.z}) << "particle " << i;
+    EXPECT_EQ(pd["velocity"][i][0].get<double>(), double{v.x}) << "particle " << i;
+    EXPECT_EQ(pd["velocity"][i][1].get<double>(), double{v.y}) << "particle " << i;
+    EXPECT_EQ(pd["velocity"][i][2].get<double>(), double{v.z}) << "particle " << i;
+    EXPECT_EQ(pd["radius"][i].get<double>(), double{p.w}) << "particle " << i;
+    EXPECT_EQ(pd["body"][i].get<std::uint32_t>(), s.particle_body[i]) << "particle " << i;
+    const double vx = v.x, vy = v.y, vz = v.z;
+    const auto speed = static_cast<float>(std::sqrt(vx * vx + vy * vy + vz * vz));
+    EXPECT_EQ(pd["speed"][i].get<double>(), double{speed}) << "particle " << i;
+  }
+}
+
+/// (file, timestep) of every DataSet in a .pvd.
+std::vector<std::pair<std::string, double>> pvd_entries(const fs::path& pvd) {
+  const std::string text = read_text(pvd);
+  const std::regex entry(R"re(<DataSet timestep="([^"]*)"[^>]*file="([^"]*)"\s*/>)re");
+  std::vector<std::pair<std::string, double>> out;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), entry);
+       it != std::sregex_iterator(); ++it) {
+    out.emplace_back((*it)[2].str(), std::strtod((*it)[1].str().c_str(), nullptr));
+  }
+  return out;
+}
+
+std::vector<std::string> split(const std::string& line, char sep) {
+  std::vector<std::string> out;
+  std::string field;
+  std::istringstream in(line);
+  while (std::getline(in, field, sep)) out.push_back(field);
+  return out;
+}
+
+float parse_float(const std::string& s) {
+  char* end = nullptr;
+  const float v = std::strtof(s.c_str(), &end);
+  EXPECT_TRUE(end != s.c_str() && *end == '\0') << "not a float: '" << s << "'";
+  return v;
+}
+
+TEST(OutputVtu, MeshioReadsEveryArrayExactly) {
+  const std::string python = meshio_python();
+  if (python.empty()) GTEST_SKIP() << "python3 with meshio not found (Debian: python3-meshio)";
+  TempDir tmp;
+  auto writer = motes::open_vtu_writer((tmp.path() / "run").string());
+  ASSERT_TRUE(writer) << writer.message();
+  const std::vector<motes::Snapshot> frames = {sample_snapshot(0, 0.0, 0.0f),
+                                               sample_snapshot(10, 1.0 / 60.0, 0.5f),
+                                               sample_snapshot(20, 2.0 / 60.0, -1.25f)};
+  for (const auto& f : frames) ASSERT_TRUE(writer.value()->write_frame(f));
+  ASSERT_TRUE(writer.value()->finish());
+  EXPECT_EQ(writer.value()->frames(), 3u);
+  EXPECT_EQ(writer.value()->main_path(), (tmp.path() / "run" / "particles.pvd").string());
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    SCOPED_TRACE("frame " + std::to_string(i));
+    const fs::path vtu = tmp.path() / "run" / ("particles_00000" + std::to_string(i) + ".vtu");
+    expect_vtu_matches(read_with_meshio(python, vtu, tmp.path()), frames[i]);
+  }
+}
+
+TEST(OutputVtu, SeriesListsEveryFrameWithItsTimeAfterEachFrame) {
+  TempDir tmp;
+  const fs::path dir = tmp.path() / "a" / "b";  // created with its parents
+  auto writer = motes::open_vtu_writer(dir.string());
+  ASSERT_TRUE(writer) << writer.message();
+  const fs::path pvd = dir / "particles.pvd";
+  ASSERT_TRUE(fs::exists(pvd));
+  EXPECT_TRUE(pvd_entries(pvd).empty());
+  const double times[] = {0.0, 0.1, 1.0 / 3.0};
+  for (std::size_t i = 0; i < 3; ++i) {
+    ASSERT_TRUE(writer.value()->write_frame(sample_snapshot(i, times[i], 0.0f)));
+    // The collection is complete after every frame, so an interrupted run still opens.
+    const auto entries = pvd_entries(pvd);
+    ASSERT_EQ(entries.size(), i + 1);
+    for (std::size_t k = 0; k <= i; ++k) {
+      EXPECT_EQ(entries[k].first, "particles_00000" + std::to_string(k) + ".vtu");
+      EXPECT_EQ(entries[k].second, times[k]);
+      EXPECT_TRUE(fs::exists(dir / entries[k].first));
+    }
+  }
+  EXPECT_FALSE(fs::exists(dir / "particles.pvd.tmp"));
+}
+
+TEST(OutputCsv, HeaderAndRowsReadBackExactly) {
+  TempDir tmp;
+  auto writer = motes::open_csv_writer(tmp.path().string());
+  ASSERT_TRUE(writer) << writer.message();
+  const std::vector<motes::Snapshot> frames = {sample_snapshot(0, 0.0, 0.0f),
+                                               sample_snapshot(5, 0.1, 2.0f)};
+  for (const auto& f : frames) ASSERT_TRUE(writer.value()->write_frame(f));
+  ASSERT_TRUE(writer.value()->finish());
+  EXPECT_EQ(writer.value()->main_path(), (tmp.path() / "particles.csv").string());
+
+  std::ifstream in(tmp.path() / "particles.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line, "frame,time,particle,body,x,y,z,vx,vy,vz");
+  std::size_t rows = 0;
+  while (std::getline(in, line)) {
+    const auto f = split(line, ',');
+    ASSERT_EQ(f.size(), 10u) << line;
+    const std::size_t frame = std::stoul(f[0]);
+    const std::size_t i = std::stoul(f[2]);
+    ASSERT_LT(frame, frames.size());
+    const motes::Snapshot& s = frames[frame];
+    ASSERT_LT(i, s.particle_pos.size());
+    EXPECT_EQ(rows, frame * s.particle_pos.size() + i) << "rows out of order";
+    EXPECT_EQ(std::strtod(f[1].c_str(), nullptr), s.time);
+    EXPECT_EQ(std::stoul(f[3]), s.particle_body[i]);
+    EXPECT_EQ(parse_float(f[4]), s.particle_pos[i].x) << line;
+    EXPECT_EQ(parse_float(f[5]), s.particle_pos[i].y) << line;
+    EXPECT_EQ(parse_float(f[6]), s.particle_pos[i].z) << line;
+    EXPECT_EQ(parse_float(f[7]), s.particle_vel[i].x) << line;
+    EXPECT_EQ(parse_float(f[8]), s.particle_vel[i].y) << line;
+    EXPECT_EQ(parse_float(f[9]), s.particle_vel[i].z) << line;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 14u);
+}
+
+TEST(OutputCsv, PointsFileAndParticleSetSnapshot) {
+  TempDir tmp;
+  const std::vector<Eigen::Vector3f> points = {{0.1f, -0.2f, 0.3f}, {1e-7f, 2.5f, -1.0f / 3.0f}};
+  const fs::path csv = tmp.path() / "points.csv";
+  ASSERT_TRUE(motes::write_points_csv(csv.string(), points));
+  std::ifstream in(csv);
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line, "x,y,z");
+  for (const auto& p : points) {
+    ASSERT_TRUE(std::getline(in, line));
+    const auto f = split(line, ',');
+    ASSERT_EQ(f.size(), 3u);
+    EXPECT_EQ(parse_float(f[0]), p.x());
+    EXPECT_EQ(parse_float(f[1]), p.y());
+    EXPECT_EQ(parse_float(f[2]), p.z());
+  }
+  EXPECT_FALSE(std::getline(in, line));
+
+  const motes::Snapshot s = motes::particle_set_snapshot(points, 0.02);
+  ASSERT_EQ(s.particle_pos.size(), 2u);
+  EXPECT_EQ(s.particle_pos[1].z, -1.0f / 3.0f);
+  EXPECT_EQ(s.particle_pos[1].w, 0.01f);
+  EXPECT_EQ(s.particle_vel[1].x, 0.0f);
+  EXPECT_EQ(s.particle_body[1], 0u);
+  const fs::path vtu = tmp.path() / "points.vtu";
+  ASSERT_TRUE(motes::write_vtu_file(vtu.string(), s));
+  const std::string python = meshio_python();
+  if (!python.empty()) expect_vtu_matches(read_with_meshio(python, vtu, tmp.path()), s);
+}
+
+TEST(OutputErrors, DirectoryThatCannotBeCreatedNamesThePath) {
+  TempDir tmp;
+  // A regular file where a parent directory should be: fails even for root.
+  const fs::path blocker = tmp.path() / "file";
+  std::ofstream(blocker) << "x";
+  const std::string dir = (blocker / "out").string();
+  for (const auto format : {motes::OutputFormat::Vtu, motes::OutputFormat::Csv}) {
+    auto writer = motes::open_frame_writer(format, dir);
+    ASSERT_FALSE(writer);
+    EXPECT_NE(writer.message().find(dir), std::string::npos) << writer.message();
+  }
+  const motes::Status s =
+      motes::write_vtu_file((blocker / "x.vtu").string(), sample_snapshot(0, 0.0, 0.0f));
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.message().find((blocker / "x.vtu").string()), std::string::npos) << s.message();
+  EXPECT_FALSE(motes::write_points_csv((blocker / "x.csv").string(), {}));
+  EXPECT_FALSE(motes::open_frame_writer(motes::OutputFormat::None, tmp.path().string()));
+}
+
+TEST(OutputErrors, FullDiskNamesTheFile) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this system";
+  TempDir tmp;
+  // /dev/full fails every write with ENOSPC, as a full disk does.
+  fs::create_symlink("/dev/full", tmp.path() / "particles.csv");
+  auto csv = motes::open_csv_writer(tmp.path().string());
+  ASSERT_FALSE(csv);
+  EXPECT_NE(csv.message().find("particles.csv"), std::string::npos) << csv.message();
+  EXPECT_NE(csv.message().find("No space left"), std::string::npos) << csv.message();
+
+  const fs::path vtu_dir = tmp.path() / "vtu";
+  fs::create_directories(vtu_dir);
+  fs::create_symlink("/dev/full", vtu_dir / "particles_000001.vtu");
+  auto vtu = motes::open_vtu_writer(vtu_dir.string());
+  ASSERT_TRUE(vtu) << vtu.message();
+  EXPECT_TRUE(vtu.value()->write_frame(sample_snapshot(0, 0.0, 0.0f)));
+  const motes::Status s = vtu.value()->write_frame(sample_snapshot(1, 0.5, 0.0f));
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.message().find("particles_000001.vtu"), std::string::npos) << s.message();
+  EXPECT_EQ(vtu.value()->frames(), 1u);
+  EXPECT_EQ(pvd_entries(vtu_dir / "particles.pvd").size(), 1u);
+}
+
+TEST(OutputErrors, InconsistentSnapshotAndUnknownFormat) {
+  TempDir tmp;
+  motes::Snapshot s = sample_snapshot(3, 0.0, 0.0f);
+  s.particle_body.pop_back();
+  auto writer = motes::open_csv_writer(tmp.path().string());
+  ASSERT_TRUE(writer);
+  const motes::Status st = writer.value()->write_frame(s);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message().find("step 3"), std::string::npos) << st.message();
+  EXPECT_FALSE(motes::write_vtu_file((tmp.path() / "x.vtu").string(), s));
+
+  const auto bad = motes::parse_output_format("vtk");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.message().find("'vtk'"), std::string::npos) << bad.message();
+  for (const auto f :
+       {motes::OutputFormat::Vtu, motes::OutputFormat::Csv, motes::OutputFormat::None}) {
+    EXPECT_EQ(motes::parse_output_format(motes::output_format_name(f)).value(), f);
+  }
+}
+
+}  // namespace
