@@ -10,8 +10,10 @@ MassProperties mass_properties(const ParticleSet& particles, double density) {
   const auto count = particles.points.size();
   if (count == 0) return out;  // the shape builders and the voxelizer never return an empty set
   const double d = particles.diameter;
-  // Each sphere stands for its lattice cell, so the body's mass is density x the cells' volume.
-  out.particle_mass = density * d * d * d;
+  // By default each sphere stands for its lattice cell, so the body's mass is density x the cells'
+  // volume; a set may say otherwise (a lone sphere weighs density x pi/6 d^3).
+  const double volume = particles.particle_volume > 0.0 ? particles.particle_volume : d * d * d;
+  out.particle_mass = density * volume;
   out.mass = out.particle_mass * static_cast<double>(count);
 
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();

@@ -196,10 +196,12 @@ Result<std::size_t> fill(const PreparedMesh& mesh, const Lattice& lattice,
   const auto nz = static_cast<std::int64_t>(lattice.n.z());
   std::vector<std::int64_t> column_x(static_cast<std::size_t>(nx));
   std::vector<std::int64_t> column_y(static_cast<std::size_t>(ny));
-  for (std::int64_t i = 0; i < nx; ++i)
+  for (std::int64_t i = 0; i < nx; ++i) {
     column_x[i] = mesh.fixed(lattice.centre(0, i), mesh.origin_x);
-  for (std::int64_t j = 0; j < ny; ++j)
+  }
+  for (std::int64_t j = 0; j < ny; ++j) {
     column_y[j] = mesh.fixed(lattice.centre(1, j), mesh.origin_y);
+  }
 
   // (column, z) of every crossing of a column's ray with the surface.
   std::vector<std::pair<std::int64_t, double>> crossings;

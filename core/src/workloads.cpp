@@ -43,8 +43,7 @@ Scene settle_workload(int nx, int ny, int nz, std::uint64_t seed) {
   scene.settings.duration = 1.2;
   Material m;
   m.name = "glass";
-  // The lattice-cell mass density * d^3 is scaled so each sphere weighs density * pi/6 d^3.
-  m.density = 2500.0 * std::numbers::pi / 6.0;
+  m.density = 2500.0;
   m.stiffness = 2000.0;
   m.damping = 50.0;
   m.tangential = 25.0;
@@ -55,6 +54,7 @@ Scene settle_workload(int nx, int ny, int nz, std::uint64_t seed) {
   auto sphere = std::make_shared<ParticleSet>();
   sphere->points.emplace_back(0.0f, 0.0f, 0.0f);
   sphere->diameter = d;
+  sphere->particle_volume = std::numbers::pi / 6.0 * d * d * d;
 
   scene.bodies.reserve(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) *
                        static_cast<std::size_t>(nz));

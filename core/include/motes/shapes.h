@@ -15,6 +15,9 @@ namespace motes {
 struct ParticleSet {
   std::vector<Eigen::Vector3f> points;  ///< sphere centres
   double diameter = 0.0;                ///< sphere diameter = lattice spacing
+  /// Volume that gives each particle its mass (density x volume). 0: diameter^3, the particle's
+  /// lattice cell, so a filled shape weighs density x its volume. A lone sphere uses pi/6 d^3.
+  double particle_volume = 0.0;
 };
 
 /// A box of size sx x sy x sz, centred at the origin: the centres of the cells of a lattice of
@@ -55,7 +58,8 @@ struct VoxelizeOptions {
 Result<ParticleSet> voxelize(const TriangleMesh& mesh, const VoxelizeOptions& options);
 
 /// Mass, centre of mass and inertia of equal spheres of the given density, each of mass
-/// density * diameter^3 (its lattice cell), with the per-sphere term 2/5 m r^2.
+/// density * particle_volume (default diameter^3, its lattice cell), with the per-sphere term
+/// 2/5 m r^2.
 struct MassProperties {
   double mass = 0.0;
   double particle_mass = 0.0;

@@ -1,0 +1,386 @@
+// Mesh loading (OBJ, STL, PLY, OFF through assimp) and voxelization by ray parity.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numbers>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "motes/shapes.h"
+
+namespace motes {
+namespace {
+
+std::string mesh_path(const std::string& name) {
+  return std::string(MOTES_TEST_DATA_DIR) + "/meshes/" + name;
+}
+
+std::string bunny_path() { return std::string(MOTES_SOURCE_DIR) + "/examples/assets/bunny.obj"; }
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// A closed box mesh of the given size, rotated and then moved by `offset`.
+TriangleMesh box_mesh(const Eigen::Vector3d& size, const Eigen::Matrix3d& rotation,
+                      const Eigen::Vector3d& offset) {
+  TriangleMesh mesh;
+  mesh.source = "box mesh";
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Vector3d corner((k & 1) != 0 ? 0.5 : -0.5, (k & 2) != 0 ? 0.5 : -0.5,
+                                 (k & 4) != 0 ? 0.5 : -0.5);
+    mesh.vertices.push_back(rotation * corner.cwiseProduct(size) + offset);
+  }
+  // Corner k has bit 0 = +x, bit 1 = +y, bit 2 = +z; quads counter-clockwise from outside.
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    mesh.triangles.emplace_back(q[0], q[1], q[2]);
+    mesh.triangles.emplace_back(q[0], q[2], q[3]);
+  }
+  return mesh;
+}
+
+/// The octahedron |x| + |y| + |z| <= r: its apexes and edges lie on lattice columns.
+TriangleMesh octahedron(double r) {
+  TriangleMesh mesh;
+  mesh.source = "octahedron";
+  mesh.vertices = {{r, 0, 0}, {-r, 0, 0}, {0, r, 0}, {0, -r, 0}, {0, 0, r}, {0, 0, -r}};
+  for (const int x : {0, 1}) {
+    for (const int y : {2, 3}) {
+      for (const int z : {4, 5}) {
+        // Counter-clockwise from outside when the octant's sign count is even.
+        const bool flip = ((x == 1) != (y == 3)) != (z == 5);
+        if (flip) {
+          mesh.triangles.emplace_back(x, z, y);
+        } else {
+          mesh.triangles.emplace_back(x, y, z);
+        }
+      }
+    }
+  }
+  return mesh;
+}
+
+/// An icosphere of the given radius: an icosahedron subdivided `levels` times.
+TriangleMesh icosphere(double radius, int levels, const Eigen::Vector3d& centre) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                                    {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                                    {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  for (auto& p : v) p.normalize();
+  std::vector<Eigen::Vector3i> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                    {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                    {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                    {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (int level = 0; level < levels; ++level) {
+    std::map<std::pair<int, int>, int> midpoints;
+    auto midpoint = [&](int a, int b) {
+      const auto key = std::minmax(a, b);
+      auto it = midpoints.find(key);
+      if (it != midpoints.end()) return it->second;
+      v.push_back((v[a] + v[b]).normalized());
+      const int index = static_cast<int>(v.size()) - 1;
+      midpoints.emplace(key, index);
+      return index;
+    };
+    std::vector<Eigen::Vector3i> next;
+    for (const auto& tri : f) {
+      const int ab = midpoint(tri[0], tri[1]);
+      const int bc = midpoint(tri[1], tri[2]);
+      const int ca = midpoint(tri[2], tri[0]);
+      next.emplace_back(tri[0], ab, ca);
+      next.emplace_back(tri[1], bc, ab);
+      next.emplace_back(tri[2], ca, bc);
+      next.emplace_back(ab, bc, ca);
+    }
+    f = std::move(next);
+  }
+  TriangleMesh mesh;
+  mesh.source = "icosphere";
+  for (const auto& p : v) mesh.vertices.push_back(centre + radius * p);
+  mesh.triangles = f;
+  return mesh;
+}
+
+std::vector<std::tuple<float, float, float>> sorted_points(const ParticleSet& set) {
+  std::vector<std::tuple<float, float, float>> out;
+  for (const auto& p : set.points) out.emplace_back(p.x(), p.y(), p.z());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+struct LatticeCount {
+  std::size_t inside = 0;  ///< lattice points strictly inside
+  std::size_t on = 0;      ///< lattice points on the surface (within 1e-9)
+};
+
+/// Classifies the points of the particles' lattice (spacing d through the first particle) within
+/// 60 cells of it by the sign of `margin` (> 0 inside), and checks that no particle is outside.
+template <typename Margin>
+LatticeCount count_lattice_points(const ParticleSet& set, Margin margin) {
+  LatticeCount out;
+  const Eigen::Vector3d anchor = set.points.front().cast<double>();
+  const int reach = 60;
+  for (int i = -reach; i <= reach; ++i) {
+    for (int j = -reach; j <= reach; ++j) {
+      for (int k = -reach; k <= reach; ++k) {
+        const double m = margin(anchor + set.diameter * Eigen::Vector3d(i, j, k));
+        if (m > 1e-9) {
+          ++out.inside;
+        } else if (m > -1e-9) {
+          ++out.on;
+        }
+      }
+    }
+  }
+  for (const auto& p : set.points) EXPECT_GT(margin(p.cast<double>()), -1e-6) << p.transpose();
+  return out;
+}
+
+Result<ParticleSet> voxelize_at(const TriangleMesh& mesh, double diameter) {
+  VoxelizeOptions options;
+  options.diameter = diameter;
+  return voxelize(mesh, options);
+}
+
+Result<ParticleSet> voxelize_to(const TriangleMesh& mesh, std::size_t count) {
+  VoxelizeOptions options;
+  options.target_count = count;
+  return voxelize(mesh, options);
+}
+
+TEST(LoadMesh, ClosedCubeInEveryFormat) {
+  std::vector<std::tuple<float, float, float>> reference;
+  for (const std::string name : {"cube.obj", "cube.stl", "cube.ply", "cube.off"}) {
+    SCOPED_TRACE(name);
+    auto mesh = load_mesh(mesh_path(name));
+    ASSERT_TRUE(mesh) << mesh.message();
+    EXPECT_EQ(mesh->source, mesh_path(name));
+    EXPECT_EQ(mesh->vertices.size(), 8U);
+    EXPECT_EQ(mesh->triangles.size(), 12U);
+    EXPECT_EQ(count_open_edges(*mesh), 0U);
+    for (const auto& [diameter, n] : {std::pair{0.1, 10}, {0.25, 4}, {1.0 / 3.0, 3}, {0.05, 20}}) {
+      auto particles = voxelize_at(*mesh, diameter);
+      ASSERT_TRUE(particles) << particles.message();
+      EXPECT_EQ(particles->points.size(), static_cast<std::size_t>(n * n * n)) << diameter;
+      EXPECT_EQ(particles->diameter, diameter);
+    }
+    // The points stay in the mesh's own frame: the cube spans [0, 1]^3.
+    auto particles = voxelize_at(*mesh, 0.1);
+    ASSERT_TRUE(particles);
+    Eigen::Vector3f lo = particles->points.front(), hi = lo;
+    for (const auto& p : particles->points) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    EXPECT_LT((lo - Eigen::Vector3f::Constant(0.05F)).norm(), 1e-6F);
+    EXPECT_LT((hi - Eigen::Vector3f::Constant(0.95F)).norm(), 1e-6F);
+    if (reference.empty()) {
+      reference = sorted_points(*particles);
+    } else {
+      EXPECT_EQ(sorted_points(*particles), reference);
+    }
+  }
+}
+
+TEST(LoadMesh, OpenCubeIsRejectedByTheVoxelizer) {
+  const auto path = mesh_path("cube_open.obj");
+  auto mesh = load_mesh(path);
+  ASSERT_TRUE(mesh) << mesh.message();
+  EXPECT_EQ(count_open_edges(*mesh), 4U);
+  auto particles = voxelize_at(*mesh, 0.1);
+  ASSERT_FALSE(particles);
+  EXPECT_TRUE(contains(particles.message(), path)) << particles.message();
+  EXPECT_TRUE(contains(particles.message(), "4 open edges")) << particles.message();
+  EXPECT_TRUE(contains(particles.message(), "repair or close")) << particles.message();
+}
+
+TEST(LoadMesh, ErrorsNameTheFile) {
+  for (const std::string name : {"empty.obj", "not_a_mesh.ply", "missing.obj", ""}) {
+    const auto path = name.empty() ? std::string(MOTES_TEST_DATA_DIR) + "/meshes" : mesh_path(name);
+    auto mesh = load_mesh(path);
+    ASSERT_FALSE(mesh) << path;
+    EXPECT_TRUE(contains(mesh.message(), path)) << mesh.message();
+  }
+  EXPECT_TRUE(contains(load_mesh(mesh_path("missing.obj")).message(), "no such file"));
+  EXPECT_TRUE(contains(load_mesh(mesh_path("empty.obj")).message(), "no triangles"))
+      << load_mesh(mesh_path("empty.obj")).message();
+}
+
+TEST(Voxelize, RaysThroughVerticesAndEdgesOfAnOctahedron) {
+  // Cell centres (i, j, k) * 2r/n with n odd: the central column runs through both apexes and
+  // other columns run along edges. Inside: |i| + |j| + |k| <= (n - 1) / 2, and the number of
+  // integer points with L1 norm m is 4 m^2 + 2 (m >= 1).
+  const double r = 1.0;
+  for (const int n : {5, 7, 9, 11}) {
+    const int reach = (n - 1) / 2;
+    std::size_t expected = 1;
+    for (int m = 1; m <= reach; ++m) expected += static_cast<std::size_t>(4 * m * m + 2);
+    auto particles = voxelize_at(octahedron(r), 2.0 * r / n);
+    ASSERT_TRUE(particles) << particles.message();
+    EXPECT_EQ(particles->points.size(), expected) << "n " << n;
+  }
+}
+
+TEST(Voxelize, CubeWithEdgesOnColumnsAndRotatedCopies) {
+  // An axis-aligned box of 20 x 16 x 24 cells, away from the origin: exact count.
+  const double d = 0.05;
+  const Eigen::Vector3d size(20 * d, 16 * d, 24 * d);
+  auto box = voxelize_at(box_mesh(size, Eigen::Matrix3d::Identity(), {3.0, -2.0, 7.0}), d);
+  ASSERT_TRUE(box) << box.message();
+  EXPECT_EQ(box->points.size(), 20U * 16U * 24U);
+  // Rotated about z by 90 degrees: the same box, exactly.
+  const Eigen::Matrix3d quarter =
+      Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  auto turned = voxelize_at(box_mesh(size, quarter, Eigen::Vector3d::Zero()), d);
+  ASSERT_TRUE(turned) << turned.message();
+  EXPECT_EQ(turned->points.size(), 20U * 16U * 24U);
+  // Rotated by 45 degrees about z (irrational corners): the count is exactly the number of
+  // lattice points inside.
+  const Eigen::Matrix3d eighth =
+      Eigen::AngleAxisd(std::numbers::pi / 4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  auto diamond = voxelize_at(box_mesh(size, eighth, Eigen::Vector3d::Zero()), d);
+  ASSERT_TRUE(diamond) << diamond.message();
+  const Eigen::Vector3d half = 0.5 * size;
+  const auto surface = count_lattice_points(*diamond, [&](const Eigen::Vector3d& p) {
+    return (half - (eighth.transpose() * p).cwiseAbs()).minCoeff();
+  });
+  EXPECT_EQ(surface.on, 0U);
+  EXPECT_EQ(diamond->points.size(), surface.inside);
+}
+
+TEST(Voxelize, ColumnsExactlyOnSlantedFaces) {
+  // A prism |x| + |y| <= a, |z| <= h with dyadic coordinates: with 20 cells across, the cell
+  // centres are at half-integer multiples of d, so x + y = a holds exactly on whole rows of
+  // columns. A centre exactly on a face may count either way; every other one must be right.
+  const double d = 1.0 / 16.0;
+  const double a = 10 * d;
+  const double h = 4 * d;
+  TriangleMesh prism;
+  prism.source = "prism";
+  prism.vertices = {{a, 0, -h}, {0, a, -h}, {-a, 0, -h}, {0, -a, -h},
+                    {a, 0, h},  {0, a, h},  {-a, 0, h},  {0, -a, h}};
+  prism.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}};
+  for (int s = 0; s < 4; ++s) {
+    const int t = (s + 1) % 4;
+    prism.triangles.emplace_back(s, t, t + 4);
+    prism.triangles.emplace_back(s, t + 4, s + 4);
+  }
+  ASSERT_EQ(count_open_edges(prism), 0U);
+  auto particles = voxelize_at(prism, d);
+  ASSERT_TRUE(particles) << particles.message();
+  const auto surface = count_lattice_points(*particles, [&](const Eigen::Vector3d& p) {
+    return std::min(a - std::abs(p.x()) - std::abs(p.y()), h - std::abs(p.z()));
+  });
+  EXPECT_GT(surface.on, 0U);  // the case this test is about
+  EXPECT_GE(particles->points.size(), surface.inside);
+  EXPECT_LE(particles->points.size(), surface.inside + surface.on);
+}
+
+TEST(Voxelize, SphereVolumeWithinThreePercent) {
+  const double radius = 1.0;
+  const double d = radius / 10.0;
+  const double exact = 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+  for (const auto& centre : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.123, -4.5, 10.01)}) {
+    auto particles = voxelize_at(icosphere(radius, 4, centre), d);
+    ASSERT_TRUE(particles) << particles.message();
+    const double volume = static_cast<double>(particles->points.size()) * d * d * d;
+    EXPECT_NEAR(volume / exact, 1.0, 0.03) << particles->points.size();
+    for (const auto& p : particles->points) {
+      EXPECT_LE((p.cast<double>() - centre).norm(), radius + 1e-5);
+    }
+  }
+}
+
+TEST(Voxelize, OptionErrors) {
+  const auto mesh =
+      box_mesh(Eigen::Vector3d::Ones(), Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  VoxelizeOptions both;
+  both.diameter = 0.1;
+  both.target_count = 100;
+  EXPECT_TRUE(contains(voxelize(mesh, both).message(), "not both"));
+  EXPECT_TRUE(contains(voxelize(mesh, VoxelizeOptions{}).message(), "exactly one"));
+  for (const double bad : {-0.1, std::nan(""), HUGE_VAL}) {
+    auto r = voxelize_at(mesh, bad);
+    ASSERT_FALSE(r);
+    EXPECT_TRUE(contains(r.message(), "box mesh: particle diameter")) << r.message();
+  }
+  auto tiny = voxelize_at(mesh, 1e-5);
+  ASSERT_FALSE(tiny);
+  EXPECT_TRUE(contains(tiny.message(), "larger particle diameter")) << tiny.message();
+  auto many = voxelize_to(mesh, 1'000'000'000);
+  ASSERT_FALSE(many);
+  EXPECT_TRUE(contains(many.message(), "limit")) << many.message();
+}
+
+TEST(Voxelize, DegenerateMeshesAreErrors) {
+  // A closed but flat surface (a square and its back side) encloses nothing.
+  TriangleMesh flat;
+  flat.source = "flat square";
+  flat.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  flat.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 2, 1}, {0, 3, 2}};
+  auto r = voxelize_at(flat, 0.1);
+  ASSERT_FALSE(r);
+  EXPECT_TRUE(contains(r.message(), "flat square")) << r.message();
+  EXPECT_TRUE(contains(r.message(), "along z is 0 m")) << r.message();
+
+  TriangleMesh empty;
+  empty.source = "nothing.obj";
+  EXPECT_TRUE(contains(voxelize_at(empty, 0.1).message(), "nothing.obj"));
+
+  TriangleMesh bad_index =
+      box_mesh(Eigen::Vector3d::Ones(), Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  bad_index.triangles[3][1] = 8;
+  EXPECT_TRUE(contains(voxelize_at(bad_index, 0.1).message(), "uses vertex 8"));
+
+  // A tetrahedron whose one (huge) cell centre lies outside it: no particle, an error.
+  TriangleMesh tetra;
+  tetra.source = "tetra";
+  tetra.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  tetra.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  auto none = voxelize_at(tetra, 2.0);
+  ASSERT_FALSE(none);
+  EXPECT_TRUE(contains(none.message(), "tetra: no particle")) << none.message();
+  auto some = voxelize_at(tetra, 0.05);
+  ASSERT_TRUE(some) << some.message();
+  EXPECT_NEAR(static_cast<double>(some->points.size()) * 0.05 * 0.05 * 0.05 / (1.0 / 6.0), 1.0,
+              0.1);
+}
+
+TEST(Voxelize, TargetCountOnTheCube) {
+  auto mesh = load_mesh(mesh_path("cube.obj"));
+  ASSERT_TRUE(mesh) << mesh.message();
+  auto particles = voxelize_to(*mesh, 1000);
+  ASSERT_TRUE(particles) << particles.message();
+  EXPECT_EQ(particles->points.size(), 1000U);
+}
+
+TEST(Voxelize, BunnyTargetCounts) {
+  auto mesh = load_mesh(bunny_path());
+  ASSERT_TRUE(mesh) << mesh.message();
+  EXPECT_EQ(count_open_edges(*mesh), 0U);
+  for (const std::size_t target : {2000U, 10000U, 100000U}) {
+    const auto start = std::chrono::steady_clock::now();
+    auto particles = voxelize_to(*mesh, target);
+    const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
+    ASSERT_TRUE(particles) << particles.message();
+    const auto count = static_cast<double>(particles->points.size());
+    EXPECT_NEAR(count / static_cast<double>(target), 1.0, 0.05) << count;
+    // The reported diameter reproduces the count.
+    auto again = voxelize_at(*mesh, particles->diameter);
+    ASSERT_TRUE(again) << again.message();
+    EXPECT_EQ(again->points.size(), particles->points.size());
+    std::printf("bunny: target %zu -> %zu particles, diameter %.6g, %.3f s\n", target,
+                particles->points.size(), particles->diameter, took.count());
+  }
+}
+
+}  // namespace
+}  // namespace motes
