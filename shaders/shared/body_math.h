@@ -15,7 +15,8 @@ MOTES_FN vec3 body_angular_velocity(vec4 q, vec4 inv_inertia, vec3 angular_momen
 }
 
 /// One semi-implicit Euler step of a dynamic body (pos_invm.w > 0):
-///   v += dt (F/m + g);  x += dt v;  L += dt tau;  q = exp(w(q, L) dt / 2) q;  w = w(q, L).
+///   v += dt (F/m + g);  x += dt v;  L += dt tau;
+///   q_half = exp(w(q, L) dt / 4) q;  q = exp(w(q_half, L) dt / 2) q;  w = w(q, L).
 /// Static bodies (pos_invm.w == 0) are left untouched.
 MOTES_FN void body_integrate(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
                              MOTES_INOUT(vec4) vel, MOTES_INOUT(vec4) angmom,
@@ -33,8 +34,10 @@ MOTES_FN void body_integrate(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
   vec4 q = quat;
   vec3 w = vec3(0.0f);
   if (l.x != 0.0f || l.y != 0.0f || l.z != 0.0f) {  // a body at rest in rotation stays so
-    w = body_angular_velocity(quat, inv_inertia, l);
-    q = quat_integrate(quat, w, dt);
+    // Midpoint rule: turn by w taken at the half-step orientation. Taking w at the start instead
+    // adds rotational energy every step (first order), which makes tumbling bodies drift.
+    vec4 half = quat_integrate(quat, body_angular_velocity(quat, inv_inertia, l), 0.5f * dt);
+    q = quat_integrate(quat, body_angular_velocity(half, inv_inertia, l), dt);
     w = body_angular_velocity(q, inv_inertia, l);
   }
   pos_invm = vec4(x, inv_m);
