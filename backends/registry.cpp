@@ -54,18 +54,18 @@ Result<std::unique_ptr<Device>> open_device(const std::string& backend, int inde
       return Status::error(
           fmt::format("backend openmp has one device (index 0); device {} does not exist", index));
     }
-    std::unique_ptr<Device> d = std::make_unique<openmp::OpenMPDevice>(options.cpu_threads,
-                                                                            options.cpu_min_parallel);
+    std::unique_ptr<Device> d =
+        std::make_unique<openmp::OpenMPDevice>(options.cpu_threads, options.cpu_min_parallel);
     return d;
   }
   for (const auto& r : list_backends()) {
     if (r.backend == chosen) {
-      return Status::error(fmt::format("backend {} is unavailable: {}", chosen,
-                                       r.unavailable_reason));
+      return Status::error(
+          fmt::format("backend {} is unavailable: {}", chosen, r.unavailable_reason));
     }
   }
-  return Status::error(fmt::format(
-      "unknown backend '{}' (choose auto, openmp, cuda or vulkan)", backend));
+  return Status::error(
+      fmt::format("unknown backend '{}' (choose auto, openmp, cuda or vulkan)", backend));
 }
 
 }  // namespace motes

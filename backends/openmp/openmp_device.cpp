@@ -14,9 +14,10 @@
 namespace motes::openmp {
 
 AlignedBuffer::AlignedBuffer(std::size_t bytes)
-    : data_(static_cast<std::byte*>(::operator new[](bytes == 0 ? 64 : bytes,
-                                                     std::align_val_t{64}))),
-      size_(bytes) {}
+    : data_(static_cast<std::byte*>(::operator new[](bytes + kPadding, std::align_val_t{64}))),
+      size_(bytes) {
+  std::memset(data_.get(), 0, bytes + kPadding);
+}
 
 namespace {
 
@@ -68,7 +69,8 @@ OpenMPDevice::OpenMPDevice(int threads, int min_parallel)
 
 Status OpenMPDevice::allocate(const Sizes& sizes) {
   if (sizes.table < 64 || (sizes.table & (sizes.table - 1)) != 0) {
-    return Status::error(fmt::format("grid table size {} is not a power of two >= 64", sizes.table));
+    return Status::error(
+        fmt::format("grid table size {} is not a power of two >= 64", sizes.table));
   }
   try {
     std::vector<AlignedBuffer> fresh;
@@ -81,13 +83,11 @@ Status OpenMPDevice::allocate(const Sizes& sizes) {
     ids_tmp_.assign(sizes.particles, 0);
     buffers_ = std::move(fresh);
   } catch (const std::bad_alloc&) {
-    return Status::error(fmt::format(
-        "out of host memory allocating {} particles and {} bodies on the openmp device",
-        sizes.particles, sizes.bodies));
+    return Status::error(
+        fmt::format("out of host memory allocating {} particles and {} bodies on the openmp device",
+                    sizes.particles, sizes.bodies));
   }
   sizes_ = sizes;
-  // Outputs start defined (zero) so a read before the first kernel is deterministic.
-  for (auto& b : buffers_) std::memset(b.data(), 0, b.size());
   return Status::ok();
 }
 
@@ -116,7 +116,8 @@ Status OpenMPDevice::read(Buffer b, void* dst, std::size_t bytes) {
 void OpenMPDevice::record(Kernel k, std::chrono::steady_clock::time_point start) {
   if (!timing_) return;
   const auto i = static_cast<std::size_t>(k);
-  times_.seconds[i] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  times_.seconds[i] +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   times_.launches[i] += 1;
 }
 

@@ -12,9 +12,11 @@
 
 namespace motes::openmp {
 
-/// Heap memory aligned for vec4 and cache lines; contents uninitialised.
+/// Zeroed heap memory aligned for vec4 and cache lines, with kPadding readable bytes past the end
+/// (so 4-wide loads of vec4 arrays may run past the last element).
 class AlignedBuffer {
  public:
+  static constexpr std::size_t kPadding = 64;
   AlignedBuffer() = default;
   explicit AlignedBuffer(std::size_t bytes);
   [[nodiscard]] std::byte* data() { return data_.get(); }

@@ -12,15 +12,15 @@ MOTES_SHARED_BEGIN
 
 /// Launch parameters of every kernel family; travels with the launch (push constants).
 struct StepParams {
-  vec4 gravity_dt;       // xyz: gravity (m/s^2), w: time step of this substep (s)
-  uint particle_count;   // N
-  uint body_count;       // B
-  uint table_mask;       // T - 1; the hashed grid has T = 2^k buckets
-  uint plane_count;      // P
-  float cell_size;       // grid cell edge (m) = largest particle diameter
-  float inv_cell_size;   // 1 / cell_size
-  uint material_count;   // M; pair table has M*M entries
-  uint flags;            // MOTES_FLAG_*
+  vec4 gravity_dt;      // xyz: gravity (m/s^2), w: time step of this substep (s)
+  uint particle_count;  // N
+  uint body_count;      // B
+  uint table_mask;      // T - 1; the hashed grid has T = 2^k buckets
+  uint plane_count;     // P
+  float cell_size;      // grid cell edge (m) = largest particle diameter
+  float inv_cell_size;  // 1 / cell_size
+  uint material_count;  // M; pair table has M*M entries
+  uint flags;           // MOTES_FLAG_*
 };
 
 /// Contact law of one pair of materials (symmetric): F_n = k d - gamma_n m* v_n,

@@ -20,10 +20,9 @@ MOTES_FN vec3 quat_rotate_inverse(vec4 q, vec3 v) {
 
 /// Hamilton product a * b (apply b, then a).
 MOTES_FN vec4 quat_mul(vec4 a, vec4 b) {
-  return vec4(a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
-              a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
-              a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w,
-              a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z);
+  return vec4(
+      a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y, a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
+      a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w, a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z);
 }
 
 MOTES_FN vec4 quat_normalize(vec4 q) {

@@ -12,10 +12,10 @@ namespace motes {
 
 /// What `motes devices` prints for one backend.
 struct BackendReport {
-  std::string backend;             ///< "openmp", "cuda", "vulkan"
-  bool compiled = false;           ///< built into this binary
-  std::vector<DeviceInfo> devices; ///< empty when unavailable
-  std::string unavailable_reason;  ///< why there are no devices (not built, no driver, ...)
+  std::string backend;              ///< "openmp", "cuda", "vulkan"
+  bool compiled = false;            ///< built into this binary
+  std::vector<DeviceInfo> devices;  ///< empty when unavailable
+  std::string unavailable_reason;   ///< why there are no devices (not built, no driver, ...)
 };
 
 /// Every backend motes knows, in preference order (cuda, vulkan, openmp).

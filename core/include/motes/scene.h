@@ -16,11 +16,11 @@ namespace motes {
 /// A named material: density and the contact law of its particles.
 struct Material {
   std::string name;
-  double density = 1000.0;   ///< kg/m^3
-  double stiffness = 0.0;    ///< k (N/m)
-  double damping = 0.0;      ///< gamma_n (1/s): normal dashpot force = gamma_n m* v_n
-  double tangential = 0.0;   ///< gamma_t (1/s): tangential force = gamma_t m* v_t
-  double friction = -1.0;    ///< Coulomb cap mu on the tangential force; < 0: no cap
+  double density = 1000.0;  ///< kg/m^3
+  double stiffness = 0.0;   ///< k (N/m)
+  double damping = 0.0;     ///< gamma_n (1/s): normal dashpot force = gamma_n m* v_n
+  double tangential = 0.0;  ///< gamma_t (1/s): tangential force = gamma_t m* v_t
+  double friction = -1.0;   ///< Coulomb cap mu on the tangential force; < 0: no cap
 };
 
 /// Global settings of a scene.

@@ -20,7 +20,7 @@ struct Snapshot {
   std::vector<shared::vec4> particle_pos;  ///< xyz, w = radius
   std::vector<shared::vec4> particle_vel;  ///< xyz, w = inverse mass
   std::vector<std::uint32_t> particle_body;
-  std::vector<shared::vec4> body_pos;      ///< centre of mass, w = inverse mass
+  std::vector<shared::vec4> body_pos;  ///< centre of mass, w = inverse mass
   std::vector<shared::vec4> body_quat;
   std::vector<shared::vec4> body_vel;
   std::vector<shared::vec4> body_angmom;

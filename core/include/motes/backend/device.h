@@ -33,13 +33,13 @@ enum class Buffer : std::uint32_t {
   BodyTorque,      ///< vec4: summed torque about the centre of mass
   BodyFirst,       ///< uint (B + 1): first particle of each body, then N
   // Hashed grid (outputs of grid_build).
-  GridBucket,     ///< uint (N): bucket of particle i
-  GridOrder,      ///< uint (N): particle ids sorted stably by bucket
-  GridCellStart,  ///< uint (T + 1): sorted position of each bucket's first particle, then N
-  SortedPos,      ///< vec4 (N): ParticlePos in grid order
-  SortedVel,      ///< vec4 (N): ParticleVel in grid order
-  SortedBody,     ///< uint (N): ParticleBody in grid order
-  SortedMaterial, ///< uint (N): ParticleMaterial in grid order
+  GridBucket,      ///< uint (N): bucket of particle i
+  GridOrder,       ///< uint (N): particle ids sorted stably by bucket
+  GridCellStart,   ///< uint (T + 1): sorted position of each bucket's first particle, then N
+  SortedPos,       ///< vec4 (N): ParticlePos in grid order
+  SortedVel,       ///< vec4 (N): ParticleVel in grid order
+  SortedBody,      ///< uint (N): ParticleBody in grid order
+  SortedMaterial,  ///< uint (N): ParticleMaterial in grid order
   // Tables.
   ContactLaws,  ///< ContactLaw (M * M): law of material pair (a, b) at a * M + b
   Planes,       ///< PlaneData (P)
