@@ -9,7 +9,8 @@ shift || true
 
 packages=(build-essential cmake ninja-build pkg-config git
   libeigen3-dev libassimp-dev nlohmann-json3-dev libcli11-dev libfmt-dev
-  libgtest-dev libgmock-dev libbenchmark-dev python3 python3-meshio clang-format)
+  libgtest-dev libgmock-dev libbenchmark-dev python3 python3-meshio clang-format
+  glslang-tools spirv-tools)
 
 if [ "${MOTES_SKIP_INSTALL:-0}" != 1 ]; then
   missing=()

@@ -36,8 +36,8 @@ MOTES_FN void body_integrate(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
   if (l.x != 0.0f || l.y != 0.0f || l.z != 0.0f) {  // a body at rest in rotation stays so
     // Midpoint rule: turn by w taken at the half-step orientation. Taking w at the start instead
     // adds rotational energy every step (first order), which makes tumbling bodies drift.
-    vec4 half = quat_integrate(quat, body_angular_velocity(quat, inv_inertia, l), 0.5f * dt);
-    q = quat_integrate(quat, body_angular_velocity(half, inv_inertia, l), dt);
+    vec4 q_half = quat_integrate(quat, body_angular_velocity(quat, inv_inertia, l), 0.5f * dt);
+    q = quat_integrate(quat, body_angular_velocity(q_half, inv_inertia, l), dt);
     w = body_angular_velocity(q, inv_inertia, l);
   }
   pos_invm = vec4(x, inv_m);

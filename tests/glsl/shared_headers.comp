@@ -1,0 +1,39 @@
+#version 450
+// Compiles every header of shaders/shared/ as GLSL: the physics is written once for C++, CUDA and
+// GLSL, and this keeps the GLSL side honest until the Vulkan backend's shaders use them.
+#extension GL_GOOGLE_include_directive : require
+
+#include "shared/common.h"
+#include "shared/params.h"
+#include "shared/grid_hash.h"
+#include "shared/quaternion.h"
+#include "shared/contact_force.h"
+#include "shared/body_math.h"
+
+layout(local_size_x = 64) in;
+layout(push_constant) uniform Push { StepParams p; };
+layout(std430, binding = 0) buffer Pos { vec4 pos[]; };
+layout(std430, binding = 1) buffer Vel { vec4 vel[]; };
+layout(std430, binding = 2) buffer Laws { ContactLaw laws[]; };
+layout(std430, binding = 3) buffer Planes { PlaneData planes[]; };
+layout(std430, binding = 4) buffer Out { vec4 result[]; };
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= p.particle_count) return;
+  vec4 a = pos[i];
+  vec4 b = pos[(i + 1u) % p.particle_count];
+  vec3 f = particle_contact_force(xyz(a), xyz(vel[i]), a.w, vel[i].w, xyz(b), xyz(b), b.w, 1.0f,
+                                  laws[0], p.flags);
+  f += plane_contact_force(xyz(a), xyz(vel[i]), a.w, vel[i].w, planes[0].normal_offset, laws[0],
+                           p.flags);
+  uint bucket = grid_bucket(grid_cell_coord(a.x, p.inv_cell_size), 0, 0, p.table_mask);
+  vec4 q = vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  vec4 body = a;
+  vec4 v = vel[i];
+  vec4 l = vec4(1.0f, 0.0f, 0.0f, 0.0f);
+  vec4 w;
+  body_integrate(body, q, v, l, w, vec4(1.0f), vec4(f, 0.0f), vec4(0.0f), p.gravity_dt);
+  vec3 x = particle_position(body, q, a) + particle_velocity(q, v, w, a);
+  result[i] = vec4(x + particle_torque(a, body, vec4(f, 0.0f)), float(bucket));
+}
