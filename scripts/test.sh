@@ -7,4 +7,6 @@ build=${MOTES_TEST_BUILD:-$root/build-test}
 "$root/scripts/setup.sh" "$build" -DMOTES_WERROR=ON
 "$root/scripts/check-format.sh"
 cd "$build"
+# Tests run side by side: OpenMP threads that spin while waiting would starve each other.
+export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
 ctest --output-on-failure -j "${JOBS:-$(nproc)}" --timeout 900

@@ -38,6 +38,34 @@ std::string line_column(const std::string& text, std::size_t index) {
   return fmt::format("{}:{}", line, column);
 }
 
+bool is_number_char(char c) {
+  return (c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.' || c == 'e' || c == 'E';
+}
+
+/// Start of the JSON token (string, number, literal or punctuation) that covers byte `index`:
+/// nlohmann reports the last character it read, which is the end of the offending token.
+std::size_t token_start(const std::string& text, std::size_t index) {
+  std::size_t i = 0;
+  while (i < text.size() && i <= index) {
+    const char c = text[i];
+    std::size_t end = i + 1;
+    if (c == '"') {
+      while (end < text.size() && text[end] != '"') end += text[end] == '\\' ? 2 : 1;
+      end = std::min(end + 1, text.size());
+    } else if (c == '-' || (c >= '0' && c <= '9')) {
+      while (end < text.size() && is_number_char(text[end])) ++end;
+    } else if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z')) {
+      while (end < text.size() &&
+             ((text[end] >= 'a' && text[end] <= 'z') || (text[end] >= 'A' && text[end] <= 'Z'))) {
+        ++end;
+      }
+    }
+    if (index < end) return i;
+    i = end;
+  }
+  return index;
+}
+
 /// The reason of a nlohmann parse error without its "[json.exception...] parse error at line L,
 /// column C: " prefix (the position is recomputed by line_column).
 std::string parse_error_reason(const std::string& what) {
@@ -46,10 +74,6 @@ std::string parse_error_reason(const std::string& what) {
   at = what.find(": ", at);
   if (at == std::string::npos) return what;
   return what.substr(at + 2);
-}
-
-bool is_number_char(char c) {
-  return (c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.' || c == 'e' || c == 'E';
 }
 
 /// Byte index of the number literal `token` in `text` outside strings, or npos.
@@ -161,8 +185,8 @@ Json parse_scene_json(const std::string& text, const std::string& source) {
   try {
     return Json::parse(text, DuplicateKeyCheck(source));
   } catch (const nlohmann::json::parse_error& e) {
-    // e.byte is the 1-based position of the last character read.
-    const std::size_t index = e.byte > 0 ? e.byte - 1 : 0;
+    // e.byte is the 1-based position of the last character read; report its token's start.
+    const std::size_t index = token_start(text, e.byte > 0 ? e.byte - 1 : 0);
     throw Error(
         fmt::format("{}:{}: {}", source, line_column(text, index), parse_error_reason(e.what())));
   } catch (const nlohmann::json::out_of_range& e) {
@@ -218,7 +242,8 @@ std::string describe(const Json& value) {
     case Json::value_t::object:
       return "an object";
     case Json::value_t::array:
-      return "an array";
+      return value.size() == 1 ? "an array of 1 value"
+                               : fmt::format("an array of {} values", value.size());
     default:
       return "an unsupported value";
   }
@@ -267,14 +292,14 @@ double Node::number(Sign sign) const {
   const double v = json_->get<double>();
   if (!std::isfinite(v)) fail(fmt::format("must be {}, got a non-finite value", sign_word(sign)));
   if (std::abs(v) > kFloatMax) {
-    fail(fmt::format("out of range: {} does not fit in a 32-bit float (largest magnitude {})",
+    fail(fmt::format("out of range: {} does not fit in a 32-bit float (largest magnitude {:.8g})",
                      describe(*json_), kFloatMax));
   }
   if ((sign == Sign::Positive && !(v > 0.0)) || (sign == Sign::NonNegative && v < 0.0)) {
     fail(fmt::format("must be {}, got {}", sign_word(sign), describe(*json_)));
   }
   if (sign == Sign::Positive && v < kFloatMin) {
-    fail(fmt::format("out of range: {} is too small for a 32-bit float (smallest {})",
+    fail(fmt::format("out of range: {} is too small for a 32-bit float (smallest {:.8g})",
                      describe(*json_), kFloatMin));
   }
   return v;
@@ -286,7 +311,9 @@ std::int64_t Node::integer(std::int64_t lo, std::int64_t hi) const {
   };
   if (json_->is_number_unsigned()) {
     const std::uint64_t u = json_->get<std::uint64_t>();
-    if (u > static_cast<std::uint64_t>(hi)) bad();
+    if ((lo > 0 && u < static_cast<std::uint64_t>(lo)) || u > static_cast<std::uint64_t>(hi)) {
+      bad();
+    }
     return static_cast<std::int64_t>(u);
   }
   if (json_->is_number_integer()) {

@@ -35,14 +35,15 @@ std::shared_ptr<const ParticleSet> read_shape(const Node& shape, ShapeCache& cac
 /// Reads {"axis": [x, y, z], "degrees": a}.
 Eigen::Quaterniond read_rotation(const Node& rotation);
 
-/// Reads the "bodies" array into scene.bodies (materials must already be in scene.materials).
-/// `dynamic_entries` receives, per dynamic body entry, its first index in scene.bodies and its
-/// number of copies; likewise `static_entries`.
+/// One entry of the "bodies" array after expansion: its copies are scene.bodies[first, first +
+/// copies).
 struct BodyEntry {
   std::size_t first = 0;
   std::size_t copies = 0;
   std::string path;  ///< JSON pointer of the entry
 };
+/// Reads the "bodies" array into scene.bodies (materials must already be in scene.materials),
+/// one BodyEntry per array element into `entries`.
 void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
                  std::vector<BodyEntry>& entries);
 

@@ -115,7 +115,9 @@ Eigen::Quaterniond read_rotation(const Node& rotation) {
 }
 
 std::shared_ptr<const ParticleSet> read_shape(const Node& shape, ShapeCache& cache) {
-  if (!shape.json().is_object()) shape.fail("must be an object with a \"type\"");
+  if (!shape.json().is_object()) {
+    shape.fail(fmt::format("must be an object with a \"type\", got {}", describe(shape.json())));
+  }
   const Node type_node = shape.at("type");
   const std::string type = type_node.string();
 
