@@ -1,9 +1,13 @@
 // Benchmark workloads W1 "settle" and W2 "dominoes" (docs/benchmarks.md).
 #include "motes/workloads.h"
 
+#include <array>
 #include <cmath>
+#include <fstream>
+#include <map>
 #include <memory>
 #include <numbers>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -29,13 +33,11 @@ PlaneSpec plane(const char* name, Eigen::Vector3d normal, Eigen::Vector3d point)
   return p;
 }
 
-}  // namespace
-
-Scene settle_workload(int nx, int ny, int nz, std::uint64_t seed) {
+/// The W1 scene without bodies: settings, material, floor and walls of a box lx x lz.
+Scene settle_base(const std::string& source, double lx, double lz) {
   constexpr double d = 0.01;
-  const double s = 1.1 * d;
   Scene scene;
-  scene.source = fmt::format("<W1 settle {}x{}x{}>", nx, ny, nz);
+  scene.source = source;
   scene.settings.dt = 2e-5;
   scene.settings.substeps = 1;
   scene.settings.gravity = {0.0, -9.81, 0.0};
@@ -50,12 +52,31 @@ Scene settle_workload(int nx, int ny, int nz, std::uint64_t seed) {
   m.friction = 0.5;
   scene.materials.push_back(m);
   scene.settings.contact = m;
+  scene.planes.push_back(plane("floor", {0, 1, 0}, {0, 0, 0}));
+  scene.planes.push_back(plane("x0", {1, 0, 0}, {0, 0, 0}));
+  scene.planes.push_back(plane("x1", {-1, 0, 0}, {lx, 0, 0}));
+  scene.planes.push_back(plane("z0", {0, 0, 1}, {0, 0, 0}));
+  scene.planes.push_back(plane("z1", {0, 0, -1}, {0, 0, lz}));
+  return scene;
+}
 
+/// A free sphere of diameter d weighing density * pi/6 d^3, as LAMMPS's spheres do.
+std::shared_ptr<ParticleSet> free_sphere(double d) {
   auto sphere = std::make_shared<ParticleSet>();
   sphere->points.emplace_back(0.0f, 0.0f, 0.0f);
   sphere->diameter = d;
   sphere->particle_volume = std::numbers::pi / 6.0 * d * d * d;
+  return sphere;
+}
 
+}  // namespace
+
+Scene settle_workload(int nx, int ny, int nz, std::uint64_t seed) {
+  constexpr double d = 0.01;
+  const double s = 1.1 * d;
+  Scene scene =
+      settle_base(fmt::format("<W1 settle {}x{}x{}>", nx, ny, nz), (nx + 1) * s, (nz + 1) * s);
+  const auto sphere = free_sphere(d);
   scene.bodies.reserve(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) *
                        static_cast<std::size_t>(nz));
   std::uint64_t state = seed;
@@ -75,13 +96,70 @@ Scene settle_workload(int nx, int ny, int nz, std::uint64_t seed) {
       }
     }
   }
-  const double lx = (nx + 1) * s;
-  const double lz = (nz + 1) * s;
-  scene.planes.push_back(plane("floor", {0, 1, 0}, {0, 0, 0}));
-  scene.planes.push_back(plane("x0", {1, 0, 0}, {0, 0, 0}));
-  scene.planes.push_back(plane("x1", {-1, 0, 0}, {lx, 0, 0}));
-  scene.planes.push_back(plane("z0", {0, 0, 1}, {0, 0, 0}));
-  scene.planes.push_back(plane("z1", {0, 0, -1}, {0, 0, lz}));
+  return scene;
+}
+
+Result<Scene> settle_workload_from_lammps(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Status::error(fmt::format("{}: cannot open LAMMPS data file", path));
+  std::size_t atoms = 0;
+  double xhi = 0.0, zhi = 0.0;
+  std::map<long, std::array<double, 4>> pos;  // id -> diameter, x, y, z
+  std::map<long, std::array<double, 3>> vel;
+  std::string line, section;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::istringstream ls(line);
+    if (line.find(" atoms") != std::string::npos && atoms == 0 && section.empty()) {
+      ls >> atoms;
+    } else if (line.find("xlo xhi") != std::string::npos) {
+      double lo = 0.0;
+      ls >> lo >> xhi;
+    } else if (line.find("zlo zhi") != std::string::npos) {
+      double lo = 0.0;
+      ls >> lo >> zhi;
+    } else if (line.rfind("Atoms", 0) == 0 || line.rfind("Velocities", 0) == 0) {
+      section = line.substr(0, line.find(' '));
+    } else if (section == "Atoms") {
+      long id = 0, type = 0;
+      double diameter = 0.0, density = 0.0, x = 0.0, y = 0.0, z = 0.0;
+      if (!(ls >> id >> type >> diameter >> density >> x >> y >> z)) {
+        return Status::error(fmt::format(
+            "{}:{}: expected 'id type diameter density x y z' (atom style sphere)", path, line_no));
+      }
+      pos[id] = {diameter, x, y, z};
+    } else if (section == "Velocities") {
+      long id = 0;
+      double vx = 0.0, vy = 0.0, vz = 0.0;
+      if (!(ls >> id >> vx >> vy >> vz)) {
+        return Status::error(fmt::format("{}:{}: expected 'id vx vy vz ...'", path, line_no));
+      }
+      vel[id] = {vx, vy, vz};
+    }
+  }
+  if (atoms == 0 || pos.size() != atoms || vel.size() != atoms || !(xhi > 0.0) || !(zhi > 0.0)) {
+    return Status::error(fmt::format(
+        "{}: not a W1 state: {} atoms declared, {} positions, {} velocities, box x {} z {}", path,
+        atoms, pos.size(), vel.size(), xhi, zhi));
+  }
+  Scene scene = settle_base(fmt::format("<W1 settle from {}>", path), xhi, zhi);
+  const auto sphere = free_sphere(0.01);
+  scene.bodies.reserve(atoms);
+  for (const auto& [id, p] : pos) {
+    if (std::abs(p[0] - 0.01) > 1e-9) {
+      return Status::error(
+          fmt::format("{}: atom {} has diameter {}, W1 uses 0.01", path, id, p[0]));
+    }
+    auto v = vel.find(id);
+    if (v == vel.end()) return Status::error(fmt::format("{}: atom {} has no velocity", path, id));
+    BodySpec b;
+    b.shape = sphere;
+    b.position = {p[1], p[2], p[3]};
+    b.velocity = {v->second[0], v->second[1], v->second[2]};
+    scene.bodies.push_back(std::move(b));
+  }
   return scene;
 }
 

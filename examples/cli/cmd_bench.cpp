@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,7 @@ struct BenchOptions {
   int domino_rows = 10;
   std::uint64_t domino_steps = 2000;
   std::string cache = "bench-cache";
+  std::string dense_from;  // LAMMPS data file: the dense phase starts from LAMMPS's settled state
   std::string json_path;
 };
 
@@ -213,6 +215,12 @@ void run_bench(const BenchOptions& o) {
   fmt::print("{:<9} {:<8} {:>9} {:>6} {:>9} {:>10}{}   (kernel columns: ms/step)\n", "workload",
              "phase", "particles", "steps", "ms/step", "p-steps/s", ks);
 
+  std::optional<motes::Scene> lammps_state;
+  if (!o.dense_from.empty()) {
+    lammps_state = must(motes::settle_workload_from_lammps(o.dense_from));
+    fmt::print("dense* = the dense phase from LAMMPS's settled state {} ({} spheres)\n",
+               o.dense_from, lammps_state->bodies.size());
+  }
   nlohmann::json results = nlohmann::json::array();
   if (o.workload != "dominoes") {
     for (std::uint64_t n : o.sizes) {
@@ -227,11 +235,17 @@ void run_bench(const BenchOptions& o) {
         results.push_back(to_json(m));
       }
       if (o.phase != "falling") {
-        const std::string path = ensure_settled(scene, o, n);
-        Measurement m = measure(scene, o, o.dense_steps,
-                                [&](motes::Simulation& s) { must(s.load_state(path)); });
+        Measurement m;
+        if (lammps_state && lammps_state->bodies.size() == n) {
+          m = measure(*lammps_state, o, o.dense_steps, [](motes::Simulation&) {});
+          m.phase = "dense*";
+        } else {
+          const std::string path = ensure_settled(scene, o, n);
+          m = measure(scene, o, o.dense_steps,
+                      [&](motes::Simulation& s) { must(s.load_state(path)); });
+          m.phase = "dense";
+        }
         m.workload = "settle";
-        m.phase = "dense";
         print_row(m);
         results.push_back(to_json(m));
       }
@@ -293,6 +307,10 @@ void add_bench_command(CLI::App& app) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--cache", opts->cache, "folder for settled W1 states")->capture_default_str();
+  cmd->add_option("--dense-from", opts->dense_from,
+                  "W1 dense phase from this LAMMPS data file (write_data after in.make_settled) "
+                  "instead of motes's own settled state, for that file's N")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--json", opts->json_path, "also write the results as JSON to this file");
   cmd->callback([opts]() { run_bench(*opts); });
 }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "motes/scene.h"
 
@@ -13,6 +14,11 @@ namespace motes {
 /// z = (NZ+1) s); k = 2000 N/m, gamma_n = 50/s, gamma_t = 25/s, mu = 0.5 (LAMMPS gran/hooke);
 /// dt = 2e-5 s. Sphere mass = density * pi/6 d^3, as in LAMMPS.
 Scene settle_workload(int nx, int ny, int nz, std::uint64_t seed = 12345);
+
+/// W1 from the state LAMMPS wrote after settling (write_data of peers' in.make_settled: atom
+/// style sphere, velocities included): the same spheres, walls at x = xhi and z = zhi, the same
+/// contact law. Lets both codes run the dense phase from one identical state.
+Result<Scene> settle_workload_from_lammps(const std::string& path);
 
 /// NX x NY x NZ for a W1 size in docs/benchmarks.md (16,384 ... 16,777,216); false if not one.
 bool settle_dimensions(std::uint64_t particles, int& nx, int& ny, int& nz);
