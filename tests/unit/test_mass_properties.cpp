@@ -7,28 +7,12 @@
 #include <numeric>
 
 #include "motes/shapes.h"
+#include "unit/test_support.h"
 
 namespace motes {
 namespace {
 
-/// A closed box mesh of the given size, rotated and then moved by `offset`.
-TriangleMesh box_mesh(const Eigen::Vector3d& size, const Eigen::Matrix3d& rotation,
-                      const Eigen::Vector3d& offset) {
-  TriangleMesh mesh;
-  mesh.source = "box mesh";
-  for (int k = 0; k < 8; ++k) {
-    const Eigen::Vector3d corner((k & 1) != 0 ? 0.5 : -0.5, (k & 2) != 0 ? 0.5 : -0.5,
-                                 (k & 4) != 0 ? 0.5 : -0.5);
-    mesh.vertices.push_back(rotation * corner.cwiseProduct(size) + offset);
-  }
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    mesh.triangles.emplace_back(q[0], q[1], q[2]);
-    mesh.triangles.emplace_back(q[0], q[2], q[3]);
-  }
-  return mesh;
-}
+using motes_test::box_mesh;
 
 /// Inertia of a solid box of the given mass and size about its centre, in its own axes.
 Eigen::Matrix3d solid_box_inertia(double mass, const Eigen::Vector3d& s) {

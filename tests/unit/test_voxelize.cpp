@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "motes/shapes.h"
+#include "unit/test_support.h"
 
 namespace motes {
 namespace {
@@ -27,25 +28,7 @@ bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
-/// A closed box mesh of the given size, rotated and then moved by `offset`.
-TriangleMesh box_mesh(const Eigen::Vector3d& size, const Eigen::Matrix3d& rotation,
-                      const Eigen::Vector3d& offset) {
-  TriangleMesh mesh;
-  mesh.source = "box mesh";
-  for (int k = 0; k < 8; ++k) {
-    const Eigen::Vector3d corner((k & 1) != 0 ? 0.5 : -0.5, (k & 2) != 0 ? 0.5 : -0.5,
-                                 (k & 4) != 0 ? 0.5 : -0.5);
-    mesh.vertices.push_back(rotation * corner.cwiseProduct(size) + offset);
-  }
-  // Corner k has bit 0 = +x, bit 1 = +y, bit 2 = +z; quads counter-clockwise from outside.
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    mesh.triangles.emplace_back(q[0], q[1], q[2]);
-    mesh.triangles.emplace_back(q[0], q[2], q[3]);
-  }
-  return mesh;
-}
+using motes_test::box_mesh;
 
 /// The octahedron |x| + |y| + |z| <= r: its apexes and edges lie on lattice columns.
 TriangleMesh octahedron(double r) {
