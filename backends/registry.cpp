@@ -1,5 +1,6 @@
 // The backend registry: which backends this binary has, their devices, and opening one.
-// Preference order for "auto": cuda, vulkan, openmp.
+// "auto" picks a Vulkan GPU when there is one, else the CPU backend (a CPU Vulkan driver such as
+// lavapipe is slower than OpenMP on the same cores).
 #include <fmt/format.h>
 
 #include <memory>
@@ -8,25 +9,48 @@
 
 #include "motes/devices.h"
 #include "openmp/openmp_device.h"
+#ifdef MOTES_HAVE_VULKAN
+#include "vulkan/vulkan_backend.h"
+#endif
 
 namespace motes {
 
 namespace {
 
-constexpr const char* kNotImplemented =
-    "not built: this version of motes has no {} backend yet (planned; see docs/architecture.md)";
+BackendReport vulkan_report() {
+  BackendReport r;
+  r.backend = "vulkan";
+#ifdef MOTES_HAVE_VULKAN
+  r.compiled = true;
+  vulkan::Listing l = vulkan::list_devices();
+  r.devices = std::move(l.devices);
+  r.unavailable_reason = l.reason;
+#else
+  r.unavailable_reason = "not built: " MOTES_VULKAN_STATUS;
+#endif
+  return r;
+}
+
+/// "auto": a Vulkan GPU, else the CPU backend (OpenMP beats lavapipe on the same cores).
+std::string auto_backend() {
+#ifdef MOTES_HAVE_VULKAN
+  const vulkan::Listing l = vulkan::list_devices();
+  if (l.preferred >= 0 && l.preferred_is_gpu) return "vulkan";
+#endif
+  return "openmp";
+}
 
 }  // namespace
 
 std::vector<BackendReport> list_backends() {
   std::vector<BackendReport> out;
-  for (const char* name : {"cuda", "vulkan"}) {
-    BackendReport r;
-    r.backend = name;
-    r.compiled = false;
-    r.unavailable_reason = fmt::format(fmt::runtime(kNotImplemented), name);
-    out.push_back(std::move(r));
-  }
+  BackendReport cuda;
+  cuda.backend = "cuda";
+  cuda.unavailable_reason =
+      "not built: this version of motes has no CUDA backend yet (planned; see "
+      "docs/architecture.md)";
+  out.push_back(std::move(cuda));
+  out.push_back(vulkan_report());
   BackendReport cpu;
   cpu.backend = "openmp";
   cpu.compiled = true;
@@ -40,15 +64,10 @@ Result<std::unique_ptr<Device>> open_device(const std::string& backend, int inde
   if (options.cpu_threads < 0) {
     return Status::error(fmt::format("cpu threads must be >= 0, got {}", options.cpu_threads));
   }
-  std::string chosen = backend;
-  if (backend == "auto") {
-    for (const auto& r : list_backends()) {
-      if (!r.devices.empty()) {
-        chosen = r.backend;
-        break;
-      }
-    }
-  }
+  const std::string chosen = backend == "auto" ? auto_backend() : backend;
+#ifdef MOTES_HAVE_VULKAN
+  if (chosen == "vulkan") return vulkan::open_device(index);
+#endif
   if (chosen == "openmp") {
     if (index > 0) {
       return Status::error(

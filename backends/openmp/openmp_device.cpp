@@ -16,7 +16,16 @@ namespace motes::openmp {
 AlignedBuffer::AlignedBuffer(std::size_t bytes)
     : data_(static_cast<std::byte*>(::operator new[](bytes + kPadding, std::align_val_t{64}))),
       size_(bytes) {
-  std::memset(data_.get(), 0, bytes + kPadding);
+  std::memset(data_.get(), 0, bytes);
+  std::memset(data_.get() + bytes, kGuardByte, kPadding);
+}
+
+bool AlignedBuffer::guard_intact() const {
+  if (!data_) return true;
+  for (std::size_t i = 0; i < kPadding; ++i) {
+    if (static_cast<unsigned char>(data_[size_ + i]) != kGuardByte) return false;
+  }
+  return true;
 }
 
 namespace {
@@ -110,6 +119,16 @@ Status OpenMPDevice::read(Buffer b, void* dst, std::size_t bytes) {
                                      buffer_name(b), buffers_[i].size()));
   }
   if (bytes > 0) std::memcpy(dst, buffers_[i].data(), bytes);
+  return Status::ok();
+}
+
+Status OpenMPDevice::check_guards() {
+  for (std::size_t i = 0; i < buffers_.size(); ++i) {
+    if (!buffers_[i].guard_intact()) {
+      return Status::error(fmt::format("openmp: a kernel wrote past the end of {} ({} bytes)",
+                                       buffer_name(static_cast<Buffer>(i)), buffers_[i].size()));
+    }
+  }
   return Status::ok();
 }
 

@@ -12,15 +12,19 @@
 
 namespace motes::openmp {
 
-/// Zeroed heap memory aligned for vec4 and cache lines, with kPadding readable bytes past the end
-/// (so 4-wide loads of vec4 arrays may run past the last element).
+/// Zeroed heap memory aligned for vec4 and cache lines, followed by kPadding bytes of guard
+/// pattern that kernels may read (4-wide loads of vec4 arrays run past the last element) but never
+/// write.
 class AlignedBuffer {
  public:
   static constexpr std::size_t kPadding = 64;
+  static constexpr unsigned char kGuardByte = 0xA5;
   AlignedBuffer() = default;
   explicit AlignedBuffer(std::size_t bytes);
   [[nodiscard]] std::byte* data() { return data_.get(); }
   [[nodiscard]] std::size_t size() const { return size_; }
+  /// True while the padding still holds the guard pattern.
+  [[nodiscard]] bool guard_intact() const;
 
  private:
   struct Free {
@@ -51,6 +55,7 @@ class OpenMPDevice final : public Device {
   void particles_update(const shared::StepParams& p) override;
 
   Status synchronize() override { return Status::ok(); }
+  Status check_guards() override;
   void set_timing(bool on) override { timing_ = on; }
   [[nodiscard]] KernelTimes kernel_times() const override { return times_; }
   void reset_kernel_times() override { times_ = {}; }

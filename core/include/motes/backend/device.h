@@ -128,6 +128,10 @@ class Device {
   /// Waits for queued work; reports any error it raised.
   virtual Status synchronize() = 0;
 
+  /// Every buffer is followed by guard words that no kernel may touch: fails, naming the buffer,
+  /// when one was overwritten (the conformance suite calls this after every case).
+  virtual Status check_guards() = 0;
+
   /// Per-kernel timing (may cost a synchronization per kernel while on).
   virtual void set_timing(bool on) = 0;
   [[nodiscard]] virtual KernelTimes kernel_times() const = 0;

@@ -1,0 +1,529 @@
+// VulkanDevice: logical device, pipelines, buffers with guard words, host transfers, and the
+// backend entry points (list_devices, open_device). Queueing and replay: vulkan_record.cpp.
+#include "vulkan_device.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "vulkan_backend.h"
+#include "vulkan_shaders.h"
+
+namespace motes::vulkan {
+
+// Binding k of the descriptor set is motes::Buffer k (shaders/vulkan_bindings.h).
+static_assert(B_PARTICLE_POS == static_cast<int>(Buffer::ParticlePos));
+static_assert(B_PARTICLE_FORCE == static_cast<int>(Buffer::ParticleForce));
+static_assert(B_BODY_POS == static_cast<int>(Buffer::BodyPos));
+static_assert(B_BODY_FIRST == static_cast<int>(Buffer::BodyFirst));
+static_assert(B_GRID_BUCKET == static_cast<int>(Buffer::GridBucket));
+static_assert(B_GRID_CELL_START == static_cast<int>(Buffer::GridCellStart));
+static_assert(B_SORTED_MATERIAL == static_cast<int>(Buffer::SortedMaterial));
+static_assert(B_PLANES == static_cast<int>(Buffer::Planes));
+static_assert(B_GRID_ARRIVAL == static_cast<int>(Buffer::Count));
+
+namespace {
+
+constexpr const char* kPipelineShaders[kPipelineCount] = {
+    "grid_build_count",   "grid_build_scan_block", "grid_build_scan_add",
+    "grid_build_scatter", "grid_build_place",      "contacts_compute",
+    "bodies_reduce",      "bodies_integrate",      "particles_update"};
+
+const char* binding_name(std::uint32_t binding) {
+  if (binding < kBufferCount) return buffer_name(static_cast<Buffer>(binding));
+  switch (binding) {
+    case B_GRID_ARRIVAL:
+      return "GridArrival (scratch)";
+    case B_GRID_UNSORTED:
+      return "GridUnsorted (scratch)";
+    case B_SCAN_SCRATCH:
+      return "ScanScratch (scratch)";
+    default:
+      return "?";
+  }
+}
+
+VkDeviceSize round_up(VkDeviceSize x, VkDeviceSize to) { return (x + to - 1) / to * to; }
+
+/// Bytes of the region a buffer's descriptor covers (never 0: Vulkan has no empty buffers).
+VkDeviceSize padded(VkDeviceSize data_bytes) {
+  return round_up(std::max<VkDeviceSize>(data_bytes, 4), 16);
+}
+
+}  // namespace
+
+Status VulkanDevice::check(VkResult r, const char* what) {
+  if (r == VK_SUCCESS) return Status::ok();
+  std::string why = result_name(r);
+  if (r == VK_ERROR_DEVICE_LOST) why += ": the GPU stopped responding (device lost)";
+  if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY) why += ": out of GPU memory";
+  Status s = Status::error(fmt::format("vulkan ({}): {} failed: {}", info_.name, what, why));
+  if (error_.is_ok()) error_ = s;
+  return s;
+}
+
+Result<std::unique_ptr<VulkanDevice>> VulkanDevice::create(std::unique_ptr<Instance> instance,
+                                                           int physical) {
+  std::unique_ptr<VulkanDevice> d(new VulkanDevice());
+  if (Status s = d->init(std::move(instance), physical); !s) return s;
+  return d;
+}
+
+Status VulkanDevice::init(std::unique_ptr<Instance> instance, int physical) {
+  instance_ = std::move(instance);
+  physical_ = instance_->devices()[static_cast<std::size_t>(physical)];
+  info_ = physical_.info;
+  if (physical_.compute_family == UINT32_MAX) {
+    return Status::error(
+        fmt::format("vulkan device {} ({}) has no compute queue", physical, info_.name));
+  }
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo queue{};
+  queue.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
+  queue.queueFamilyIndex = physical_.compute_family;
+  queue.queueCount = 1;
+  queue.pQueuePriorities = &priority;
+  VkDeviceCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+  info.queueCreateInfoCount = 1;
+  info.pQueueCreateInfos = &queue;
+  if (Status s =
+          check(vkCreateDevice(physical_.handle, &info, nullptr, &device_), "vkCreateDevice");
+      !s) {
+    return s;
+  }
+  volkLoadDevice(device_);
+  if (const char* env = std::getenv("MOTES_VULKAN_MAX_GROUPS_X"); env != nullptr && *env != '\0') {
+    const long v = std::strtol(env, nullptr, 10);
+    if (v >= 1 && v < 65535) max_groups_x_ = static_cast<std::uint64_t>(v);
+  }
+  vkGetDeviceQueue(device_, physical_.compute_family, 0, &queue_);
+  vkGetPhysicalDeviceMemoryProperties(physical_.handle, &memory_);
+
+  VkCommandPoolCreateInfo pool{};
+  pool.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+  pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pool.queueFamilyIndex = physical_.compute_family;
+  if (Status s = check(vkCreateCommandPool(device_, &pool, nullptr, &pool_), "vkCreateCommandPool");
+      !s) {
+    return s;
+  }
+  VkFenceCreateInfo fence{};
+  fence.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+  if (Status s = check(vkCreateFence(device_, &fence, nullptr, &fence_), "vkCreateFence"); !s) {
+    return s;
+  }
+  return create_pipelines();
+}
+
+Status VulkanDevice::create_pipelines() {
+  std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
+  for (std::uint32_t i = 0; i < kBindingCount; ++i) {
+    bindings[i].binding = i;
+    bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[i].descriptorCount = 1;
+    bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  }
+  VkDescriptorSetLayoutCreateInfo set_info{};
+  set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+  set_info.bindingCount = kBindingCount;
+  set_info.pBindings = bindings.data();
+  if (Status s = check(vkCreateDescriptorSetLayout(device_, &set_info, nullptr, &set_layout_),
+                       "vkCreateDescriptorSetLayout");
+      !s) {
+    return s;
+  }
+  VkPushConstantRange push{};
+  push.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  push.size = sizeof(PushConstants);
+  VkPipelineLayoutCreateInfo layout{};
+  layout.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  layout.setLayoutCount = 1;
+  layout.pSetLayouts = &set_layout_;
+  layout.pushConstantRangeCount = 1;
+  layout.pPushConstantRanges = &push;
+  if (Status s = check(vkCreatePipelineLayout(device_, &layout, nullptr, &pipeline_layout_),
+                       "vkCreatePipelineLayout");
+      !s) {
+    return s;
+  }
+  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount};
+  VkDescriptorPoolCreateInfo pool{};
+  pool.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  pool.maxSets = 1;
+  pool.poolSizeCount = 1;
+  pool.pPoolSizes = &pool_size;
+  if (Status s = check(vkCreateDescriptorPool(device_, &pool, nullptr, &descriptor_pool_),
+                       "vkCreateDescriptorPool");
+      !s) {
+    return s;
+  }
+  VkDescriptorSetAllocateInfo alloc{};
+  alloc.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  alloc.descriptorPool = descriptor_pool_;
+  alloc.descriptorSetCount = 1;
+  alloc.pSetLayouts = &set_layout_;
+  if (Status s =
+          check(vkAllocateDescriptorSets(device_, &alloc, &set_), "vkAllocateDescriptorSets");
+      !s) {
+    return s;
+  }
+
+  for (std::size_t i = 0; i < kPipelineCount; ++i) {
+    const Shader* shader = find_shader(kPipelineShaders[i]);
+    if (shader == nullptr) {
+      return Status::error(
+          fmt::format("vulkan: shader {} is not embedded in this build", kPipelineShaders[i]));
+    }
+    VkShaderModuleCreateInfo module_info{};
+    module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+    module_info.codeSize = shader->word_count * 4;
+    module_info.pCode = shader->words;
+    VkShaderModule module = VK_NULL_HANDLE;
+    if (Status s = check(vkCreateShaderModule(device_, &module_info, nullptr, &module),
+                         "vkCreateShaderModule");
+        !s) {
+      return s;
+    }
+    VkComputePipelineCreateInfo pipe{};
+    pipe.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+    pipe.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    pipe.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    pipe.stage.module = module;
+    pipe.stage.pName = "main";
+    pipe.layout = pipeline_layout_;
+    const VkResult r =
+        vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipe, nullptr, &pipelines_[i]);
+    vkDestroyShaderModule(device_, module, nullptr);
+    if (Status s = check(r, "vkCreateComputePipelines"); !s) return s;
+  }
+  return Status::ok();
+}
+
+VulkanDevice::~VulkanDevice() {
+  if (device_ != VK_NULL_HANDLE) {
+    vkDeviceWaitIdle(device_);
+    free_recordings();
+    release_buffers();
+    destroy_buffer(staging_);
+    for (VkPipeline p : pipelines_) {
+      if (p != VK_NULL_HANDLE) vkDestroyPipeline(device_, p, nullptr);
+    }
+    if (queries_ != VK_NULL_HANDLE) vkDestroyQueryPool(device_, queries_, nullptr);
+    if (descriptor_pool_ != VK_NULL_HANDLE) {
+      vkDestroyDescriptorPool(device_, descriptor_pool_, nullptr);
+    }
+    if (pipeline_layout_ != VK_NULL_HANDLE) {
+      vkDestroyPipelineLayout(device_, pipeline_layout_, nullptr);
+    }
+    if (set_layout_ != VK_NULL_HANDLE) vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
+    if (fence_ != VK_NULL_HANDLE) vkDestroyFence(device_, fence_, nullptr);
+    if (pool_ != VK_NULL_HANDLE) vkDestroyCommandPool(device_, pool_, nullptr);
+    vkDestroyDevice(device_, nullptr);
+  }
+}
+
+Status VulkanDevice::create_buffer(GpuBuffer& out, VkDeviceSize data_bytes, bool host_visible,
+                                   const char* name) {
+  VkBufferCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+  info.size = padded(data_bytes) + kGuardBytes;
+  info.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  if (!host_visible) info.usage |= VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  if (info.size > physical_.max_allocation && physical_.max_allocation != 0) {
+    return Status::error(fmt::format(
+        "vulkan ({}): buffer {} needs {} bytes, more than the device's largest allocation ({} "
+        "bytes); use fewer particles",
+        info_.name, name, info.size, physical_.max_allocation));
+  }
+  if (Status s = check(vkCreateBuffer(device_, &info, nullptr, &out.buffer), "vkCreateBuffer");
+      !s) {
+    return s;
+  }
+  out.data_bytes = data_bytes;
+  VkMemoryRequirements req{};
+  vkGetBufferMemoryRequirements(device_, out.buffer, &req);
+  const VkMemoryPropertyFlags want =
+      host_visible ? (VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT |
+                      VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+                   : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+  const VkMemoryPropertyFlags need =
+      host_visible ? (VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)
+                   : 0u;
+  std::uint32_t type = UINT32_MAX;
+  for (VkMemoryPropertyFlags flags : {want, need}) {
+    for (std::uint32_t t = 0; t < memory_.memoryTypeCount && type == UINT32_MAX; ++t) {
+      if ((req.memoryTypeBits & (1u << t)) != 0 &&
+          (memory_.memoryTypes[t].propertyFlags & flags) == flags) {
+        type = t;
+      }
+    }
+  }
+  if (type == UINT32_MAX) {
+    return Status::error(
+        fmt::format("vulkan ({}): no memory type for buffer {}", info_.name, name));
+  }
+  VkMemoryAllocateInfo alloc{};
+  alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  alloc.allocationSize = req.size;
+  alloc.memoryTypeIndex = type;
+  if (VkResult r = vkAllocateMemory(device_, &alloc, nullptr, &out.memory); r != VK_SUCCESS) {
+    return Status::error(fmt::format(
+        "vulkan ({}): cannot allocate {:.1f} MiB for buffer {}: {}{}", info_.name,
+        static_cast<double>(req.size) / 1048576.0, name, result_name(r),
+        r == VK_ERROR_OUT_OF_DEVICE_MEMORY ? " (out of GPU memory: use fewer particles)" : ""));
+  }
+  if (Status s =
+          check(vkBindBufferMemory(device_, out.buffer, out.memory, 0), "vkBindBufferMemory");
+      !s) {
+    return s;
+  }
+  if (host_visible) {
+    if (Status s = check(vkMapMemory(device_, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped),
+                         "vkMapMemory");
+        !s) {
+      return s;
+    }
+  }
+  return Status::ok();
+}
+
+void VulkanDevice::destroy_buffer(GpuBuffer& b) {
+  if (b.buffer != VK_NULL_HANDLE) vkDestroyBuffer(device_, b.buffer, nullptr);
+  if (b.memory != VK_NULL_HANDLE) vkFreeMemory(device_, b.memory, nullptr);
+  b = GpuBuffer{};
+}
+
+void VulkanDevice::release_buffers() {
+  for (GpuBuffer& b : buffers_) destroy_buffer(b);
+  allocated_ = false;
+}
+
+Status VulkanDevice::ensure_staging(VkDeviceSize bytes) {
+  if (staging_.buffer != VK_NULL_HANDLE && padded(staging_.data_bytes) >= bytes) {
+    return Status::ok();
+  }
+  destroy_buffer(staging_);
+  return create_buffer(staging_, std::max<VkDeviceSize>(bytes, VkDeviceSize{1} << 20), true,
+                       "staging");
+}
+
+Status VulkanDevice::allocate(const Sizes& sizes) {
+  if (sizes.table < 64 || (sizes.table & (sizes.table - 1)) != 0) {
+    return Status::error(
+        fmt::format("grid table size {} is not a power of two >= 64", sizes.table));
+  }
+  if (Status s = flush(); !s) return s;
+  free_recordings();
+  release_buffers();
+  sizes_ = sizes;
+
+  // The bucket-count scan: level 0 is GridCellStart (T + 1 values); each level's block totals
+  // are the next level's values, until one block holds them all.
+  scan_levels_.clear();
+  std::uint32_t count = sizes.table + 1;
+  std::uint32_t offset = 0;
+  bool in_scratch = false;
+  std::uint32_t next = 0;
+  while (true) {
+    const std::uint32_t blocks = (count + SCAN_BLOCK - 1) / SCAN_BLOCK;
+    scan_levels_.push_back({in_scratch ? 1u : 0u, offset, count, next});
+    offset = next;
+    next += blocks;
+    if (blocks <= 1) break;
+    count = blocks;
+    in_scratch = true;
+  }
+  const std::uint32_t scratch_words = next;
+
+  for (std::uint32_t i = 0; i < kBindingCount; ++i) {
+    VkDeviceSize bytes = 0;
+    if (i < kBufferCount) {
+      bytes = buffer_layout(static_cast<Buffer>(i), sizes).bytes();
+    } else if (i == B_SCAN_SCRATCH) {
+      bytes = VkDeviceSize{scratch_words} * 4;
+    } else {
+      bytes = VkDeviceSize{sizes.particles} * 4;
+    }
+    if (padded(bytes) > physical_.max_storage_range) {
+      release_buffers();
+      return Status::error(fmt::format(
+          "vulkan ({}): buffer {} needs {} bytes, more than this device's storage-buffer range "
+          "({} bytes, maxStorageBufferRange); use fewer particles",
+          info_.name, binding_name(i), bytes, physical_.max_storage_range));
+    }
+    if (Status s = create_buffer(buffers_[i], bytes, false, binding_name(i)); !s) {
+      release_buffers();
+      return s;
+    }
+  }
+  allocated_ = true;
+
+  std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
+  std::array<VkWriteDescriptorSet, kBindingCount> writes{};
+  for (std::uint32_t i = 0; i < kBindingCount; ++i) {
+    infos[i] = {buffers_[i].buffer, 0, padded(buffers_[i].data_bytes)};
+    writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    writes[i].dstSet = set_;
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[i].pBufferInfo = &infos[i];
+  }
+  vkUpdateDescriptorSets(device_, kBindingCount, writes.data(), 0, nullptr);
+
+  // Zero every buffer and write the guard words after it.
+  return run_once([&](VkCommandBuffer cb) {
+    for (const GpuBuffer& b : buffers_) {
+      vkCmdFillBuffer(cb, b.buffer, 0, padded(b.data_bytes), 0);
+      vkCmdFillBuffer(cb, b.buffer, padded(b.data_bytes), kGuardBytes, kGuardWord);
+    }
+  });
+}
+
+Status VulkanDevice::write(Buffer b, const void* src, std::size_t bytes) {
+  const auto i = static_cast<std::size_t>(b);
+  if (!allocated_) return Status::error("vulkan: write before allocate");
+  if (bytes > buffers_[i].data_bytes) {
+    return Status::error(fmt::format("vulkan: writing {} bytes into {} of {} bytes", bytes,
+                                     buffer_name(b), buffers_[i].data_bytes));
+  }
+  if (bytes == 0) return Status::ok();
+  if (Status s = flush(); !s) return s;
+  if (Status s = ensure_staging(bytes); !s) return s;
+  std::memcpy(staging_.mapped, src, bytes);
+  return run_once([&](VkCommandBuffer cb) {
+    const VkBufferCopy region{0, 0, bytes};
+    vkCmdCopyBuffer(cb, staging_.buffer, buffers_[i].buffer, 1, &region);
+  });
+}
+
+Status VulkanDevice::read(Buffer b, void* dst, std::size_t bytes) {
+  const auto i = static_cast<std::size_t>(b);
+  if (!allocated_) return Status::error("vulkan: read before allocate");
+  if (bytes > buffers_[i].data_bytes) {
+    return Status::error(fmt::format("vulkan: reading {} bytes from {} of {} bytes", bytes,
+                                     buffer_name(b), buffers_[i].data_bytes));
+  }
+  if (bytes == 0) return synchronize();
+  if (Status s = flush(); !s) return s;
+  if (Status s = ensure_staging(bytes); !s) return s;
+  if (Status s = run_once([&](VkCommandBuffer cb) {
+        const VkBufferCopy region{0, 0, bytes};
+        vkCmdCopyBuffer(cb, buffers_[i].buffer, staging_.buffer, 1, &region);
+      });
+      !s) {
+    return s;
+  }
+  std::memcpy(dst, staging_.mapped, bytes);
+  return validation_status();
+}
+
+Status VulkanDevice::synchronize() {
+  if (Status s = flush(); !s) return s;
+  return validation_status();
+}
+
+Status VulkanDevice::check_guards() {
+  if (!allocated_) return Status::ok();
+  if (Status s = flush(); !s) return s;
+  if (Status s = ensure_staging(kGuardBytes * kBindingCount); !s) return s;
+  if (Status s = run_once([&](VkCommandBuffer cb) {
+        for (std::uint32_t i = 0; i < kBindingCount; ++i) {
+          const VkBufferCopy region{padded(buffers_[i].data_bytes), i * kGuardBytes, kGuardBytes};
+          vkCmdCopyBuffer(cb, buffers_[i].buffer, staging_.buffer, 1, &region);
+        }
+      });
+      !s) {
+    return s;
+  }
+  const auto* words = static_cast<const std::uint32_t*>(staging_.mapped);
+  for (std::uint32_t i = 0; i < kBindingCount; ++i) {
+    for (VkDeviceSize w = 0; w < kGuardBytes / 4; ++w) {
+      if (words[i * kGuardBytes / 4 + w] != kGuardWord) {
+        return Status::error(
+            fmt::format("vulkan ({}): a kernel wrote past the end of {} ({} bytes)", info_.name,
+                        binding_name(i), buffers_[i].data_bytes));
+      }
+    }
+  }
+  return validation_status();
+}
+
+Status VulkanDevice::validation_status() {
+  if (!error_) return error_;
+  MessageLog& log = instance_->log();
+  const std::lock_guard<std::mutex> lock(log.mutex);
+  if (log.messages.empty()) return Status::ok();
+  std::string text =
+      fmt::format("vulkan validation layer reported {} message{}:", log.messages.size(),
+                  log.messages.size() == 1 ? "" : "s");
+  for (const std::string& m : log.messages) text += "\n  " + m;
+  log.messages.clear();
+  return Status::error(text);
+}
+
+void VulkanDevice::grid_build(const shared::StepParams& p) { enqueue(Kernel::GridBuild, p); }
+void VulkanDevice::contacts_compute(const shared::StepParams& p) {
+  enqueue(Kernel::ContactsCompute, p);
+}
+void VulkanDevice::bodies_reduce(const shared::StepParams& p) { enqueue(Kernel::BodiesReduce, p); }
+void VulkanDevice::bodies_integrate(const shared::StepParams& p) {
+  enqueue(Kernel::BodiesIntegrate, p);
+}
+void VulkanDevice::particles_update(const shared::StepParams& p) {
+  enqueue(Kernel::ParticlesUpdate, p);
+}
+
+Listing list_devices() {
+  Listing out;
+  Result<std::unique_ptr<Instance>> inst = Instance::create(false);
+  if (!inst) {
+    out.reason = inst.message();
+    return out;
+  }
+  for (const PhysicalDevice& d : inst.value()->devices()) out.devices.push_back(d.info);
+  out.preferred = inst.value()->preferred();
+  if (out.devices.empty()) out.reason = "the Vulkan loader found no device (no driver installed)";
+  if (out.preferred >= 0) {
+    out.preferred_is_gpu = inst.value()->devices()[static_cast<std::size_t>(out.preferred)].type !=
+                           VK_PHYSICAL_DEVICE_TYPE_CPU;
+  }
+  return out;
+}
+
+Result<std::unique_ptr<Device>> open_device(int index) {
+  Result<std::unique_ptr<Instance>> inst = Instance::create(validation_requested());
+  if (!inst) return inst.status();
+  const auto count = static_cast<int>(inst.value()->devices().size());
+  if (index < 0) {
+    if (const char* env = std::getenv("MOTES_VULKAN_DEVICE"); env != nullptr && *env != '\0') {
+      char* end = nullptr;
+      const long v = std::strtol(env, &end, 10);
+      if (*end != '\0' || v < 0 || v >= count) {
+        return Status::error(fmt::format(
+            "MOTES_VULKAN_DEVICE='{}' is not a Vulkan device index (this machine has {})", env,
+            count));
+      }
+      index = static_cast<int>(v);
+    } else {
+      index = inst.value()->preferred();
+    }
+  }
+  if (count == 0) return Status::error("vulkan: the Vulkan loader found no device");
+  if (index < 0 || index >= count) {
+    return Status::error(
+        fmt::format("vulkan device {} does not exist (this machine has {}; see `motes devices`)",
+                    index, count));
+  }
+  Result<std::unique_ptr<VulkanDevice>> d = VulkanDevice::create(std::move(inst.value()), index);
+  if (!d) return d.status();
+  std::unique_ptr<Device> out = std::move(d.value());
+  return out;
+}
+
+}  // namespace motes::vulkan

@@ -1,0 +1,270 @@
+// Queueing, recording and replay. Kernel calls are queued; flush() finds the shortest cycle of
+// calls that the queue repeats (a step: the five families, once per substep), records it once into
+// a command buffer, caches it, and submits that command buffer as many times as the cycle repeats.
+// A barrier starts and ends every command buffer and separates every dispatch, so each kernel
+// sees all earlier writes. Timing records timestamps around every kernel family instead.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstring>
+
+#include "vulkan_device.h"
+
+namespace motes::vulkan {
+
+namespace {
+
+bool same(const std::vector<VulkanDevice::Op>& a, std::size_t ai,
+          const std::vector<VulkanDevice::Op>& b, std::size_t bi) {
+  return a[ai].kernel == b[bi].kernel &&
+         std::memcmp(&a[ai].params, &b[bi].params, sizeof(shared::StepParams)) == 0;
+}
+
+/// Recordings kept for replay; more than this and the oldest is freed.
+constexpr std::size_t kMaxRecordings = 8;
+/// Timed runs record this many cycles per command buffer (two timestamps per kernel call each).
+constexpr std::size_t kTimedCycles = 256;
+/// Command buffers per vkQueueSubmit when a cycle is replayed many times.
+constexpr std::size_t kSubmitBatch = 512;
+
+}  // namespace
+
+void VulkanDevice::enqueue(Kernel k, const shared::StepParams& p) {
+  if (!allocated_) {
+    if (error_) error_ = Status::error("vulkan: kernel launched before allocate");
+    return;
+  }
+  pending_.push_back({k, p});
+}
+
+void VulkanDevice::barrier(VkCommandBuffer cb) const {
+  VkMemoryBarrier b{};
+  b.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+  b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT |
+                    VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT |
+                    VK_ACCESS_HOST_READ_BIT;
+  const VkPipelineStageFlags stages =
+      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
+  vkCmdPipelineBarrier(cb, stages, stages | VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &b, 0, nullptr, 0,
+                       nullptr);
+}
+
+void VulkanDevice::dispatch_groups(VkCommandBuffer cb, Pipeline pipeline,
+                                   const shared::StepParams& p, std::uint64_t groups,
+                                   const std::uint32_t args[4]) const {
+  if (groups == 0) return;
+  PushConstants push{};
+  push.params = p;
+  std::copy(args, args + 4, push.args);
+  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE,
+                    pipelines_[static_cast<std::size_t>(pipeline)]);
+  vkCmdPushConstants(cb, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+  // More than 65,535 workgroups (the smallest limit Vulkan allows per dimension) go as a 2D grid;
+  // shaders flatten it (kernel_common.glsl: flat_group) and skip the padding groups.
+  const std::uint64_t x = std::min<std::uint64_t>(groups, max_groups_x_);
+  const std::uint64_t y = (groups + x - 1) / x;
+  vkCmdDispatch(cb, static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), 1);
+}
+
+void VulkanDevice::dispatch(VkCommandBuffer cb, Pipeline pipeline, const shared::StepParams& p,
+                            std::uint64_t threads, std::uint32_t a0, std::uint32_t a1,
+                            std::uint32_t a2, std::uint32_t a3) const {
+  const std::uint32_t args[4] = {a0, a1, a2, a3};
+  dispatch_groups(cb, pipeline, p, (threads + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE, args);
+}
+
+Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool timing) {
+  VkCommandBufferAllocateInfo alloc{};
+  alloc.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+  alloc.commandPool = pool_;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  VkCommandBuffer cb = VK_NULL_HANDLE;
+  if (Status s = check(vkAllocateCommandBuffers(device_, &alloc, &cb), "vkAllocateCommandBuffers");
+      !s) {
+    return s;
+  }
+  VkCommandBufferBeginInfo begin{};
+  begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  // A replayed cycle is listed several times in one submission.
+  begin.flags = VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT;
+  vkBeginCommandBuffer(cb, &begin);
+  if (timing) vkCmdResetQueryPool(cb, queries_, 0, static_cast<std::uint32_t>(2 * ops.size()));
+  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set_, 0,
+                          nullptr);
+  barrier(cb);
+  for (std::size_t i = 0; i < ops.size(); ++i) {
+    const auto q = static_cast<std::uint32_t>(2 * i);
+    if (timing) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, queries_, q);
+    const shared::StepParams& p = ops[i].params;
+    switch (ops[i].kernel) {
+      case Kernel::GridBuild:
+        record_grid_build(cb, p);
+        break;
+      case Kernel::ContactsCompute:
+        record_contacts_compute(cb, p);
+        break;
+      case Kernel::BodiesReduce:
+        record_bodies_reduce(cb, p);
+        break;
+      case Kernel::BodiesIntegrate:
+        record_bodies_integrate(cb, p);
+        break;
+      case Kernel::ParticlesUpdate:
+        record_particles_update(cb, p);
+        break;
+      case Kernel::Count:
+        break;
+    }
+    barrier(cb);
+    if (timing) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, queries_, q + 1);
+  }
+  if (Status s = check(vkEndCommandBuffer(cb), "vkEndCommandBuffer"); !s) {
+    vkFreeCommandBuffers(device_, pool_, 1, &cb);
+    return s;
+  }
+  return cb;
+}
+
+Status VulkanDevice::submit_and_wait(const VkCommandBuffer* commands, std::uint32_t count) {
+  VkSubmitInfo submit{};
+  submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+  submit.commandBufferCount = count;
+  submit.pCommandBuffers = commands;
+  if (Status s = check(vkResetFences(device_, 1, &fence_), "vkResetFences"); !s) return s;
+  if (Status s = check(vkQueueSubmit(queue_, 1, &submit, fence_), "vkQueueSubmit"); !s) return s;
+  return check(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+}
+
+Status VulkanDevice::run_once(const std::function<void(VkCommandBuffer)>& fill) {
+  if (!error_) return error_;
+  VkCommandBufferAllocateInfo alloc{};
+  alloc.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+  alloc.commandPool = pool_;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  VkCommandBuffer cb = VK_NULL_HANDLE;
+  if (Status s = check(vkAllocateCommandBuffers(device_, &alloc, &cb), "vkAllocateCommandBuffers");
+      !s) {
+    return s;
+  }
+  VkCommandBufferBeginInfo begin{};
+  begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  vkBeginCommandBuffer(cb, &begin);
+  barrier(cb);
+  fill(cb);
+  barrier(cb);
+  Status s = check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
+  if (s) s = submit_and_wait(&cb, 1);
+  vkFreeCommandBuffers(device_, pool_, 1, &cb);
+  return s;
+}
+
+void VulkanDevice::free_recordings() {
+  for (Recording& r : recordings_) vkFreeCommandBuffers(device_, pool_, 1, &r.commands);
+  recordings_.clear();
+}
+
+Status VulkanDevice::flush() {
+  if (!error_) {
+    pending_.clear();
+    return error_;
+  }
+  if (pending_.empty()) return Status::ok();
+  std::vector<Op> ops;
+  ops.swap(pending_);
+
+  // The shortest cycle that the queued calls repeat.
+  const std::size_t n = ops.size();
+  std::size_t period = n;
+  for (std::size_t p = 1; p <= std::min<std::size_t>(n, 64); ++p) {
+    if (n % p != 0) continue;
+    bool repeats = true;
+    for (std::size_t i = p; i < n && repeats; ++i) repeats = same(ops, i, ops, i % p);
+    if (repeats) {
+      period = p;
+      break;
+    }
+  }
+  const std::vector<Op> cycle(ops.begin(), ops.begin() + static_cast<std::ptrdiff_t>(period));
+  std::size_t reps = n / period;
+
+  if (timing_) {
+    // Timed: record up to kTimedCycles cycles per command buffer with timestamps around every
+    // call, run it, read the timestamps. Not cached: timing is for benchmarks.
+    const bool stamps = physical_.timestamp_bits > 0;
+    while (reps > 0) {
+      const std::size_t k = std::min(reps, kTimedCycles);
+      std::vector<Op> batch;
+      batch.reserve(k * period);
+      for (std::size_t r = 0; r < k; ++r) batch.insert(batch.end(), cycle.begin(), cycle.end());
+      const auto queries = static_cast<std::uint32_t>(2 * batch.size());
+      if (stamps && queries > query_capacity_) {
+        if (queries_ != VK_NULL_HANDLE) vkDestroyQueryPool(device_, queries_, nullptr);
+        VkQueryPoolCreateInfo qi{};
+        qi.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+        qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+        qi.queryCount = queries;
+        if (Status s =
+                check(vkCreateQueryPool(device_, &qi, nullptr, &queries_), "vkCreateQueryPool");
+            !s) {
+          return s;
+        }
+        query_capacity_ = queries;
+      }
+      Result<VkCommandBuffer> cb = record(batch, stamps);
+      if (!cb) return cb.status();
+      Status s = submit_and_wait(&cb.value(), 1);
+      if (s && stamps) {
+        std::vector<std::uint64_t> t(queries);
+        s = check(vkGetQueryPoolResults(device_, queries_, 0, queries, t.size() * 8, t.data(), 8,
+                                        VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+                  "vkGetQueryPoolResults");
+        const std::uint64_t mask = physical_.timestamp_bits >= 64
+                                       ? ~std::uint64_t{0}
+                                       : (std::uint64_t{1} << physical_.timestamp_bits) - 1;
+        for (std::size_t i = 0; s && i < batch.size(); ++i) {
+          const std::uint64_t ticks = (t[2 * i + 1] - t[2 * i]) & mask;
+          const auto kernel = static_cast<std::size_t>(batch[i].kernel);
+          times_.seconds[kernel] += static_cast<double>(ticks) *
+                                    static_cast<double>(physical_.timestamp_period_ns) * 1e-9;
+          times_.launches[kernel] += 1;
+        }
+      }
+      vkFreeCommandBuffers(device_, pool_, 1, &cb.value());
+      if (!s) return s;
+      reps -= k;
+    }
+    return Status::ok();
+  }
+
+  // Replay: the recording of this cycle, made once.
+  auto found = std::find_if(recordings_.begin(), recordings_.end(), [&](const Recording& r) {
+    if (r.ops.size() != cycle.size()) return false;
+    for (std::size_t i = 0; i < cycle.size(); ++i) {
+      if (!same(r.ops, i, cycle, i)) return false;
+    }
+    return true;
+  });
+  if (found == recordings_.end()) {
+    if (recordings_.size() >= kMaxRecordings) {  // nothing is in flight between flushes
+      vkFreeCommandBuffers(device_, pool_, 1, &recordings_.front().commands);
+      recordings_.erase(recordings_.begin());
+    }
+    Result<VkCommandBuffer> cb = record(cycle, false);
+    if (!cb) return cb.status();
+    recordings_.push_back({cycle, cb.value()});
+    found = recordings_.end() - 1;
+  }
+  const std::vector<VkCommandBuffer> list(std::min(reps, kSubmitBatch), found->commands);
+  while (reps > 0) {
+    const std::size_t k = std::min(reps, kSubmitBatch);
+    if (Status s = submit_and_wait(list.data(), static_cast<std::uint32_t>(k)); !s) return s;
+    reps -= k;
+  }
+  return Status::ok();
+}
+
+}  // namespace motes::vulkan

@@ -1,0 +1,22 @@
+#version 450
+// bodies_integrate: one semi-implicit Euler step of every body (shared/body_math.h).
+#extension GL_GOOGLE_include_directive : require
+#include "kernel_common.glsl"
+#include "shared/body_math.h"
+
+void main() {
+  uint b = thread_index();
+  if (b >= p.body_count) return;
+  vec4 pos = body_pos[b];
+  vec4 quat = body_quat[b];
+  vec4 vel = body_vel[b];
+  vec4 angmom = body_angmom[b];
+  vec4 angvel;
+  body_integrate(pos, quat, vel, angmom, angvel, body_inv_inertia[b], body_force[b],
+                 body_torque[b], p.gravity_dt);
+  body_pos[b] = pos;
+  body_quat[b] = quat;
+  body_vel[b] = vel;
+  body_angmom[b] = angmom;
+  body_angvel[b] = angvel;
+}

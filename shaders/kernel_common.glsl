@@ -1,0 +1,50 @@
+// Included by every compute shader of the Vulkan backend: the shared physics headers, launch
+// parameters, every buffer of the single descriptor set, and the flat thread index.
+#ifndef MOTES_KERNEL_COMMON_GLSL
+#define MOTES_KERNEL_COMMON_GLSL
+
+#include "shared/common.h"
+#include "shared/params.h"
+#include "vulkan_bindings.h"
+
+layout(local_size_x = WORKGROUP_SIZE) in;
+
+// StepParams travels with every dispatch; args are the pass's own values (scan levels).
+layout(push_constant) uniform Push {
+  StepParams p;
+  uvec4 args;
+};
+
+layout(std430, binding = B_PARTICLE_POS) buffer ParticlePosBuf { vec4 particle_pos[]; };
+layout(std430, binding = B_PARTICLE_VEL) buffer ParticleVelBuf { vec4 particle_vel[]; };
+layout(std430, binding = B_PARTICLE_LOCAL) readonly buffer ParticleLocalBuf { vec4 particle_local[]; };
+layout(std430, binding = B_PARTICLE_BODY) readonly buffer ParticleBodyBuf { uint particle_body[]; };
+layout(std430, binding = B_PARTICLE_MATERIAL) readonly buffer ParticleMaterialBuf { uint particle_material[]; };
+layout(std430, binding = B_PARTICLE_FORCE) buffer ParticleForceBuf { vec4 particle_force[]; };
+layout(std430, binding = B_BODY_POS) buffer BodyPosBuf { vec4 body_pos[]; };
+layout(std430, binding = B_BODY_QUAT) buffer BodyQuatBuf { vec4 body_quat[]; };
+layout(std430, binding = B_BODY_VEL) buffer BodyVelBuf { vec4 body_vel[]; };
+layout(std430, binding = B_BODY_ANGMOM) buffer BodyAngMomBuf { vec4 body_angmom[]; };
+layout(std430, binding = B_BODY_ANGVEL) buffer BodyAngVelBuf { vec4 body_angvel[]; };
+layout(std430, binding = B_BODY_INV_INERTIA) readonly buffer BodyInvInertiaBuf { vec4 body_inv_inertia[]; };
+layout(std430, binding = B_BODY_FORCE) buffer BodyForceBuf { vec4 body_force[]; };
+layout(std430, binding = B_BODY_TORQUE) buffer BodyTorqueBuf { vec4 body_torque[]; };
+layout(std430, binding = B_BODY_FIRST) readonly buffer BodyFirstBuf { uint body_first[]; };
+layout(std430, binding = B_GRID_BUCKET) buffer GridBucketBuf { uint grid_bucket_of[]; };
+layout(std430, binding = B_GRID_ORDER) buffer GridOrderBuf { uint grid_order[]; };
+layout(std430, binding = B_GRID_CELL_START) buffer GridCellStartBuf { uint grid_cell_start[]; };
+layout(std430, binding = B_SORTED_POS) buffer SortedPosBuf { vec4 sorted_pos[]; };
+layout(std430, binding = B_SORTED_VEL) buffer SortedVelBuf { vec4 sorted_vel[]; };
+layout(std430, binding = B_SORTED_BODY) buffer SortedBodyBuf { uint sorted_body[]; };
+layout(std430, binding = B_SORTED_MATERIAL) buffer SortedMaterialBuf { uint sorted_material[]; };
+layout(std430, binding = B_CONTACT_LAWS) readonly buffer ContactLawsBuf { ContactLaw contact_laws[]; };
+layout(std430, binding = B_PLANES) readonly buffer PlanesBuf { PlaneData planes[]; };
+layout(std430, binding = B_GRID_ARRIVAL) buffer GridArrivalBuf { uint grid_arrival[]; };
+layout(std430, binding = B_GRID_UNSORTED) buffer GridUnsortedBuf { uint grid_unsorted[]; };
+layout(std430, binding = B_SCAN_SCRATCH) buffer ScanScratchBuf { uint scan_scratch[]; };
+
+// Workgroups beyond 65,535 are dispatched as a 2D grid (x, y); this is the flat index.
+uint flat_group() { return gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x; }
+uint thread_index() { return flat_group() * WORKGROUP_SIZE + gl_LocalInvocationID.x; }
+
+#endif  // MOTES_KERNEL_COMMON_GLSL

@@ -1,0 +1,41 @@
+// Descriptor bindings of the Vulkan backend: one set, binding k = motes::Buffer k, then the
+// backend's own scratch buffers. Valid C++ and GLSL; vulkan_device.cpp static_asserts that the
+// numbers match the Buffer enum.
+#ifndef MOTES_VULKAN_BINDINGS_H
+#define MOTES_VULKAN_BINDINGS_H
+
+#define B_PARTICLE_POS 0
+#define B_PARTICLE_VEL 1
+#define B_PARTICLE_LOCAL 2
+#define B_PARTICLE_BODY 3
+#define B_PARTICLE_MATERIAL 4
+#define B_PARTICLE_FORCE 5
+#define B_BODY_POS 6
+#define B_BODY_QUAT 7
+#define B_BODY_VEL 8
+#define B_BODY_ANGMOM 9
+#define B_BODY_ANGVEL 10
+#define B_BODY_INV_INERTIA 11
+#define B_BODY_FORCE 12
+#define B_BODY_TORQUE 13
+#define B_BODY_FIRST 14
+#define B_GRID_BUCKET 15
+#define B_GRID_ORDER 16
+#define B_GRID_CELL_START 17
+#define B_SORTED_POS 18
+#define B_SORTED_VEL 19
+#define B_SORTED_BODY 20
+#define B_SORTED_MATERIAL 21
+#define B_CONTACT_LAWS 22
+#define B_PLANES 23
+// Scratch buffers of the grid build (not part of motes::Buffer).
+#define B_GRID_ARRIVAL 24  // uint (N): arrival rank of a particle in its bucket (atomic, any order)
+#define B_GRID_UNSORTED 25  // uint (N): particle ids grouped by bucket, in arrival order
+#define B_SCAN_SCRATCH 26   // uint: block sums of every level of the bucket-count scan
+#define B_COUNT 27
+
+// Threads per workgroup of every kernel; the scan handles 4 elements per thread.
+#define WORKGROUP_SIZE 256
+#define SCAN_BLOCK 1024
+
+#endif  // MOTES_VULKAN_BINDINGS_H
