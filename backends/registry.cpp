@@ -26,7 +26,7 @@ BackendReport vulkan_report() {
   r.devices = std::move(l.devices);
   r.unavailable_reason = l.reason;
 #else
-  r.unavailable_reason = "not built: " MOTES_VULKAN_STATUS;
+  r.unavailable_reason = MOTES_VULKAN_STATUS;
 #endif
   return r;
 }

@@ -28,7 +28,7 @@ if [ -z "$(ls "$bundle"/debs/*.deb 2>/dev/null)" ]; then
   apt-get $o update -qq
   # shellcheck disable=SC2086
   (cd "$bundle/debs" && apt-get $o download -qq libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 \
-    libglx0 libgles2 libx11-6 libxext6 libxcb1 libxau6 libxdmcp6 libbsd0 libmd0 2>&1 |
+    libglx0 libgles2 libx11-6 libxext6 libxcb1 libxau6 libxdmcp6 libbsd0 libmd0 vulkan-validationlayers 2>&1 |
     grep -v unsandboxed || true)
 fi
 du -sh "$bundle"

@@ -1,0 +1,118 @@
+// Whole-scene helpers: example scenes, simulations on any device, state copies, the oracle run.
+#include "scene_support.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <utility>
+
+#include "motes/devices.h"
+
+namespace motes_conf {
+
+namespace {
+
+template <typename T>
+motes::Status read_all(motes::Simulation& sim, motes::Buffer b, std::vector<T>& out) {
+  const motes::BufferLayout layout = motes::buffer_layout(b, sim.sizes());
+  out.resize(layout.count);
+  return sim.device().read(b, out.data(), layout.bytes());
+}
+
+template <typename T>
+motes::Status write_all(motes::Simulation& sim, motes::Buffer b, const std::vector<T>& in) {
+  return sim.device().write(b, in.data(), in.size() * sizeof(T));
+}
+
+}  // namespace
+
+const motes::Result<motes::Scene>& example_scene(const std::string& name) {
+  static std::map<std::string, motes::Result<motes::Scene>> cache;
+  auto it = cache.find(name);
+  if (it == cache.end()) {
+    const std::string path = std::string(MOTES_SOURCE_DIR) + "/examples/scenes/" + name;
+    it = cache.emplace(name, motes::load_scene_file(path)).first;
+  }
+  return it->second;
+}
+
+motes::Scene fast_forward(motes::Scene scene, double seconds) {
+  const Eigen::Vector3d g = scene.settings.gravity;
+  for (motes::BodySpec& b : scene.bodies) {
+    if (b.kind != motes::BodyKind::Dynamic) continue;
+    b.position += b.velocity * seconds + 0.5 * g * seconds * seconds;
+    b.velocity += g * seconds;
+  }
+  return scene;
+}
+
+motes::Result<std::unique_ptr<motes::Simulation>> simulate(const motes::Scene& scene,
+                                                           const std::string& backend, int index) {
+  auto device = motes::open_device(backend, index);
+  if (!device) return device.status();
+  return motes::Simulation::create(scene, std::move(device).value());
+}
+
+motes::Status read_state(motes::Simulation& sim, DynamicState& out) {
+  motes::Status s = read_all(sim, motes::Buffer::ParticlePos, out.particle_pos);
+  if (s) s = read_all(sim, motes::Buffer::ParticleVel, out.particle_vel);
+  if (s) s = read_all(sim, motes::Buffer::BodyPos, out.body_pos);
+  if (s) s = read_all(sim, motes::Buffer::BodyQuat, out.body_quat);
+  if (s) s = read_all(sim, motes::Buffer::BodyVel, out.body_vel);
+  if (s) s = read_all(sim, motes::Buffer::BodyAngMom, out.body_angmom);
+  if (s) s = read_all(sim, motes::Buffer::BodyAngVel, out.body_angvel);
+  return s;
+}
+
+motes::Status write_state(motes::Simulation& sim, const DynamicState& state) {
+  motes::Status s = write_all(sim, motes::Buffer::ParticlePos, state.particle_pos);
+  if (s) s = write_all(sim, motes::Buffer::ParticleVel, state.particle_vel);
+  if (s) s = write_all(sim, motes::Buffer::BodyPos, state.body_pos);
+  if (s) s = write_all(sim, motes::Buffer::BodyQuat, state.body_quat);
+  if (s) s = write_all(sim, motes::Buffer::BodyVel, state.body_vel);
+  if (s) s = write_all(sim, motes::Buffer::BodyAngMom, state.body_angmom);
+  if (s) s = write_all(sim, motes::Buffer::BodyAngVel, state.body_angvel);
+  return s;
+}
+
+void OracleRun::step(std::uint64_t steps) {
+  for (std::uint64_t k = 0; k < steps; ++k) {
+    for (int sub = 0; sub < substeps; ++sub) {
+      motes_ref::step(particles, bodies, laws, planes, params);
+    }
+  }
+}
+
+motes::Status capture(motes::Simulation& sim, OracleRun& out) {
+  motes::Status s = read_all(sim, motes::Buffer::ParticlePos, out.particles.pos);
+  if (s) s = read_all(sim, motes::Buffer::ParticleVel, out.particles.vel);
+  if (s) s = read_all(sim, motes::Buffer::ParticleLocal, out.particles.local);
+  if (s) s = read_all(sim, motes::Buffer::ParticleBody, out.particles.body);
+  if (s) s = read_all(sim, motes::Buffer::ParticleMaterial, out.particles.material);
+  if (s) s = read_all(sim, motes::Buffer::BodyPos, out.bodies.pos);
+  if (s) s = read_all(sim, motes::Buffer::BodyQuat, out.bodies.quat);
+  if (s) s = read_all(sim, motes::Buffer::BodyVel, out.bodies.vel);
+  if (s) s = read_all(sim, motes::Buffer::BodyAngMom, out.bodies.angmom);
+  if (s) s = read_all(sim, motes::Buffer::BodyAngVel, out.bodies.angvel);
+  if (s) s = read_all(sim, motes::Buffer::BodyInvInertia, out.bodies.inv_inertia);
+  if (s) s = read_all(sim, motes::Buffer::BodyFirst, out.bodies.first);
+  if (s) s = read_all(sim, motes::Buffer::ContactLaws, out.laws);
+  if (s) s = read_all(sim, motes::Buffer::Planes, out.planes);
+  out.params = sim.step_params();
+  out.substeps = sim.settings().substeps;
+  return s;
+}
+
+double max_distance(const std::vector<vec4>& a, const std::vector<vec4>& b) {
+  double worst = a.size() == b.size() ? 0.0 : HUGE_VAL;
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    const double dx = static_cast<double>(a[i].x) - static_cast<double>(b[i].x);
+    const double dy = static_cast<double>(a[i].y) - static_cast<double>(b[i].y);
+    const double dz = static_cast<double>(a[i].z) - static_cast<double>(b[i].z);
+    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    worst = std::isnan(d) ? HUGE_VAL : std::max(worst, d);
+  }
+  return worst;
+}
+
+}  // namespace motes_conf

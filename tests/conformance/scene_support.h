@@ -1,0 +1,54 @@
+// Whole-scene helpers for test_scenes.cpp: the example scenes, simulations on a chosen device,
+// copying the dynamic state between simulations, and the oracle's copy of a simulation.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "motes/scene.h"
+#include "motes/simulation.h"
+#include "motes/status.h"
+#include "reference/reference.h"
+#include "test_data.h"
+
+namespace motes_conf {
+
+/// examples/scenes/<name>, loaded once per process (the bunny is voxelized on load).
+const motes::Result<motes::Scene>& example_scene(const std::string& name);
+
+/// The scene `seconds` later, for bodies in free fall that do not turn (dice, bunny): positions
+/// advanced by v t + g t^2 / 2, velocities by g t. Skips the uneventful fall before the first
+/// contact, which would cost thousands of steps.
+motes::Scene fast_forward(motes::Scene scene, double seconds);
+
+/// A simulation of `scene` on device `index` of `backend`.
+motes::Result<std::unique_ptr<motes::Simulation>> simulate(const motes::Scene& scene,
+                                                           const std::string& backend, int index);
+
+/// The dynamic state of a simulation: what Simulation::save_state keeps.
+struct DynamicState {
+  std::vector<vec4> particle_pos, particle_vel;
+  std::vector<vec4> body_pos, body_quat, body_vel, body_angmom, body_angvel;
+};
+motes::Status read_state(motes::Simulation& sim, DynamicState& out);
+motes::Status write_state(motes::Simulation& sim, const DynamicState& state);
+
+/// The oracle's copy of a simulation: every buffer a step reads, and the launch parameters.
+struct OracleRun {
+  motes_ref::Particles particles;
+  motes_ref::Bodies bodies;
+  std::vector<ContactLaw> laws;
+  std::vector<PlaneData> planes;
+  StepParams params{};
+  int substeps = 1;
+  /// Advances `steps` steps with motes_ref::step (each settings.substeps substeps).
+  void step(std::uint64_t steps);
+};
+motes::Status capture(motes::Simulation& sim, OracleRun& out);
+
+/// Largest distance (m) between corresponding positions.
+double max_distance(const std::vector<vec4>& a, const std::vector<vec4>& b);
+
+}  // namespace motes_conf

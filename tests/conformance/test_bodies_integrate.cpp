@@ -1,0 +1,75 @@
+// bodies_integrate against the oracle, the kernel alone: BodyPos, BodyQuat, BodyVel, BodyAngMom,
+// BodyInvInertia, BodyForce and BodyTorque are written, every other buffer (BodyAngVel included)
+// is poisoned; the five state buffers are read back. Static bodies keep their state and get a
+// zero angular velocity; bodies with L = 0 or a tiny |w dt| take the no-rotation branches.
+// BodyPos is compared by NMSE on xyz and bitwise on w (the inverse mass, kept); the other four
+// by NMSE on all components (a quaternion; w = 0 for the vectors).
+//
+// Tolerance: NMSE 1e-10. Per body the same shared body_integrate runs on the same floats, so
+// openmp matches bitwise (measures 0). A GPU may fuse multiply-adds and has its own sin, cos and
+// sqrt (a few ulps, or an absolute 2^-21 for sin/cos on some drivers): errors of ~1e-7 relative,
+// NMSE ~1e-14. Faults measured by breaking the oracle: a time step 1% off gives 6e-8 (so the
+// default 1e-7 would miss it), gravity's y and z swapped 2e-4, another body's inertia 3e-4.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "conformance.h"
+#include "reference/reference.h"
+#include "test_data.h"
+
+namespace motes_conf {
+namespace {
+
+using motes::Buffer;
+
+constexpr double kTolerance = 1.0e-10;
+
+class BodiesIntegrate : public DeviceTest {
+ protected:
+  void run_case(const std::string& layout, World w) {
+    motes_ref::Bodies want = w.bodies;
+    motes_ref::bodies_integrate(want, w.params);
+    ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
+    ASSERT_NO_FATAL_FAILURE(
+        poison_all_but({Buffer::BodyPos, Buffer::BodyQuat, Buffer::BodyVel, Buffer::BodyAngMom,
+                        Buffer::BodyInvInertia, Buffer::BodyForce, Buffer::BodyTorque}));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyPos, w.bodies.pos));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyQuat, w.bodies.quat));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyVel, w.bodies.vel));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyAngMom, w.bodies.angmom));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyInvInertia, w.bodies.inv_inertia));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyForce, w.bodies.force));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyTorque, w.bodies.torque));
+    device().bodies_integrate(w.params);
+    ASSERT_NO_FATAL_FAILURE(finish_kernel());
+    motes_ref::Bodies got;
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyPos, got.pos));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyQuat, got.quat));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyVel, got.vel));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngMom, got.angmom));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngVel, got.angvel));
+
+    begin_case("bodies_integrate/" + layout, w.sizes.bodies);
+    check_close("BodyPos", got.pos, want.pos, kTolerance, Part::Xyz);
+    check_w_identical("BodyPos.w (inverse mass) kept", got.pos, want.pos);
+    check_close("BodyQuat", got.quat, want.quat, kTolerance);
+    check_close("BodyVel", got.vel, want.vel, kTolerance);
+    check_close("BodyAngMom", got.angmom, want.angmom, kTolerance);
+    check_close("BodyAngVel", got.angvel, want.angvel, kTolerance);
+    end_case();
+  }
+};
+
+TEST_P(BodiesIntegrate, Empty) { run_case("random", random_bodies(51, 0)); }
+TEST_P(BodiesIntegrate, One) { run_case("random", random_bodies(52, 1)); }
+TEST_P(BodiesIntegrate, Random31) { run_case("random", random_bodies(53, 31)); }
+TEST_P(BodiesIntegrate, Random1234) { run_case("random", random_bodies(54, 1234)); }
+TEST_P(BodiesIntegrate, Random65536) { run_case("random", random_bodies(55, 65536)); }
+
+INSTANTIATE_TEST_SUITE_P(Conformance, BodiesIntegrate, testing::ValuesIn(device_params()),
+                         param_name);
+
+}  // namespace
+}  // namespace motes_conf

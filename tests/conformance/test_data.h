@@ -1,0 +1,83 @@
+// Inputs for the kernel cases: fixed-seed particle layouts and complete worlds (particles,
+// bodies, contact laws, planes, launch parameters) built around them.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "motes/backend/device.h"
+#include "reference/reference.h"
+#include "shared/common.h"
+#include "shared/params.h"
+
+namespace motes_conf {
+
+using motes::shared::vec3;
+using motes::shared::vec4;
+using motes_ref::ContactLaw;
+using motes_ref::PlaneData;
+using motes_ref::StepParams;
+using motes_ref::uint;
+
+/// Floats from a fixed-seed std::mt19937's raw 32-bit output: the generator's sequence is fixed
+/// by the standard, the std distributions' results are not (they differ between libraries).
+class Rng {
+ public:
+  explicit Rng(std::uint32_t seed) : gen_(seed) {}
+  /// Uniform in [0, 1), a multiple of 2^-24 (exact in float).
+  float unit() { return static_cast<float>(gen_() >> 8) * (1.0f / 16777216.0f); }
+  /// Uniform in [lo, hi).
+  float uniform(float lo, float hi) { return lo + (hi - lo) * unit(); }
+  /// Uniform integer in [0, n).
+  std::uint32_t below(std::uint32_t n) {
+    return static_cast<std::uint32_t>((std::uint64_t{gen_()} * n) >> 32);
+  }
+  bool chance(float p) { return unit() < p; }
+
+ private:
+  std::mt19937 gen_;
+};
+
+/// Everything a kernel can read: the oracle's host state plus the tables and launch parameters.
+struct World {
+  motes_ref::Particles particles;
+  motes_ref::Bodies bodies;
+  std::vector<ContactLaw> laws;  ///< M * M, at a * M + b
+  std::vector<PlaneData> planes;
+  StepParams params{};
+  motes::Sizes sizes;
+};
+
+// Particle layouts: xyz = centre, w = radius (the largest radius, rmax, always occurs once).
+
+/// Uniform in a cube of side `side` at `origin`, radii in [rmax/2, rmax].
+std::vector<vec4> random_cloud(Rng& rng, std::size_t n, float rmax, float side, vec3 origin);
+/// A cube side for random_cloud that gives about four overlapping neighbours per particle.
+float dense_side(std::size_t n, float rmax);
+/// Coordinates that are whole multiples of the cell size 2 rmax (one, two or all three of them):
+/// particles on cell faces, edges and corners, many touching or coincident.
+std::vector<vec4> on_cell_faces(Rng& rng, std::size_t n, float rmax);
+/// Every particle inside the one cell whose lowest corner is `corner`.
+std::vector<vec4> one_cell(Rng& rng, std::size_t n, float rmax, vec3 corner);
+/// A random cloud plus particles at huge coordinates (up to 1e30 m), where the cell index clamps.
+std::vector<vec4> with_huge_coordinates(Rng& rng, std::size_t n, float rmax);
+
+/// Builds a world around `positions`: bodies are runs of consecutive particles (one particle to
+/// 64, about 10% static with inverse mass 0), random velocities, three materials with an
+/// asymmetric law table (caps and no caps), planes touching the cloud, random body states;
+/// cell size = the largest diameter, T = motes::grid_table_size(N). The planes are a floor and a
+/// wall, plus a tilted one when `tilted_plane`: far from the origin a tilted plane's gap
+/// dot(n, x) - offset is only good to about ulp(|x|) (8 mm at 1e5 m), so fused and unfused
+/// arithmetic may rightly disagree there; axis-aligned planes are exact at any distance.
+World make_world(Rng& rng, std::vector<vec4> positions, std::uint32_t flags, bool tilted_plane);
+
+/// `bodies` bodies without particles (N = 0), for bodies_integrate: random poses, velocities,
+/// angular momenta, inertia, forces and torques; about 10% static.
+World random_bodies(std::uint32_t seed, std::size_t bodies);
+
+/// Particles in a cloud of about `n` particles with random bodies (make_world).
+World random_world(std::uint32_t seed, std::size_t n, std::uint32_t flags = 0);
+
+}  // namespace motes_conf

@@ -1,0 +1,140 @@
+// The reference oracle: naive serial loops, written from the kernels' definitions (see
+// reference.h). Deliberately simple: no grid in contacts_compute, std::stable_sort in grid_build.
+#include "reference.h"
+
+#include <algorithm>
+#include <cstddef>
+#include <numeric>
+
+#include "shared/body_math.h"
+#include "shared/contact_force.h"
+#include "shared/grid_hash.h"
+
+namespace motes_ref {
+
+using motes::shared::vec3;
+using motes::shared::xyz;
+
+Grid grid_build(const Particles& particles, const StepParams& p) {
+  const std::size_t n = particles.size();
+  const std::size_t table = std::size_t{p.table_mask} + 1;
+  Grid g;
+  g.bucket.assign(n, 0u);
+  for (std::size_t i = 0; i < n; ++i) {
+    const vec4 x = particles.pos[i];
+    g.bucket[i] = motes::shared::grid_bucket(motes::shared::grid_cell_coord(x.x, p.inv_cell_size),
+                                             motes::shared::grid_cell_coord(x.y, p.inv_cell_size),
+                                             motes::shared::grid_cell_coord(x.z, p.inv_cell_size),
+                                             p.table_mask);
+  }
+  g.order.assign(n, 0u);
+  std::iota(g.order.begin(), g.order.end(), uint{0});
+  std::stable_sort(g.order.begin(), g.order.end(),
+                   [&](uint a, uint b) { return g.bucket[a] < g.bucket[b]; });
+
+  // cell_start[b] = first sorted position whose bucket is >= b (a linear scan, one bucket at a
+  // time); cell_start[T] = N.
+  g.cell_start.assign(table + 1, 0u);
+  std::size_t s = 0;
+  for (std::size_t b = 0; b <= table; ++b) {
+    while (s < n && g.bucket[g.order[s]] < b) ++s;
+    g.cell_start[b] = static_cast<uint>(s);
+  }
+
+  g.sorted_pos.assign(n, vec4(0.0f));
+  g.sorted_vel.assign(n, vec4(0.0f));
+  g.sorted_body.assign(n, 0u);
+  g.sorted_material.assign(n, 0u);
+  for (std::size_t k = 0; k < n; ++k) {
+    const uint i = g.order[k];
+    g.sorted_pos[k] = particles.pos[i];
+    g.sorted_vel[k] = particles.vel[i];
+    g.sorted_body[k] = particles.body[i];
+    g.sorted_material[k] = particles.material[i];
+  }
+  return g;
+}
+
+std::vector<vec4> contacts_compute(const Particles& particles, const std::vector<ContactLaw>& laws,
+                                   const std::vector<PlaneData>& planes, const StepParams& p) {
+  const std::size_t n = particles.size();
+  const std::size_t m = p.material_count;
+  std::vector<vec4> force(n, vec4(0.0f));
+  for (std::size_t i = 0; i < n; ++i) {
+    const vec4 xi = particles.pos[i];
+    const vec4 vi = particles.vel[i];
+    if (vi.w == 0.0f) continue;  // static particles get no force
+    double sum[3] = {0.0, 0.0, 0.0};
+    auto add = [&](vec3 f) {
+      sum[0] += static_cast<double>(f.x);
+      sum[1] += static_cast<double>(f.y);
+      sum[2] += static_cast<double>(f.z);
+    };
+    for (std::size_t j = 0; j < n; ++j) {
+      if (particles.body[j] == particles.body[i]) continue;  // includes j == i
+      const vec4 xj = particles.pos[j];
+      const vec4 vj = particles.vel[j];
+      const ContactLaw law = laws[particles.material[i] * m + particles.material[j]];
+      add(motes::shared::particle_contact_force(xyz(xi), xyz(vi), xi.w, vi.w, xyz(xj), xyz(vj),
+                                                xj.w, vj.w, law, p.flags));
+    }
+    for (std::size_t k = 0; k < p.plane_count; ++k) {
+      const ContactLaw law = laws[particles.material[i] * m + planes[k].material];
+      add(motes::shared::plane_contact_force(xyz(xi), xyz(vi), xi.w, vi.w, planes[k].normal_offset,
+                                             law, p.flags));
+    }
+    force[i] = vec4(static_cast<float>(sum[0]), static_cast<float>(sum[1]),
+                    static_cast<float>(sum[2]), 0.0f);
+  }
+  return force;
+}
+
+void bodies_reduce(const std::vector<vec4>& particle_pos, const std::vector<vec4>& particle_force,
+                   Bodies& bodies) {
+  const std::size_t count = bodies.size();
+  bodies.force.assign(count, vec4(0.0f));
+  bodies.torque.assign(count, vec4(0.0f));
+  for (std::size_t b = 0; b < count; ++b) {
+    const vec4 com = bodies.pos[b];
+    if (com.w == 0.0f) continue;  // static bodies: nothing to integrate, zero sums
+    vec3 f(0.0f);
+    vec3 tau(0.0f);
+    for (uint i = bodies.first[b]; i < bodies.first[b + 1]; ++i) {
+      f += xyz(particle_force[i]);
+      tau += motes::shared::particle_torque(particle_pos[i], com, particle_force[i]);
+    }
+    bodies.force[b] = vec4(f, 0.0f);
+    bodies.torque[b] = vec4(tau, 0.0f);
+  }
+}
+
+void bodies_integrate(Bodies& bodies, const StepParams& p) {
+  bodies.angvel.assign(bodies.size(), vec4(0.0f));
+  for (std::size_t b = 0; b < bodies.size(); ++b) {
+    motes::shared::body_integrate(bodies.pos[b], bodies.quat[b], bodies.vel[b], bodies.angmom[b],
+                                  bodies.angvel[b], bodies.inv_inertia[b], bodies.force[b],
+                                  bodies.torque[b], p.gravity_dt);
+  }
+}
+
+void particles_update(const Bodies& bodies, Particles& particles) {
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    const uint b = particles.body[i];
+    const vec4 local = particles.local[i];
+    particles.pos[i] = vec4(motes::shared::particle_position(bodies.pos[b], bodies.quat[b], local),
+                            particles.pos[i].w);
+    particles.vel[i] = vec4(
+        motes::shared::particle_velocity(bodies.quat[b], bodies.vel[b], bodies.angvel[b], local),
+        particles.vel[i].w);
+  }
+}
+
+void step(Particles& particles, Bodies& bodies, const std::vector<ContactLaw>& laws,
+          const std::vector<PlaneData>& planes, const StepParams& p) {
+  const std::vector<vec4> force = contacts_compute(particles, laws, planes, p);
+  bodies_reduce(particles.pos, force, bodies);
+  bodies_integrate(bodies, p);
+  particles_update(bodies, particles);
+}
+
+}  // namespace motes_ref

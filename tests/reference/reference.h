@@ -1,0 +1,91 @@
+// The reference oracle: every kernel family of motes::Device (core/include/motes/backend/device.h)
+// written as naive serial loops over host vectors, straight from its definition. Never optimized:
+// it is what the conformance suite (tests/conformance/) compares every backend against.
+//
+// The per-particle and per-body math comes from the same shared headers the backends use
+// (shaders/shared/), so the oracle checks each backend's scaffolding (indexing, sorting, ranges,
+// neighbour search, summation, which buffers are read and written), not the physics formulas.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "shared/common.h"
+#include "shared/params.h"
+
+namespace motes_ref {
+
+using motes::shared::ContactLaw;
+using motes::shared::PlaneData;
+using motes::shared::StepParams;
+using motes::shared::uint;
+using motes::shared::vec4;
+
+/// Per-particle buffers (N each), as in motes::Buffer::Particle*.
+struct Particles {
+  std::vector<vec4> pos;       ///< xyz, w = radius
+  std::vector<vec4> vel;       ///< xyz, w = inverse mass (0 = static)
+  std::vector<vec4> local;     ///< body-frame offset from the body's centre of mass
+  std::vector<uint> body;      ///< body index
+  std::vector<uint> material;  ///< material index
+  [[nodiscard]] std::size_t size() const { return pos.size(); }
+};
+
+/// Per-body buffers (B each), as in motes::Buffer::Body*; first has B + 1 entries.
+struct Bodies {
+  std::vector<vec4> pos;          ///< centre of mass, w = inverse mass (0 = static)
+  std::vector<vec4> quat;         ///< orientation (x, y, z, w), body frame to world
+  std::vector<vec4> vel;          ///< linear velocity
+  std::vector<vec4> angmom;       ///< angular momentum (world)
+  std::vector<vec4> angvel;       ///< angular velocity (world)
+  std::vector<vec4> inv_inertia;  ///< inverse principal moments
+  std::vector<vec4> force;        ///< summed contact force
+  std::vector<vec4> torque;       ///< summed torque about the centre of mass
+  std::vector<uint> first;        ///< first particle of each body, then N
+  [[nodiscard]] std::size_t size() const { return pos.size(); }
+};
+
+/// Outputs of grid_build (GridBucket, GridOrder, GridCellStart, Sorted*).
+struct Grid {
+  std::vector<uint> bucket;      ///< N: bucket of particle i
+  std::vector<uint> order;       ///< N: particle ids stably sorted by bucket
+  std::vector<uint> cell_start;  ///< T + 1: first sorted position with bucket >= b; [T] = N
+  std::vector<vec4> sorted_pos;
+  std::vector<vec4> sorted_vel;
+  std::vector<uint> sorted_body;
+  std::vector<uint> sorted_material;
+};
+
+/// grid_build: bucket = shared::grid_bucket of the particle's cell (shared::grid_cell_coord with
+/// p.inv_cell_size), order = std::stable_sort of the ids by bucket, the T = p.table_mask + 1
+/// bucket starts, and copies of the particle data in that order.
+Grid grid_build(const Particles& particles, const StepParams& p);
+
+/// contacts_compute, by brute force over all pairs: the force on dynamic particle i is the sum,
+/// over every particle j of another body, of shared::particle_contact_force with law
+/// laws[material_i * M + material_j], plus shared::plane_contact_force of each plane with law
+/// laws[material_i * M + plane.material]. Static particles (vel.w == 0) get 0. Indexed by
+/// particle id; w = 0. Terms are summed in double, in id order, then rounded once to float: this
+/// is the most accurate sum of the float terms, not the device's canonical order.
+std::vector<vec4> contacts_compute(const Particles& particles, const std::vector<ContactLaw>& laws,
+                                   const std::vector<PlaneData>& planes, const StepParams& p);
+
+/// bodies_reduce: force and torque (shared::particle_torque about the body's centre) of each
+/// dynamic body, summed in float over its particles in particle order; static bodies get 0.
+/// Writes bodies.force and bodies.torque (w = 0).
+void bodies_reduce(const std::vector<vec4>& particle_pos, const std::vector<vec4>& particle_force,
+                   Bodies& bodies);
+
+/// bodies_integrate: shared::body_integrate on every body, with p.gravity_dt.
+void bodies_integrate(Bodies& bodies, const StepParams& p);
+
+/// particles_update: ParticlePos/Vel xyz from the body pose (shared::particle_position and
+/// particle_velocity); w (radius, inverse mass) kept.
+void particles_update(const Bodies& bodies, Particles& particles);
+
+/// One whole step in the core's order (grid_build is skipped: the brute-force contacts do not
+/// need it).
+void step(Particles& particles, Bodies& bodies, const std::vector<ContactLaw>& laws,
+          const std::vector<PlaneData>& planes, const StepParams& p);
+
+}  // namespace motes_ref
