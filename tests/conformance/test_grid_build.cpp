@@ -70,6 +70,8 @@ TEST_P(GridBuild, One) { run_case("random", random_world(2, 1)); }
 TEST_P(GridBuild, Random31) { run_case("random", random_world(3, 31)); }
 TEST_P(GridBuild, Random1234) { run_case("random", random_world(4, 1234)); }
 TEST_P(GridBuild, Random65536) { run_case("random", random_world(5, 65536)); }
+// T = 2^21 buckets: the Vulkan bucket-count scan needs three levels (2,097,153 -> 2,049 -> 3).
+TEST_P(GridBuild, Random300000) { run_case("random", random_world(13, 300000)); }
 
 TEST_P(GridBuild, OnCellFacesExactCell) {
   // cell = 0.5 m: every face coordinate k * 0.5 is exact, so floor() sits right on the boundary.
