@@ -245,6 +245,19 @@ Result<std::unique_ptr<Instance>> Instance::create(bool validation) {
   return inst;
 }
 
+Result<std::shared_ptr<Instance>> shared_instance() {
+  static std::mutex mutex;
+  // Never destroyed: destroying an instance from a static destructor can run after the driver
+  // has been unloaded.
+  static auto* kept = new std::shared_ptr<Instance>();
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (*kept) return *kept;
+  Result<std::unique_ptr<Instance>> made = Instance::create(validation_requested());
+  if (!made) return made.status();
+  *kept = std::shared_ptr<Instance>(std::move(made.value()));
+  return *kept;
+}
+
 int Instance::preferred() const {
   int best = -1;
   for (std::size_t i = 0; i < devices_.size(); ++i) {

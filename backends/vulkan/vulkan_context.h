@@ -64,4 +64,9 @@ class Instance {
 /// True when MOTES_VULKAN_VALIDATION is set to something other than 0.
 bool validation_requested();
 
+/// The process's one instance, made on first use (with validation when validation_requested())
+/// and kept until the process ends. An instance per device is wasteful, and NVIDIA's driver
+/// refused new instances (VK_ERROR_INCOMPATIBLE_DRIVER) after about fifty had come and gone.
+Result<std::shared_ptr<Instance>> shared_instance();
+
 }  // namespace motes::vulkan

@@ -65,14 +65,14 @@ Status VulkanDevice::check(VkResult r, const char* what) {
   return s;
 }
 
-Result<std::unique_ptr<VulkanDevice>> VulkanDevice::create(std::unique_ptr<Instance> instance,
+Result<std::unique_ptr<VulkanDevice>> VulkanDevice::create(std::shared_ptr<Instance> instance,
                                                            int physical) {
   std::unique_ptr<VulkanDevice> d(new VulkanDevice());
   if (Status s = d->init(std::move(instance), physical); !s) return s;
   return d;
 }
 
-Status VulkanDevice::init(std::unique_ptr<Instance> instance, int physical) {
+Status VulkanDevice::init(std::shared_ptr<Instance> instance, int physical) {
   instance_ = std::move(instance);
   physical_ = instance_->devices()[static_cast<std::size_t>(physical)];
   info_ = physical_.info;
@@ -481,7 +481,7 @@ void VulkanDevice::particles_update(const shared::StepParams& p) {
 
 Listing list_devices() {
   Listing out;
-  Result<std::unique_ptr<Instance>> inst = Instance::create(false);
+  Result<std::shared_ptr<Instance>> inst = shared_instance();
   if (!inst) {
     out.reason = inst.message();
     return out;
@@ -497,7 +497,7 @@ Listing list_devices() {
 }
 
 Result<std::unique_ptr<Device>> open_device(int index) {
-  Result<std::unique_ptr<Instance>> inst = Instance::create(validation_requested());
+  Result<std::shared_ptr<Instance>> inst = shared_instance();
   if (!inst) return inst.status();
   const auto count = static_cast<int>(inst.value()->devices().size());
   if (index < 0) {
@@ -520,7 +520,7 @@ Result<std::unique_ptr<Device>> open_device(int index) {
         fmt::format("vulkan device {} does not exist (this machine has {}; see `motes devices`)",
                     index, count));
   }
-  Result<std::unique_ptr<VulkanDevice>> d = VulkanDevice::create(std::move(inst.value()), index);
+  Result<std::unique_ptr<VulkanDevice>> d = VulkanDevice::create(inst.value(), index);
   if (!d) return d.status();
   std::unique_ptr<Device> out = std::move(d.value());
   return out;

@@ -52,7 +52,7 @@ class VulkanDevice final : public Device {
   };
 
   /// Creates the logical device on `physical` (an index into instance->devices()).
-  static Result<std::unique_ptr<VulkanDevice>> create(std::unique_ptr<Instance> instance,
+  static Result<std::unique_ptr<VulkanDevice>> create(std::shared_ptr<Instance> instance,
                                                       int physical);
   ~VulkanDevice() override;
 
@@ -91,7 +91,7 @@ class VulkanDevice final : public Device {
   };
 
   VulkanDevice() = default;
-  Status init(std::unique_ptr<Instance> instance, int physical);
+  Status init(std::shared_ptr<Instance> instance, int physical);
   Status create_pipelines();
   void release_buffers();
   Status create_buffer(GpuBuffer& out, VkDeviceSize data_bytes, bool host_visible,
@@ -128,7 +128,7 @@ class VulkanDevice final : public Device {
   void record_bodies_integrate(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_particles_update(VkCommandBuffer cb, const shared::StepParams& p) const;
 
-  std::unique_ptr<Instance> instance_;
+  std::shared_ptr<Instance> instance_;
   PhysicalDevice physical_;
   DeviceInfo info_;
   VkDevice device_ = VK_NULL_HANDLE;
