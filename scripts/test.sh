@@ -13,3 +13,16 @@ export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
 # it prints fails the test that caused it.
 export MOTES_VULKAN_VALIDATION=${MOTES_VULKAN_VALIDATION:-1}
 ctest --output-on-failure -j "${JOBS:-$(nproc)}" --timeout 900
+
+# The sanitizer stage: every test again, built with AddressSanitizer and UndefinedBehaviorSanitizer
+# (MOTES_SANITIZER_STAGE=0 skips it). The Vulkan tests run without the validation layer here (it
+# ran above); the Vulkan loader's and lavapipe's process-lifetime allocations are suppressed.
+if [ "${MOTES_SANITIZER_STAGE:-1}" = 1 ]; then
+  MOTES_SKIP_INSTALL=1 "$root/scripts/setup.sh" "$build-sanitize" -DMOTES_WERROR=ON \
+    -DMOTES_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMOTES_TEST_VULKAN_VALIDATION=OFF
+  cd "$build-sanitize"
+  MOTES_VULKAN_VALIDATION=0 \
+    LSAN_OPTIONS=suppressions=$root/tests/sanitizers/lsan.supp:print_suppressions=0 \
+    UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --output-on-failure -j "${JOBS:-$(nproc)}" --timeout 1800
+fi

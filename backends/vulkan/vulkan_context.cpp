@@ -247,15 +247,14 @@ Result<std::unique_ptr<Instance>> Instance::create(bool validation) {
 
 Result<std::shared_ptr<Instance>> shared_instance() {
   static std::mutex mutex;
-  // Never destroyed: destroying an instance from a static destructor can run after the driver
-  // has been unloaded.
-  static auto* kept = new std::shared_ptr<Instance>();
+  // Destroyed at exit, before the loader and drivers (dlopen'ed, finalized last) go away.
+  static std::shared_ptr<Instance> kept;
   const std::lock_guard<std::mutex> lock(mutex);
-  if (*kept) return *kept;
+  if (kept) return kept;
   Result<std::unique_ptr<Instance>> made = Instance::create(validation_requested());
   if (!made) return made.status();
-  *kept = std::shared_ptr<Instance>(std::move(made.value()));
-  return *kept;
+  kept = std::shared_ptr<Instance>(std::move(made.value()));
+  return kept;
 }
 
 int Instance::preferred() const {

@@ -65,7 +65,7 @@ class Instance {
 bool validation_requested();
 
 /// The process's one instance, made on first use (with validation when validation_requested())
-/// and kept until the process ends. An instance per device is wasteful, and NVIDIA's driver
+/// and destroyed at exit. An instance per device is wasteful, and NVIDIA's driver
 /// refused new instances (VK_ERROR_INCOMPATIBLE_DRIVER) after about fifty had come and gone.
 Result<std::shared_ptr<Instance>> shared_instance();
 

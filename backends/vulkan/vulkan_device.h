@@ -103,6 +103,8 @@ class VulkanDevice final : public Device {
   void enqueue(Kernel k, const shared::StepParams& p);
   /// Submits every queued call, replaying a cached recording when the calls repeat one.
   Status flush();
+  /// A new primary command buffer, begun with `usage`.
+  Result<VkCommandBuffer> begin_commands(VkCommandBufferUsageFlags usage);
   /// Records `ops` (with timestamps when `timing`) into a new primary command buffer.
   Result<VkCommandBuffer> record(const std::vector<Op>& ops, bool timing);
   Status submit_and_wait(const VkCommandBuffer* commands, std::uint32_t count);

@@ -74,7 +74,7 @@ void VulkanDevice::dispatch(VkCommandBuffer cb, Pipeline pipeline, const shared:
   dispatch_groups(cb, pipeline, p, (threads + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE, args);
 }
 
-Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool timing) {
+Result<VkCommandBuffer> VulkanDevice::begin_commands(VkCommandBufferUsageFlags usage) {
   VkCommandBufferAllocateInfo alloc{};
   alloc.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
   alloc.commandPool = pool_;
@@ -87,9 +87,19 @@ Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool ti
   }
   VkCommandBufferBeginInfo begin{};
   begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  begin.flags = usage;
+  if (Status s = check(vkBeginCommandBuffer(cb, &begin), "vkBeginCommandBuffer"); !s) {
+    vkFreeCommandBuffers(device_, pool_, 1, &cb);
+    return s;
+  }
+  return cb;
+}
+
+Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool timing) {
   // A replayed cycle is listed several times in one submission.
-  begin.flags = VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT;
-  vkBeginCommandBuffer(cb, &begin);
+  Result<VkCommandBuffer> began = begin_commands(VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT);
+  if (!began) return began;
+  VkCommandBuffer cb = began.value();
   if (timing) vkCmdResetQueryPool(cb, queries_, 0, static_cast<std::uint32_t>(2 * ops.size()));
   vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set_, 0,
                           nullptr);
@@ -139,20 +149,9 @@ Status VulkanDevice::submit_and_wait(const VkCommandBuffer* commands, std::uint3
 
 Status VulkanDevice::run_once(const std::function<void(VkCommandBuffer)>& fill) {
   if (!error_) return error_;
-  VkCommandBufferAllocateInfo alloc{};
-  alloc.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
-  alloc.commandPool = pool_;
-  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  alloc.commandBufferCount = 1;
-  VkCommandBuffer cb = VK_NULL_HANDLE;
-  if (Status s = check(vkAllocateCommandBuffers(device_, &alloc, &cb), "vkAllocateCommandBuffers");
-      !s) {
-    return s;
-  }
-  VkCommandBufferBeginInfo begin{};
-  begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  vkBeginCommandBuffer(cb, &begin);
+  Result<VkCommandBuffer> began = begin_commands(VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT);
+  if (!began) return began.status();
+  VkCommandBuffer cb = began.value();
   barrier(cb);
   fill(cb);
   barrier(cb);

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds motes for the GPU machine and bundles what has to travel there (it has no network and
 # lacks assimp, the Vulkan loader and the glvnd libraries NVIDIA's Vulkan driver needs):
-#   gpu-bundle/bin/   motes, motes_conformance_tests
+#   gpu-bundle/bin/   motes, motes_conformance_tests, motes_gpu_floors (bench/gpu, needs nvcc)
 #   gpu-bundle/lib/   their shared libraries, except those the GPU machine has (libc, libstdc++...)
 #   gpu-bundle/debs/  Debian packages of the Vulkan loader and glvnd (unpacked there by run.sh)
 # Usage: scripts/gpu/bundle.sh [BUILD_DIR]   (gpu-bundle/ is ignored by git; carry it along)
@@ -14,6 +14,14 @@ cmake --build "$build" -j "${JOBS:-$(nproc)}" --target motes_cli motes_conforman
 rm -rf "$bundle/bin" "$bundle/lib"
 mkdir -p "$bundle/bin" "$bundle/lib" "$bundle/debs"
 cp "$build/bin/motes" "$build/tests/motes_conformance_tests" "$bundle/bin/"
+# The floors every GPU number is compared with (copy bandwidth, CUB sort), for sm_90 plus PTX.
+nvcc=${NVCC:-$(command -v nvcc || echo /usr/local/cuda/bin/nvcc)}
+if [ -x "$nvcc" ]; then
+  "$nvcc" -O3 -std=c++17 -gencode arch=compute_90,code=sm_90 -gencode arch=compute_90,code=compute_90 \
+    -cudart static -o "$bundle/bin/motes_gpu_floors" "$root/bench/gpu/gpu_floors.cu"
+else
+  echo "no nvcc: gpu-bundle/bin/motes_gpu_floors not built" >&2
+fi
 # Libraries the GPU machine has itself (or must take from its own driver) stay behind.
 skip='^(linux-vdso|ld-linux|libc\.|libm\.|libstdc\+\+|libgcc_s|libgomp|libdl\.|libpthread|librt|libcuda|libvulkan)'
 for exe in "$bundle"/bin/*; do

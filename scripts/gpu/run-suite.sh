@@ -33,6 +33,9 @@ if [ "$what" = all ] || [ "$what" = conformance ]; then
 fi
 if [ "$what" = all ] || [ "$what" = bench ]; then
   mkdir -p bench-cache
+  # The floors, in the same run: device-to-device copy and CUB's sort of N (key, value) pairs.
+  part 60 bench-falling motes_gpu_floors \
+    $(echo "${MOTES_GPU_SIZES:-16384,65536,262144,1048576,4194304,16777216}" | tr , ' ')
   part "${LIMIT_FALLING:-170}" bench-falling motes bench --backend vulkan --workload settle \
     --phase falling --sizes "${MOTES_GPU_SIZES:-16384,65536,262144,1048576,4194304,16777216}" \
     --json "$out/bench-falling.json"
