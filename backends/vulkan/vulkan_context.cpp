@@ -119,6 +119,10 @@ PhysicalDevice describe(VkPhysicalDevice handle, int index) {
   const VkPhysicalDeviceProperties& p = props.properties;
   d.type = p.deviceType;
   d.subgroup_size = subgroup.subgroupSize;
+  d.subgroup_arithmetic =
+      (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 &&
+      (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) != 0 &&
+      (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_BASIC_BIT) != 0;
   d.max_storage_range = p.limits.maxStorageBufferRange;
   d.timestamp_period_ns = p.limits.timestampPeriod;
 
@@ -155,9 +159,10 @@ PhysicalDevice describe(VkPhysicalDevice handle, int index) {
   d.info.index = index;
   d.info.name = p.deviceName;
   d.info.detail = fmt::format(
-      "{}, driver {} {}, Vulkan {}.{}.{}, subgroup size {}, {:.1f} GiB device memory",
+      "{}, driver {} {}, Vulkan {}.{}.{}, subgroup size {}{}, {:.1f} GiB device memory",
       type_name(d.type), driver.driverName, driver.driverInfo, VK_API_VERSION_MAJOR(p.apiVersion),
       VK_API_VERSION_MINOR(p.apiVersion), VK_API_VERSION_PATCH(p.apiVersion), d.subgroup_size,
+      d.subgroup_arithmetic ? " with arithmetic" : "",
       static_cast<double>(local) / (1024.0 * 1024.0 * 1024.0));
   if (d.compute_family == UINT32_MAX) d.info.detail += ", no compute queue";
   return d;

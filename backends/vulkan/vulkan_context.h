@@ -33,6 +33,7 @@ struct PhysicalDevice {
   std::uint32_t timestamp_bits = 0;           ///< of that family; 0 = no timestamps
   float timestamp_period_ns = 0.0f;
   std::uint32_t subgroup_size = 0;
+  bool subgroup_arithmetic = false;     ///< subgroupAdd and friends in compute shaders
   std::uint64_t max_storage_range = 0;  ///< maxStorageBufferRange
   std::uint64_t max_allocation = 0;     ///< maxMemoryAllocationSize
 };

@@ -172,11 +172,19 @@ Status VulkanDevice::create_pipelines() {
     return s;
   }
 
+  // The block scan uses subgroup arithmetic where the device has it (MOTES_VULKAN_NO_SUBGROUPS=1
+  // forces the shared-memory version, so that tests cover both).
+  const char* no_subgroups = std::getenv("MOTES_VULKAN_NO_SUBGROUPS");
+  use_subgroups_ = physical_.subgroup_arithmetic &&
+                   (no_subgroups == nullptr || std::strcmp(no_subgroups, "1") != 0);
   for (std::size_t i = 0; i < kPipelineCount; ++i) {
-    const Shader* shader = find_shader(kPipelineShaders[i]);
+    std::string name = kPipelineShaders[i];
+    if (use_subgroups_ && static_cast<Pipeline>(i) == Pipeline::GridBuildScanBlock) {
+      name += "_subgroup";
+    }
+    const Shader* shader = find_shader(name);
     if (shader == nullptr) {
-      return Status::error(
-          fmt::format("vulkan: shader {} is not embedded in this build", kPipelineShaders[i]));
+      return Status::error(fmt::format("vulkan: shader {} is not embedded in this build", name));
     }
     VkShaderModuleCreateInfo module_info{};
     module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;

@@ -159,6 +159,7 @@ class VulkanDevice final : public Device {
   /// Workgroups per dispatch dimension: 65,535 (Vulkan's guaranteed minimum), or less when
   /// MOTES_VULKAN_MAX_GROUPS_X says so (tests use it to exercise the 2D dispatch on small sizes).
   std::uint64_t max_groups_x_ = 65535;
+  bool use_subgroups_ = false;  ///< the subgroup-arithmetic variant of the block scan
   std::vector<Op> pending_;
   std::vector<Recording> recordings_;
   Status error_;  ///< sticky: the first failure (device lost, out of memory...)
