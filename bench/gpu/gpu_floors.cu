@@ -3,22 +3,21 @@
 // radix sort of N (key, value) pairs on only the key bits the grid uses (log2 of the 4N-bucket
 // table), the sort floor for grid_build. Median of 20 timed runs after 3 warm-ups (CUDA events).
 // Usage: motes_gpu_floors N...   Prints one JSON object per N.
-#include <cub/device/device_radix_sort.cuh>
 #include <cuda_runtime.h>
+#include <cub/device/device_radix_sort.cuh>
 
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <vector>
 
-#define CHECK(x)                                                                       \
-  do {                                                                                 \
-    cudaError_t e = (x);                                                               \
-    if (e != cudaSuccess) {                                                            \
-      std::fprintf(stderr, "%s:%d: %s: %s\n", __FILE__, __LINE__, #x,                  \
-                   cudaGetErrorString(e));                                             \
-      std::exit(1);                                                                    \
-    }                                                                                  \
+#define CHECK(x)                                                                              \
+  do {                                                                                        \
+    cudaError_t e = (x);                                                                      \
+    if (e != cudaSuccess) {                                                                   \
+      std::fprintf(stderr, "%s:%d: %s: %s\n", __FILE__, __LINE__, #x, cudaGetErrorString(e)); \
+      std::exit(1);                                                                           \
+    }                                                                                         \
   } while (0)
 
 __global__ void fill_keys(unsigned* keys, unsigned* values, unsigned n, unsigned mask) {
@@ -74,8 +73,8 @@ int main(int argc, char** argv) {
     void* temp;
     CHECK(cudaMalloc(&temp, temp_bytes));
     const double sort_ms = median_ms([&] {
-      CHECK(cub::DeviceRadixSort::SortPairs(temp, temp_bytes, keys, keys_out, values, values_out,
-                                            n, 0, bits));
+      CHECK(cub::DeviceRadixSort::SortPairs(temp, temp_bytes, keys, keys_out, values, values_out, n,
+                                            0, bits));
     });
     // Copy 16 bytes per particle (one vec4 array): read + write counted.
     const size_t copy_bytes = 16ull * n;
@@ -83,8 +82,8 @@ int main(int argc, char** argv) {
     CHECK(cudaMalloc(&src, copy_bytes));
     CHECK(cudaMalloc(&dst, copy_bytes));
     CHECK(cudaMemset(src, 1, copy_bytes));
-    const double copy_ms = median_ms(
-        [&] { CHECK(cudaMemcpyAsync(dst, src, copy_bytes, cudaMemcpyDeviceToDevice)); });
+    const double copy_ms =
+        median_ms([&] { CHECK(cudaMemcpyAsync(dst, src, copy_bytes, cudaMemcpyDeviceToDevice)); });
     std::printf(
         "{\"gpu\": \"%s\", \"n\": %u, \"key_bits\": %d, \"cub_sort_pairs_ms\": %.5f, "
         "\"cub_pairs_per_s\": %.4g, \"copy_bytes\": %zu, \"copy_ms\": %.5f, "
