@@ -26,10 +26,15 @@ part() {  # part SECONDS NAME COMMAND...: runs COMMAND, its output to $out/NAME.
 if [ "$what" = all ] || [ "$what" = conformance ]; then
   MOTES_VULKAN_VALIDATION=1 MOTES_CONFORMANCE_TABLE="$out/conformance.md" \
     part "${LIMIT_CONFORMANCE:-180}" conformance motes_conformance_tests --gtest_brief=1 || status=1
-  # Again with at most 3 workgroups per dimension: every shader through the 2D-dispatch path.
-  MOTES_VULKAN_VALIDATION=1 MOTES_VULKAN_MAX_GROUPS_X=3 MOTES_CONFORMANCE_BACKENDS=vulkan \
+  # Again with at most 3 workgroups per dimension (every shader through the 2D-dispatch path) and
+  # the scan without subgroup arithmetic.
+  MOTES_VULKAN_VALIDATION=1 MOTES_VULKAN_MAX_GROUPS_X=3 MOTES_VULKAN_NO_SUBGROUPS=1 \
+    MOTES_CONFORMANCE_BACKENDS=vulkan \
     part 60 conformance motes_conformance_tests --gtest_brief=1 --gtest_filter=-*Scenes* ||
     status=1
+  # The README's main job, on the GPU.
+  MOTES_VULKAN_VALIDATION=1 part 60 conformance motes run examples/scenes/dominoes.json \
+    --backend vulkan --out "${TMPDIR:-/tmp}/motes-dominoes" || status=1
 fi
 if [ "$what" = all ] || [ "$what" = bench ]; then
   mkdir -p bench-cache
