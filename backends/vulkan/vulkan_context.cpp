@@ -250,15 +250,34 @@ Result<std::unique_ptr<Instance>> Instance::create(bool validation) {
   return inst;
 }
 
+namespace {
+
+std::mutex instance_mutex;
+
+/// Heap-held so that no static destructor runs it: see release_shared_instance.
+std::shared_ptr<Instance>& kept_instance() {
+  static auto* kept = new std::shared_ptr<Instance>();
+  return *kept;
+}
+
+/// Registered with atexit right after the instance is made, so it runs before the exit handlers
+/// the driver registered while the instance was made (destroying an instance from a static
+/// destructor, after NVIDIA's driver had cleaned up, crashed every program at exit).
+void release_shared_instance() {
+  const std::lock_guard<std::mutex> lock(instance_mutex);
+  kept_instance().reset();
+}
+
+}  // namespace
+
 Result<std::shared_ptr<Instance>> shared_instance() {
-  static std::mutex mutex;
-  // Destroyed at exit, before the loader and drivers (dlopen'ed, finalized last) go away.
-  static std::shared_ptr<Instance> kept;
-  const std::lock_guard<std::mutex> lock(mutex);
+  const std::lock_guard<std::mutex> lock(instance_mutex);
+  std::shared_ptr<Instance>& kept = kept_instance();
   if (kept) return kept;
   Result<std::unique_ptr<Instance>> made = Instance::create(validation_requested());
   if (!made) return made.status();
   kept = std::shared_ptr<Instance>(std::move(made.value()));
+  std::atexit(release_shared_instance);
   return kept;
 }
 

@@ -66,8 +66,10 @@ class Instance {
 bool validation_requested();
 
 /// The process's one instance, made on first use (with validation when validation_requested())
-/// and destroyed at exit. An instance per device is wasteful, and NVIDIA's driver
-/// refused new instances (VK_ERROR_INCOMPATIBLE_DRIVER) after about fifty had come and gone.
+/// and destroyed at exit, once the last device is gone (destroy devices before exit: a device
+/// that outlives the exit handlers outlives the driver). An instance per device is wasteful, and
+/// NVIDIA's driver refused new instances (VK_ERROR_INCOMPATIBLE_DRIVER) after about fifty had come
+/// and gone.
 Result<std::shared_ptr<Instance>> shared_instance();
 
 }  // namespace motes::vulkan
