@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "motes/backend/device.h"
+#include "motes/backend/kernel_queue.h"
 #include "shared/common.h"
 #include "vulkan_bindings.h"
 #include "vulkan_context.h"
@@ -46,10 +47,7 @@ static_assert(sizeof(PushConstants) == 64, "PushConstants layout");
 class VulkanDevice final : public Device {
  public:
   /// One queued kernel call.
-  struct Op {
-    Kernel kernel;
-    shared::StepParams params;
-  };
+  using Op = KernelCall;
 
   /// Creates the logical device on `physical` (an index into instance->devices()).
   static Result<std::unique_ptr<VulkanDevice>> create(std::shared_ptr<Instance> instance,

@@ -6,19 +6,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cstring>
 
 #include "vulkan_device.h"
 
 namespace motes::vulkan {
 
 namespace {
-
-bool same(const std::vector<VulkanDevice::Op>& a, std::size_t ai,
-          const std::vector<VulkanDevice::Op>& b, std::size_t bi) {
-  return a[ai].kernel == b[bi].kernel &&
-         std::memcmp(&a[ai].params, &b[bi].params, sizeof(shared::StepParams)) == 0;
-}
 
 /// Recordings kept for replay; more than this and the oldest is freed.
 constexpr std::size_t kMaxRecordings = 8;
@@ -177,16 +170,7 @@ Status VulkanDevice::flush() {
 
   // The shortest cycle that the queued calls repeat.
   const std::size_t n = ops.size();
-  std::size_t period = n;
-  for (std::size_t p = 1; p <= std::min<std::size_t>(n, 64); ++p) {
-    if (n % p != 0) continue;
-    bool repeats = true;
-    for (std::size_t i = p; i < n && repeats; ++i) repeats = same(ops, i, ops, i % p);
-    if (repeats) {
-      period = p;
-      break;
-    }
-  }
+  const std::size_t period = repeating_period(ops);
   const std::vector<Op> cycle(ops.begin(), ops.begin() + static_cast<std::ptrdiff_t>(period));
   std::size_t reps = n / period;
 
@@ -240,13 +224,8 @@ Status VulkanDevice::flush() {
   }
 
   // Replay: the recording of this cycle, made once.
-  auto found = std::find_if(recordings_.begin(), recordings_.end(), [&](const Recording& r) {
-    if (r.ops.size() != cycle.size()) return false;
-    for (std::size_t i = 0; i < cycle.size(); ++i) {
-      if (!same(r.ops, i, cycle, i)) return false;
-    }
-    return true;
-  });
+  auto found = std::find_if(recordings_.begin(), recordings_.end(),
+                            [&](const Recording& r) { return same_calls(r.ops, cycle); });
   if (found == recordings_.end()) {
     if (recordings_.size() >= kMaxRecordings) {  // nothing is in flight between flushes
       vkFreeCommandBuffers(device_, pool_, 1, &recordings_.front().commands);
