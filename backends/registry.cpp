@@ -1,5 +1,5 @@
 // The backend registry: which backends this binary has, their devices, and opening one.
-// "auto" picks a Vulkan GPU when there is one, else the CPU backend (a CPU Vulkan driver such as
+// "auto" picks a CUDA GPU, else a Vulkan GPU, else the CPU backend (a CPU Vulkan driver such as
 // lavapipe is slower than OpenMP on the same cores).
 #include <fmt/format.h>
 
@@ -9,6 +9,9 @@
 
 #include "motes/devices.h"
 #include "openmp/openmp_device.h"
+#ifdef MOTES_HAVE_CUDA
+#include "cuda/cuda_backend.h"
+#endif
 #ifdef MOTES_HAVE_VULKAN
 #include "vulkan/vulkan_backend.h"
 #endif
@@ -16,6 +19,20 @@
 namespace motes {
 
 namespace {
+
+BackendReport cuda_report() {
+  BackendReport r;
+  r.backend = "cuda";
+#ifdef MOTES_HAVE_CUDA
+  r.compiled = true;
+  cuda::Listing l = cuda::list_devices();
+  r.devices = std::move(l.devices);
+  r.unavailable_reason = l.reason;
+#else
+  r.unavailable_reason = MOTES_CUDA_STATUS;
+#endif
+  return r;
+}
 
 BackendReport vulkan_report() {
   BackendReport r;
@@ -31,8 +48,12 @@ BackendReport vulkan_report() {
   return r;
 }
 
-/// "auto": a Vulkan GPU, else the CPU backend (OpenMP beats lavapipe on the same cores).
+/// "auto": a CUDA GPU, else a Vulkan GPU, else the CPU backend (OpenMP beats lavapipe on the
+/// same cores).
 std::string auto_backend() {
+#ifdef MOTES_HAVE_CUDA
+  if (!cuda::list_devices().devices.empty()) return "cuda";
+#endif
 #ifdef MOTES_HAVE_VULKAN
   const vulkan::Listing l = vulkan::list_devices();
   if (l.preferred >= 0 && l.preferred_is_gpu) return "vulkan";
@@ -44,12 +65,7 @@ std::string auto_backend() {
 
 std::vector<BackendReport> list_backends() {
   std::vector<BackendReport> out;
-  BackendReport cuda;
-  cuda.backend = "cuda";
-  cuda.unavailable_reason =
-      "not built: this version of motes has no CUDA backend yet (planned; see "
-      "docs/architecture.md)";
-  out.push_back(std::move(cuda));
+  out.push_back(cuda_report());
   out.push_back(vulkan_report());
   BackendReport cpu;
   cpu.backend = "openmp";
@@ -65,6 +81,9 @@ Result<std::unique_ptr<Device>> open_device(const std::string& backend, int inde
     return Status::error(fmt::format("cpu threads must be >= 0, got {}", options.cpu_threads));
   }
   const std::string chosen = backend == "auto" ? auto_backend() : backend;
+#ifdef MOTES_HAVE_CUDA
+  if (chosen == "cuda") return cuda::open_device(index);
+#endif
 #ifdef MOTES_HAVE_VULKAN
   if (chosen == "vulkan") return vulkan::open_device(index);
 #endif

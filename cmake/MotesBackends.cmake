@@ -51,10 +51,41 @@ if(NOT MOTES_WITH_VULKAN STREQUAL "OFF")
   endif()
 endif()
 
-# The CUDA backend is not part of this version yet (see docs/architecture.md); the registry reports
-# it as not built. ON asks for something that does not exist: refuse clearly.
-set(MOTES_CUDA_STATUS "not built (the CUDA backend is not implemented in this version)")
-if(MOTES_WITH_CUDA STREQUAL "ON")
-  message(FATAL_ERROR "MOTES_WITH_CUDA=ON: the CUDA backend is not implemented in this version "
-                      "of motes; use AUTO or OFF")
+# CUDA: nvcc (CMake's CUDA language; /usr/local/cuda/bin/nvcc is tried when it is not on PATH) and
+# the CUDA toolkit with CUB. Compiled for sm_90 (H100, H200) plus PTX for it; CMAKE_CUDA_ARCHITECTURES
+# overrides. `native` is never the default: it fails on machines without a GPU, CI among them.
+# Runs need only the NVIDIA driver (static runtime); without one, `motes devices` says why.
+set(MOTES_CUDA OFF)
+set(MOTES_CUDA_STATUS "not built: MOTES_WITH_CUDA=OFF")
+if(NOT MOTES_WITH_CUDA STREQUAL "OFF")
+  if(NOT CMAKE_CUDA_COMPILER AND NOT DEFINED ENV{CUDACXX} AND EXISTS /usr/local/cuda/bin/nvcc)
+    find_program(motes_nvcc nvcc)
+    if(NOT motes_nvcc)
+      set(CMAKE_CUDA_COMPILER /usr/local/cuda/bin/nvcc)
+    endif()
+  endif()
+  include(CheckLanguage)
+  check_language(CUDA)
+  if(CMAKE_CUDA_COMPILER)
+    if(NOT DEFINED CMAKE_CUDA_ARCHITECTURES)
+      set(CMAKE_CUDA_ARCHITECTURES 90-real 90-virtual)
+    endif()
+    enable_language(CUDA)
+    find_package(CUDAToolkit)
+    # CMake 3.25 knows nvcc's dialect flags only up to C++17; nvcc 12+ takes -std=c++20.
+    if(NOT CMAKE_CUDA20_STANDARD_COMPILE_OPTION AND CMAKE_CUDA_COMPILER_VERSION VERSION_GREATER_EQUAL 12)
+      set(CMAKE_CUDA20_STANDARD_COMPILE_OPTION "-std=c++20")
+      set(CMAKE_CUDA20_EXTENSION_COMPILE_OPTION "-std=c++20")
+    endif()
+  endif()
+  if(CMAKE_CUDA_COMPILER AND CUDAToolkit_FOUND)
+    set(MOTES_CUDA ON)
+    set(MOTES_CUDA_STATUS "built")
+  else()
+    set(MOTES_CUDA_STATUS "not built: no CUDA toolkit (nvcc) was found when motes was compiled")
+    if(MOTES_WITH_CUDA STREQUAL "ON")
+      message(FATAL_ERROR "MOTES_WITH_CUDA=ON but no CUDA compiler (nvcc) or toolkit was found; "
+                          "set CMAKE_CUDA_COMPILER or CUDACXX")
+    endif()
+  endif()
 endif()

@@ -13,6 +13,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "motes/devices.h"
 #include "unit/test_support.h"
 
 namespace fs = std::filesystem;
@@ -93,6 +95,24 @@ TEST(Cli, DevicesListsOpenmp) {
   for (const char* backend : {"cuda", "vulkan"}) {
     EXPECT_TRUE(contains(o.out, backend)) << describe(o);
   }
+}
+
+// The CUDA backend through the command line: runs where there is a CUDA GPU (the GPU machine);
+// elsewhere `--backend cuda` must fail with the reason, and the run itself is reported skipped.
+TEST(Cli, RunOnCuda) {
+  TempDir tmp;
+  const std::string out = tmp / "out";
+  const Outcome o = run_motes(tmp, {"run", kSmallScene, "--backend", "cuda", "--steps", "20",
+                                    "--every", "10", "--out", out});
+  for (const motes::BackendReport& r : motes::list_backends()) {
+    if (r.backend != "cuda" || !r.devices.empty()) continue;
+    EXPECT_NE(o.exit_code, 0) << describe(o);
+    EXPECT_TRUE(contains(o.err, "cuda")) << describe(o);
+    EXPECT_TRUE(contains(o.err, r.unavailable_reason)) << describe(o);
+    GTEST_SKIP() << "no CUDA device: " << r.unavailable_reason;
+  }
+  EXPECT_EQ(o.exit_code, 0) << describe(o);
+  EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(out) / "particles.pvd")) << describe(o);
 }
 
 TEST(Cli, VersionAndUsage) {

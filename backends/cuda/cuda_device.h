@@ -1,0 +1,133 @@
+// The CUDA backend: every kernel family as CUDA kernels over the shared physics headers, CUB's
+// radix sort for the grid, and the step's repeating cycle of kernel calls captured once into a
+// CUDA graph and replayed (docs/architecture.md, "The CUDA backend").
+#pragma once
+
+#include <cuda_runtime_api.h>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "body_buffers.h"
+#include "motes/backend/device.h"
+#include "motes/backend/kernel_queue.h"
+#include "shared/common.h"
+
+namespace motes::cuda {
+
+class CudaDevice final : public Device {
+ public:
+  /// Guard bytes after every buffer (pattern kGuardByte); no kernel may write them.
+  static constexpr std::size_t kGuardBytes = 64;
+  static constexpr unsigned char kGuardByte = 0xA5;
+  /// Threads per block of every motes kernel.
+  static constexpr unsigned kBlock = 256;
+
+  /// Opens CUDA device `ordinal` and creates its stream.
+  static Result<std::unique_ptr<Device>> open(int ordinal);
+  ~CudaDevice() override;
+
+  [[nodiscard]] const DeviceInfo& info() const override { return info_; }
+  Status allocate(const Sizes& sizes) override;
+  Status write(Buffer b, const void* src, std::size_t bytes) override;
+  Status read(Buffer b, void* dst, std::size_t bytes) override;
+
+  void grid_build(const shared::StepParams& p) override { enqueue(Kernel::GridBuild, p); }
+  void contacts_compute(const shared::StepParams& p) override {
+    enqueue(Kernel::ContactsCompute, p);
+  }
+  void bodies_reduce(const shared::StepParams& p) override { enqueue(Kernel::BodiesReduce, p); }
+  void bodies_integrate(const shared::StepParams& p) override {
+    enqueue(Kernel::BodiesIntegrate, p);
+  }
+  void particles_update(const shared::StepParams& p) override {
+    enqueue(Kernel::ParticlesUpdate, p);
+  }
+
+  Status synchronize() override;
+  Status check_guards() override;
+  void set_timing(bool on) override { timing_ = on; }
+  [[nodiscard]] KernelTimes kernel_times() const override { return times_; }
+  void reset_kernel_times() override { times_ = {}; }
+
+ private:
+  /// A captured and instantiated graph of `copies` repetitions of a cycle of calls.
+  struct Graph {
+    std::vector<KernelCall> cycle;
+    std::size_t copies = 0;
+    cudaGraphExec_t exec = nullptr;
+  };
+
+  CudaDevice() = default;
+
+  template <typename T>
+  T* buf(Buffer b) const {
+    return static_cast<T*>(buffers_[static_cast<std::size_t>(b)]);
+  }
+  /// Records the first failure (sticky); later calls report it.
+  Status check(cudaError_t e, const char* what);
+  void release_buffers();
+  void release_graphs();
+
+  void enqueue(Kernel k, const shared::StepParams& p);
+  /// Runs every queued call: captured graphs when timing is off, timed launches when on.
+  Status flush();
+  Status run_timed(const std::vector<KernelCall>& calls);
+  Status run_graphs(const std::vector<KernelCall>& cycle, std::size_t reps);
+  Result<cudaGraphExec_t> graph_for(const std::vector<KernelCall>& cycle, std::size_t copies);
+  /// Launches calls[i] (and, when they allow it, fuses it with the calls after it); returns how
+  /// many calls it consumed.
+  std::size_t launch(const std::vector<KernelCall>& calls, std::size_t i);
+
+  // One file per kernel family launches it on stream_ (grid_build.cu, contacts_compute.cu...).
+  void launch_grid_build(const shared::StepParams& p);
+  void launch_contacts_compute(const shared::StepParams& p);
+  void launch_bodies_reduce(const shared::StepParams& p);
+  void launch_bodies_integrate(const shared::StepParams& p);
+  void launch_particles_update(const shared::StepParams& p);
+  /// bodies_reduce, bodies_integrate and particles_update in one pass (bodies_step.cu), for scenes
+  /// whose bodies are small; the same arithmetic as the three kernels.
+  void launch_bodies_step(const shared::StepParams& p);
+  /// CUB's temporary storage for sorting n pairs on key_bits bits (grid_build.cu).
+  static Result<std::size_t> sort_temp_size(std::uint32_t n, int key_bits);
+  /// Fills ids_ with 0..n-1 (grid_build.cu).
+  void launch_ids_fill(std::uint32_t n);
+  /// The buffers of the three body passes.
+  [[nodiscard]] BodyBuffers body_buffers() const;
+
+  DeviceInfo info_;
+  int ordinal_ = 0;
+  cudaStream_t stream_ = nullptr;
+  Sizes sizes_;
+  bool allocated_ = false;
+  std::array<void*, kBufferCount> buffers_{};
+  std::array<std::size_t, kBufferCount> bytes_{};
+  // grid_build scratch: particle ids 0..N-1 (CUB's input values), sorted keys, CUB temp storage.
+  shared::uint* ids_ = nullptr;
+  shared::uint* sorted_keys_ = nullptr;
+  void* sort_temp_ = nullptr;
+  std::size_t sort_temp_bytes_ = 0;
+  /// Host copies of BodyFirst and ParticleBody as last written: the fused body pass is used only
+  /// when they agree (body b owns exactly particles [first[b], first[b+1])) and every body is
+  /// small, so that it computes what the three separate kernels compute.
+  std::vector<shared::uint> host_first_, host_body_;
+  bool bodies_fusable_ = false;
+  void update_fusable();
+
+  std::vector<KernelCall> pending_;
+  std::vector<Graph> graphs_;
+  std::vector<cudaEvent_t> events_;
+  Status error_;
+  bool timing_ = false;
+  KernelTimes times_;
+};
+
+/// Blocks for n threads of CudaDevice::kBlock.
+inline unsigned blocks_for(std::uint64_t n) {
+  return static_cast<unsigned>((n + CudaDevice::kBlock - 1) / CudaDevice::kBlock);
+}
+
+}  // namespace motes::cuda

@@ -1,0 +1,188 @@
+// Queueing, graphs and timing. Kernel calls are queued; flush() finds the shortest cycle the queue
+// repeats (a step: the five families, once per substep), captures it once into a CUDA graph (and
+// a graph of kGraphCycles repetitions of it), caches both, and launches them as many times as the
+// cycle repeats: no host synchronization or allocation per step. Timing launches the calls one by
+// one between CUDA events instead.
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "cuda_device.h"
+
+namespace motes::cuda {
+
+namespace {
+
+/// Cycles per big graph: a graph launch costs a few microseconds of host time, so long runs
+/// launch one graph per kGraphCycles steps.
+constexpr std::size_t kGraphCycles = 16;
+/// Graphs kept; more and the oldest is freed.
+constexpr std::size_t kMaxGraphs = 8;
+/// Timed calls between two waits for their events.
+constexpr std::size_t kTimedBatch = 256;
+
+}  // namespace
+
+void CudaDevice::enqueue(Kernel k, const shared::StepParams& p) {
+  if (!error_) return;
+  if (!allocated_) {
+    error_ = Status::error("cuda: kernel launched before allocate");
+    return;
+  }
+  // Every kernel indexes its buffers by these counts: refuse any the allocation cannot hold.
+  if (p.particle_count > sizes_.particles || p.body_count > sizes_.bodies ||
+      std::uint64_t{p.table_mask} + 1 > sizes_.table || p.plane_count > sizes_.planes ||
+      p.material_count > sizes_.materials) {
+    error_ = Status::error(fmt::format(
+        "cuda: {} launched with {} particles, {} bodies, {} buckets, {} planes and {} materials "
+        "on buffers allocated for {}, {}, {}, {} and {}",
+        kernel_name(k), p.particle_count, p.body_count, std::uint64_t{p.table_mask} + 1,
+        p.plane_count, p.material_count, sizes_.particles, sizes_.bodies, sizes_.table,
+        sizes_.planes, sizes_.materials));
+    return;
+  }
+  pending_.push_back({k, p});
+}
+
+std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t i) {
+  const shared::StepParams& p = calls[i].params;
+  switch (calls[i].kernel) {
+    case Kernel::GridBuild:
+      launch_grid_build(p);
+      return 1;
+    case Kernel::ContactsCompute:
+      launch_contacts_compute(p);
+      return 1;
+    case Kernel::BodiesReduce:
+      if (bodies_fusable_ && p.body_count == sizes_.bodies &&
+          p.particle_count == sizes_.particles && i + 2 < calls.size() &&
+          same_call(calls[i + 1], {Kernel::BodiesIntegrate, p}) &&
+          same_call(calls[i + 2], {Kernel::ParticlesUpdate, p})) {
+        launch_bodies_step(p);
+        return 3;
+      }
+      launch_bodies_reduce(p);
+      return 1;
+    case Kernel::BodiesIntegrate:
+      launch_bodies_integrate(p);
+      return 1;
+    case Kernel::ParticlesUpdate:
+      launch_particles_update(p);
+      return 1;
+    case Kernel::Count:
+      break;
+  }
+  return 1;
+}
+
+void CudaDevice::release_graphs() {
+  for (Graph& g : graphs_) cudaGraphExecDestroy(g.exec);
+  graphs_.clear();
+}
+
+Result<cudaGraphExec_t> CudaDevice::graph_for(const std::vector<KernelCall>& cycle,
+                                              std::size_t copies) {
+  for (const Graph& g : graphs_) {
+    if (g.copies == copies && same_calls(g.cycle, cycle)) return g.exec;
+  }
+  if (graphs_.size() >= kMaxGraphs) {  // nothing is in flight between flushes
+    cudaGraphExecDestroy(graphs_.front().exec);
+    graphs_.erase(graphs_.begin());
+  }
+  if (Status s = check(cudaStreamBeginCapture(stream_, cudaStreamCaptureModeThreadLocal),
+                       "cudaStreamBeginCapture");
+      !s) {
+    return s;
+  }
+  for (std::size_t c = 0; c < copies; ++c) {
+    for (std::size_t i = 0; i < cycle.size();) i += launch(cycle, i);
+  }
+  const cudaError_t launched = cudaGetLastError();
+  cudaGraph_t graph = nullptr;
+  const cudaError_t ended = cudaStreamEndCapture(stream_, &graph);
+  if (Status s = check(launched, "a kernel launch during graph capture"); !s) {
+    if (graph != nullptr) cudaGraphDestroy(graph);
+    return s;
+  }
+  if (Status s = check(ended, "cudaStreamEndCapture"); !s) return s;
+  cudaGraphExec_t exec = nullptr;
+  const cudaError_t made = cudaGraphInstantiate(&exec, graph, 0);
+  cudaGraphDestroy(graph);
+  if (Status s = check(made, "cudaGraphInstantiate"); !s) return s;
+  graphs_.push_back({cycle, copies, exec});
+  return exec;
+}
+
+Status CudaDevice::run_graphs(const std::vector<KernelCall>& cycle, std::size_t reps) {
+  if (reps >= kGraphCycles) {
+    Result<cudaGraphExec_t> big = graph_for(cycle, kGraphCycles);
+    if (!big) return big.status();
+    for (; reps >= kGraphCycles; reps -= kGraphCycles) {
+      if (Status s = check(cudaGraphLaunch(big.value(), stream_), "cudaGraphLaunch"); !s) return s;
+    }
+  }
+  if (reps == 0) return Status::ok();
+  Result<cudaGraphExec_t> one = graph_for(cycle, 1);
+  if (!one) return one.status();
+  for (; reps > 0; --reps) {
+    if (Status s = check(cudaGraphLaunch(one.value(), stream_), "cudaGraphLaunch"); !s) return s;
+  }
+  return Status::ok();
+}
+
+Status CudaDevice::run_timed(const std::vector<KernelCall>& calls) {
+  if (events_.size() < 2 * kTimedBatch) {
+    events_.reserve(2 * kTimedBatch);
+    while (events_.size() < 2 * kTimedBatch) {
+      cudaEvent_t e = nullptr;
+      if (Status s = check(cudaEventCreate(&e), "cudaEventCreate"); !s) return s;
+      events_.push_back(e);
+    }
+  }
+  for (std::size_t start = 0; start < calls.size(); start += kTimedBatch) {
+    const std::size_t end = std::min(calls.size(), start + kTimedBatch);
+    for (std::size_t i = start; i < end; ++i) {
+      const std::size_t e = 2 * (i - start);
+      cudaEventRecord(events_[e], stream_);
+      // Unfused: the time of every family on its own.
+      const std::vector<KernelCall> one(1, calls[i]);
+      launch(one, 0);
+      cudaEventRecord(events_[e + 1], stream_);
+    }
+    if (Status s = check(cudaGetLastError(), "a kernel launch"); !s) return s;
+    if (Status s = check(cudaStreamSynchronize(stream_), "running the queued kernels"); !s) {
+      return s;
+    }
+    for (std::size_t i = start; i < end; ++i) {
+      const std::size_t e = 2 * (i - start);
+      float ms = 0.0f;
+      if (Status s =
+              check(cudaEventElapsedTime(&ms, events_[e], events_[e + 1]), "cudaEventElapsedTime");
+          !s) {
+        return s;
+      }
+      const auto k = static_cast<std::size_t>(calls[i].kernel);
+      times_.seconds[k] += 1e-3 * static_cast<double>(ms);
+      times_.launches[k] += 1;
+    }
+  }
+  return Status::ok();
+}
+
+Status CudaDevice::flush() {
+  if (!error_) {
+    pending_.clear();
+    return error_;
+  }
+  if (pending_.empty()) return Status::ok();
+  std::vector<KernelCall> calls;
+  calls.swap(pending_);
+  cudaSetDevice(ordinal_);
+  if (timing_) return run_timed(calls);
+  const std::size_t period = repeating_period(calls);
+  const std::vector<KernelCall> cycle(calls.begin(),
+                                      calls.begin() + static_cast<std::ptrdiff_t>(period));
+  return run_graphs(cycle, calls.size() / period);
+}
+
+}  // namespace motes::cuda
