@@ -43,9 +43,11 @@ struct BenchOptions {
 struct Measurement {
   std::string workload, phase;
   std::uint32_t particles = 0, bodies = 0;
-  std::uint64_t steps = 0;
-  std::vector<double> seconds;  // per repeat
-  motes::KernelTimes kernels;   // of the median repeat
+  std::uint32_t table = 0;
+  std::uint64_t steps = 0;         // per timed repeat
+  std::vector<double> seconds;     // per repeat, kernel timing off
+  std::uint64_t kernel_steps = 0;  // of the run with kernel timing on
+  motes::KernelTimes kernels;      // of that run
   std::string backend, device, detail;
 };
 
@@ -72,44 +74,71 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-/// Runs `steps` steps `repeats` times, each from a fresh simulation prepared by `prepare`.
+/// Runs `steps` steps `repeats` times, each from a fresh simulation prepared by `prepare`, with
+/// kernel timing off (timing may synchronize per kernel and keeps GPU backends from replaying a
+/// captured step); then once more with timing on, for the time of every kernel family.
 template <typename Prepare>
 Measurement measure(const motes::Scene& scene, const BenchOptions& o, std::uint64_t steps,
                     Prepare prepare) {
   Measurement m;
-  {  // Warm-up: first touch of memory, thread pool start.
+  {  // Warm-up: first touch of memory, thread pool start, graph capture.
     auto sim = make_sim(scene, o);
     prepare(*sim);
     must(sim->step(std::min<std::uint64_t>(steps, 50)));
   }
-  std::vector<motes::KernelTimes> kernels;
   for (int r = 0; r < o.repeats; ++r) {
     auto sim = make_sim(scene, o);
     prepare(*sim);
-    sim->device().set_timing(true);
-    sim->device().reset_kernel_times();
     const auto t0 = std::chrono::steady_clock::now();
     must(sim->step(steps));
     const auto t1 = std::chrono::steady_clock::now();
     m.seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
-    kernels.push_back(sim->device().kernel_times());
     if (r == 0) {
       m.particles = sim->particle_count();
       m.bodies = sim->body_count();
+      m.table = sim->sizes().table;
       m.backend = sim->device().info().backend;
       m.device = sim->device().info().name;
       m.detail = sim->device().info().detail;
     }
   }
-  const double med = median(m.seconds);
-  for (std::size_t r = 0; r < m.seconds.size(); ++r) {
-    if (m.seconds[r] == med || r + 1 == m.seconds.size()) {
-      m.kernels = kernels[r];
-      break;
-    }
-  }
+  auto sim = make_sim(scene, o);
+  prepare(*sim);
+  m.kernel_steps = std::min<std::uint64_t>(steps, 500);
+  sim->device().set_timing(true);
+  sim->device().reset_kernel_times();
+  must(sim->step(m.kernel_steps));
+  m.kernels = sim->device().kernel_times();
   m.steps = steps;
   return m;
+}
+
+/// Bytes each kernel family must move per step at the least (every input read once, every output
+/// written once; body data gathered per particle counted once per body): what "achieved bandwidth"
+/// is computed from. docs/benchmarks.md explains each term.
+double compulsory_bytes(motes::Kernel k, const Measurement& m) {
+  const double n = m.particles, b = m.bodies, t = m.table;
+  switch (k) {
+    case motes::Kernel::GridBuild:  // read pos, vel, body, material; write bucket, order, 4 sorted
+      return 40 * n + 8 * n + 40 * n + 4 * (t + 1);
+    case motes::Kernel::ContactsCompute:  // read the 4 sorted arrays, order, starts; write force
+      return 40 * n + 4 * n + 4 * (t + 1) + 16 * n;
+    case motes::Kernel::BodiesReduce:  // read first, com, particle pos + force; write force, torque
+      return 4 * (b + 1) + 16 * b + 32 * n + 32 * b;
+    case motes::Kernel::BodiesIntegrate:  // read 8 vec4, write 5 vec4 per body
+      return 13 * 16 * b;
+    case motes::Kernel::ParticlesUpdate:  // read body, local, pos, vel, 4 body vec4; write pos, vel
+      return (4 + 16 + 32) * n + 64 * b + 32 * n;
+    case motes::Kernel::Count:
+      break;
+  }
+  return 0;
+}
+
+/// Kernel time of family k per step (ms), from the timed run.
+double kernel_ms(const Measurement& m, std::size_t k) {
+  return m.kernel_steps == 0 ? 0.0
+                             : 1e3 * m.kernels.seconds[k] / static_cast<double>(m.kernel_steps);
 }
 
 std::string settle_cache_path(const BenchOptions& o, std::uint64_t n) {
@@ -148,9 +177,12 @@ std::string ensure_settled(const motes::Scene& scene, const BenchOptions& o, std
 nlohmann::json to_json(const Measurement& m) {
   const double med = median(m.seconds);
   nlohmann::json kernels = nlohmann::json::object();
+  nlohmann::json bandwidth = nlohmann::json::object();
   for (std::size_t k = 0; k < motes::kKernelCount; ++k) {
-    kernels[motes::kernel_name(static_cast<motes::Kernel>(k))] =
-        1e3 * m.kernels.seconds[k] / static_cast<double>(m.steps);
+    const auto kernel = static_cast<motes::Kernel>(k);
+    const double ms = kernel_ms(m, k);
+    kernels[motes::kernel_name(kernel)] = ms;
+    bandwidth[motes::kernel_name(kernel)] = ms > 0 ? compulsory_bytes(kernel, m) / (ms * 1e6) : 0.0;
   }
   return {{"workload", m.workload},
           {"phase", m.phase},
@@ -163,6 +195,9 @@ nlohmann::json to_json(const Measurement& m) {
            static_cast<double>(m.particles) * static_cast<double>(m.steps) / med},
           {"body_steps_per_s", static_cast<double>(m.bodies) * static_cast<double>(m.steps) / med},
           {"kernel_ms_per_step", kernels},
+          {"kernel_timed_steps", m.kernel_steps},
+          {"kernel_compulsory_gb_per_s", bandwidth},
+          {"table_buckets", m.table},
           {"backend", m.backend},
           {"device", m.device},
           {"detail", m.detail},
@@ -177,7 +212,7 @@ void print_row(const Measurement& m) {
   const double per = 1e3 * med / static_cast<double>(m.steps);
   std::string ks;
   for (std::size_t k = 0; k < motes::kKernelCount; ++k) {
-    ks += fmt::format(" {:>8.3f}", 1e3 * m.kernels.seconds[k] / static_cast<double>(m.steps));
+    ks += fmt::format(" {:>8.3f}", kernel_ms(m, k));
   }
   fmt::print("{:<9} {:<8} {:>9} {:>6} {:>9.3f} {:>10.3e}{}\n", m.workload, m.phase, m.particles,
              m.steps, per, static_cast<double>(m.particles) * static_cast<double>(m.steps) / med,
@@ -203,9 +238,11 @@ void run_bench(const BenchOptions& o) {
   }
   {
     auto probe = must(motes::open_device(o.backend, o.device, {o.threads}));
-    fmt::print("motes bench on {} device {}: {} ({}); median of {} repeats after a warm-up\n",
-               probe->info().backend, probe->info().index, probe->info().name, probe->info().detail,
-               o.repeats);
+    fmt::print(
+        "motes bench on {} device {}: {} ({}); ms/step: median of {} repeats after a warm-up; "
+        "kernel columns: one more run with kernel timing on (up to 500 steps)\n",
+        probe->info().backend, probe->info().index, probe->info().name, probe->info().detail,
+        o.repeats);
   }
   std::string ks;
   for (std::size_t k = 0; k < motes::kKernelCount; ++k) {
