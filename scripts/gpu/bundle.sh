@@ -1,15 +1,18 @@
 #!/usr/bin/env bash
 # Builds motes for the GPU machine and bundles what has to travel there (it has no network and
 # lacks assimp, the Vulkan loader and the glvnd libraries NVIDIA's Vulkan driver needs):
-#   gpu-bundle/bin/   motes, motes_conformance_tests, motes_gpu_floors (bench/gpu, needs nvcc)
+#   gpu-bundle/bin/   motes, motes_conformance_tests (CUDA for sm_90, Vulkan, OpenMP),
+#                     motes_gpu_floors (bench/gpu)
 #   gpu-bundle/lib/   their shared libraries, except those the GPU machine has (libc, libstdc++...)
 #   gpu-bundle/debs/  Debian packages of the Vulkan loader and glvnd (unpacked there by run.sh)
 # Usage: scripts/gpu/bundle.sh [BUILD_DIR]   (gpu-bundle/ is ignored by git; carry it along)
+# Then, with the device tool: run `scripts/gpu/run-suite.sh` there, carrying gpu-bundle.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 build=${1:-$root/build-gpu}
 bundle=$root/gpu-bundle
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DMOTES_WITH_VULKAN=ON >/dev/null
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DMOTES_WITH_VULKAN=ON \
+  -DMOTES_WITH_CUDA=ON >/dev/null
 cmake --build "$build" -j "${JOBS:-$(nproc)}" --target motes_cli motes_conformance_tests
 rm -rf "$bundle/bin" "$bundle/lib"
 mkdir -p "$bundle/bin" "$bundle/lib" "$bundle/debs"

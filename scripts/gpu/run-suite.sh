@@ -1,53 +1,81 @@
 #!/usr/bin/env bash
 # Runs on the GPU machine, in the repository root, after scripts/gpu/bundle.sh built gpu-bundle/
-# here and it travelled along: devices, the conformance suite (validation layer on), and the
-# benchmarks, each part under its own time limit so that one slow part cannot lose the others'
-# results. Results go to ${OUT:-gpu-out}/.
-# Usage: scripts/gpu/run-suite.sh [conformance|bench|all]   (default all)
+# here and it travelled along: devices, the conformance suite on every backend side by side
+# (openmp, cuda, vulkan with the validation layer on), compute-sanitizer's memcheck and racecheck
+# over the suite's CUDA cases, and the benchmarks, each part under its own time limit so that one
+# slow part cannot lose the others' results. Results go to ${OUT:-gpu-out}/ (at most 8 files come
+# back from the GPU machine): conformance.txt, conformance.md, sanitize.txt, bench.txt, bench.json.
+# Usage: scripts/gpu/run-suite.sh [conformance|sanitize|bench|all]...   (default all)
+#   MOTES_BENCH_BACKENDS="cuda vulkan"   backends benchmarked, in this order
+#   MOTES_GPU_SIZES, MOTES_GPU_DENSE_SIZES   W1 sizes of the falling and dense phases
+#   LIMIT_CONFORMANCE, LIMIT_SANITIZE, LIMIT_FALLING, LIMIT_DENSE, LIMIT_DOMINOES   seconds
 set -uo pipefail
-what=${1:-all}
+parts=${*:-all}
 out=${OUT:-gpu-out}
 mkdir -p "$out"
 . "$(dirname "$0")/prelude.sh"
-# At most 8 files come back from the GPU machine: the device list heads the conformance log.
+want() { [[ " $parts " == *" all "* || " $parts " == *" $1 "* ]]; }
+# The device list heads the conformance log.
 { nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader; motes devices; } \
-  2>&1 | tee "$out/conformance.txt"
+  2>&1 | tee -a "$out/conformance.txt"
 status=0
-part() {  # part SECONDS NAME COMMAND...: runs COMMAND, its output to $out/NAME.txt
+part() {  # part SECONDS LOG COMMAND...: runs COMMAND, its output appended to $out/LOG.txt
   local limit=$1 name=$2
   shift 2
-  echo "== $name (at most ${limit} s)"
+  echo "== $name: $* (at most ${limit} s)" | tee -a "$out/$name.txt"
   timeout "$limit" "$@" >>"$out/$name.txt" 2>&1
   local rc=$?
   tail -n 25 "$out/$name.txt"
-  echo "== $name: exit $rc"
+  echo "== $name: exit $rc" | tee -a "$out/$name.txt"
   return $rc
 }
-if [ "$what" = all ] || [ "$what" = conformance ]; then
+if want conformance; then
   MOTES_VULKAN_VALIDATION=1 MOTES_CONFORMANCE_TABLE="$out/conformance.md" \
-    part "${LIMIT_CONFORMANCE:-180}" conformance motes_conformance_tests --gtest_brief=1 || status=1
+    part "${LIMIT_CONFORMANCE:-240}" conformance motes_conformance_tests --gtest_brief=1 || status=1
   # Again with at most 3 workgroups per dimension (every shader through the 2D-dispatch path) and
   # the scan without subgroup arithmetic.
   MOTES_VULKAN_VALIDATION=1 MOTES_VULKAN_MAX_GROUPS_X=3 MOTES_VULKAN_NO_SUBGROUPS=1 \
     MOTES_CONFORMANCE_BACKENDS=vulkan \
     part 60 conformance motes_conformance_tests --gtest_brief=1 --gtest_filter=-*Scenes* ||
     status=1
-  # The README's main job, on the GPU.
-  MOTES_VULKAN_VALIDATION=1 part 60 conformance motes run examples/scenes/dominoes.json \
-    --backend vulkan --out "${TMPDIR:-/tmp}/motes-dominoes" || status=1
+  # The README's main job, on each GPU backend.
+  for backend in cuda vulkan; do
+    MOTES_VULKAN_VALIDATION=1 part 60 conformance motes run examples/scenes/dominoes.json \
+      --backend "$backend" --out "${TMPDIR:-/tmp}/motes-dominoes-$backend" || status=1
+  done
 fi
-if [ "$what" = all ] || [ "$what" = bench ]; then
-  mkdir -p bench-cache
+if want sanitize; then
+  sanitizer=$(command -v compute-sanitizer || echo /usr/local/cuda/bin/compute-sanitizer)
+  for tool in memcheck racecheck; do
+    MOTES_CONFORMANCE_BACKENDS=cuda part "${LIMIT_SANITIZE:-200}" sanitize "$sanitizer" \
+      --tool "$tool" --error-exitcode 1 motes_conformance_tests --gtest_brief=1 || status=1
+  done
+fi
+if want bench; then
+  mkdir -p bench-cache "${TMPDIR:-/tmp}/motes-bench"
+  sizes=${MOTES_GPU_SIZES:-16384,65536,262144,1048576,4194304,16777216}
   # The floors, in the same run: device-to-device copy and CUB's sort of N (key, value) pairs.
-  part 60 bench-falling motes_gpu_floors \
-    $(echo "${MOTES_GPU_SIZES:-16384,65536,262144,1048576,4194304,16777216}" | tr , ' ')
-  part "${LIMIT_FALLING:-170}" bench-falling motes bench --backend vulkan --workload settle \
-    --phase falling --sizes "${MOTES_GPU_SIZES:-16384,65536,262144,1048576,4194304,16777216}" \
-    --json "$out/bench-falling.json"
-  part "${LIMIT_DOMINOES:-60}" bench-dominoes motes bench --backend vulkan --workload dominoes \
-    --dominoes 100000 --domino-rows 100 --json "$out/bench-dominoes.json"
-  part "${LIMIT_DENSE:-150}" bench-dense motes bench --backend vulkan --workload settle \
-    --phase dense --sizes "${MOTES_GPU_DENSE_SIZES:-16384,65536,262144,1048576}" \
-    --json "$out/bench-dense.json"
+  part 60 bench motes_gpu_floors $(echo "$sizes" | tr , ' ')
+  for backend in ${MOTES_BENCH_BACKENDS:-cuda vulkan}; do
+    j=${TMPDIR:-/tmp}/motes-bench/$backend
+    part "${LIMIT_FALLING:-200}" bench motes bench --backend "$backend" --workload settle \
+      --phase falling --sizes "$sizes" --json "$j-falling.json"
+    part "${LIMIT_DOMINOES:-60}" bench motes bench --backend "$backend" --workload dominoes \
+      --dominoes 100000 --domino-rows 100 --json "$j-dominoes.json"
+    part "${LIMIT_DENSE:-200}" bench motes bench --backend "$backend" --workload settle \
+      --phase dense --sizes "${MOTES_GPU_DENSE_SIZES:-16384,65536,262144,1048576}" \
+      --json "$j-dense.json"
+  done
+  # Every JSON result in one file.
+  python3 - "$out/bench.json" "${TMPDIR:-/tmp}"/motes-bench/*.json <<'PY'
+import json, sys
+rows = []
+for path in sys.argv[2:]:
+    try:
+        rows += json.load(open(path))
+    except (OSError, ValueError) as e:
+        print(f"{path}: {e}", file=sys.stderr)
+json.dump(rows, open(sys.argv[1], "w"), indent=1)
+PY
 fi
 exit "$status"
