@@ -17,9 +17,12 @@ ctest --output-on-failure -j "${JOBS:-$(nproc)}" --timeout 900
 # The sanitizer stage: every test again, built with AddressSanitizer and UndefinedBehaviorSanitizer
 # (MOTES_SANITIZER_STAGE=0 skips it). The Vulkan tests run without the validation layer here (it
 # ran above); the Vulkan loader's and lavapipe's process-lifetime allocations are suppressed.
+# CUDA is left out of this build: its kernels run only on a GPU, where compute-sanitizer's
+# memcheck and racecheck check them (scripts/gpu/run-suite.sh sanitize).
 if [ "${MOTES_SANITIZER_STAGE:-1}" = 1 ]; then
   MOTES_SKIP_INSTALL=1 "$root/scripts/setup.sh" "$build-sanitize" -DMOTES_WERROR=ON \
-    -DMOTES_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMOTES_TEST_VULKAN_VALIDATION=OFF
+    -DMOTES_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMOTES_TEST_VULKAN_VALIDATION=OFF \
+    -DMOTES_WITH_CUDA=OFF
   cd "$build-sanitize"
   MOTES_VULKAN_VALIDATION=0 \
     LSAN_OPTIONS=suppressions=$root/tests/sanitizers/lsan.supp:print_suppressions=0 \
