@@ -1,8 +1,10 @@
 #version 450
-// contacts_compute: every particle (one thread per sorted slot) gathers the forces of the
+// contacts_compute: every particle (one thread per particle id) gathers the forces of the
 // particles overlapping it over the 27 neighbouring cells in the canonical order
 // (docs/architecture.md), then the planes, and writes only its own force: no atomics, a fixed
-// summation order. Same loop structure as backends/openmp/contacts_compute.cpp.
+// summation order. Same loop structure as backends/openmp/contacts_compute.cpp. Threads go in
+// particle order (neighbours in space share the rows of cells they read; no scattered write), as
+// in backends/cuda/contacts_compute.cu.
 #extension GL_GOOGLE_include_directive : require
 #include "kernel_common.glsl"
 #include "shared/contact_force.h"
@@ -25,19 +27,18 @@ void gather_range(uint lo, uint hi, vec3 xi, vec3 ui, vec4 pi, float inv_mi, uin
 }
 
 void main() {
-  uint s = thread_index();
-  if (s >= p.particle_count) return;
-  vec4 pi = sorted_pos[s];
-  vec4 vi = sorted_vel[s];
-  uint out_index = grid_order[s];
+  uint i = thread_index();
+  if (i >= p.particle_count) return;
+  vec4 pi = particle_pos[i];
+  vec4 vi = particle_vel[i];
   if (vi.w == 0.0f) {  // static particle: its force is never used
-    particle_force[out_index] = vec4(0.0f);
+    particle_force[i] = vec4(0.0f);
     return;
   }
   vec3 xi = xyz(pi);
   vec3 ui = xyz(vi);
-  uint body_i = sorted_body[s];
-  uint law_base = sorted_material[s] * p.material_count;
+  uint body_i = particle_body[i];
+  uint law_base = particle_material[i] * p.material_count;
   uint mask = p.table_mask;
   int cx = grid_cell_coord(pi.x, p.inv_cell_size);
   int cy = grid_cell_coord(pi.y, p.inv_cell_size);
@@ -75,5 +76,5 @@ void main() {
     f += plane_contact_force(xi, ui, pi.w, vi.w, pl.normal_offset,
                              contact_laws[law_base + pl.material], p.flags);
   }
-  particle_force[out_index] = vec4(f, 0.0f);
+  particle_force[i] = vec4(f, 0.0f);
 }

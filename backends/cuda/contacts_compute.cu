@@ -1,8 +1,10 @@
-// contacts_compute: every particle (one thread per sorted slot) gathers the forces of the
+// contacts_compute: every particle (one thread per particle id) gathers the forces of the
 // particles overlapping it over the 27 neighbouring cells in the canonical order
 // (docs/architecture.md), then the planes, and writes only its own force: no atomics, a fixed
 // summation order. Same loop structure as backends/openmp/contacts_compute.cpp and
-// shaders/contacts_compute.comp.
+// shaders/contacts_compute.comp. Threads go in particle order, not grid order: scenes are built
+// body by body, so neighbouring threads are neighbours in space and share the rows of cells they
+// read, where grid order jumps between hashed rows; the force is written without a scatter.
 #include "cuda_device.h"
 #include "shared/contact_force.h"
 #include "shared/grid_hash.h"
@@ -41,22 +43,28 @@ __device__ void gather_range(const ContactInputs& in, uint lo, uint hi, vec4 pi,
   }
 }
 
+/// The particle's own data, in particle order (the same values as its sorted copies).
+struct ParticleInputs {
+  const vec4* __restrict__ pos;
+  const vec4* __restrict__ vel;
+  const uint* __restrict__ body;
+  const uint* __restrict__ material;
+};
+
 __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
-                                        const uint* __restrict__ order,
-                                        const uint* __restrict__ cell_start,
+                                        ParticleInputs own, const uint* __restrict__ cell_start,
                                         const shared::PlaneData* __restrict__ planes,
                                         vec4* __restrict__ force) {
-  const std::uint64_t s = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
-  if (s >= p.particle_count) return;
-  const vec4 pi = in.spos[s];
-  const vec4 vi = in.svel[s];
-  const uint out_index = order[s];
+  const std::uint64_t i = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
+  if (i >= p.particle_count) return;
+  const vec4 pi = own.pos[i];
+  const vec4 vi = own.vel[i];
   if (vi.w == 0.0f) {  // static particle: its force is never used
-    force[out_index] = vec4(0.0f);
+    force[i] = vec4(0.0f);
     return;
   }
-  const uint body_i = in.sbody[s];
-  const shared::ContactLaw* law_row = in.laws + std::size_t{in.smat[s]} * p.material_count;
+  const uint body_i = own.body[i];
+  const shared::ContactLaw* law_row = in.laws + std::size_t{own.material[i]} * p.material_count;
   const uint mask = p.table_mask;
   const int cx = shared::grid_cell_coord(pi.x, p.inv_cell_size);
   const int cy = shared::grid_cell_coord(pi.y, p.inv_cell_size);
@@ -94,7 +102,7 @@ __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
     f += shared::plane_contact_force(xi, ui, pi.w, vi.w, pl.normal_offset, law_row[pl.material],
                                      p.flags);
   }
-  force[out_index] = vec4(f, 0.0f);
+  force[i] = vec4(f, 0.0f);
 }
 
 }  // namespace
@@ -104,8 +112,10 @@ void CudaDevice::launch_contacts_compute(const shared::StepParams& p) {
   const ContactInputs in{buf<vec4>(Buffer::SortedPos), buf<vec4>(Buffer::SortedVel),
                          buf<uint>(Buffer::SortedBody), buf<uint>(Buffer::SortedMaterial),
                          buf<shared::ContactLaw>(Buffer::ContactLaws)};
+  const ParticleInputs own{buf<vec4>(Buffer::ParticlePos), buf<vec4>(Buffer::ParticleVel),
+                           buf<uint>(Buffer::ParticleBody), buf<uint>(Buffer::ParticleMaterial)};
   contacts_compute_kernel<<<blocks_for(p.particle_count), kBlock, 0, stream_>>>(
-      p, in, buf<uint>(Buffer::GridOrder), buf<uint>(Buffer::GridCellStart),
+      p, in, own, buf<uint>(Buffer::GridCellStart),
       buf<shared::PlaneData>(Buffer::Planes), buf<vec4>(Buffer::ParticleForce));
 }
 

@@ -1,6 +1,7 @@
-// contacts_compute against the O(N^2) oracle, the kernel alone: the oracle's grid (GridOrder,
-// GridCellStart, Sorted*) and the ContactLaws and Planes are written to the device, every other
-// buffer is poisoned, and ParticleForce (indexed by particle id, w = 0) is read back.
+// contacts_compute against the O(N^2) oracle, the kernel alone: the particles (ParticlePos/Vel/
+// Body/Material), the oracle's grid (GridOrder, GridCellStart, Sorted*) and the ContactLaws and
+// Planes are written to the device, every other buffer is poisoned, and ParticleForce (indexed by
+// particle id, w = 0) is read back.
 //
 // Tolerance: NMSE 1e-7 (the default). Each term comes from the same shared function and the same
 // floats; the device sums the terms in float in the canonical order, the oracle in double in id
@@ -46,8 +47,13 @@ class ContactsCompute : public DeviceTest {
 
     ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
     ASSERT_NO_FATAL_FAILURE(poison_all_but(
-        {Buffer::GridOrder, Buffer::GridCellStart, Buffer::SortedPos, Buffer::SortedVel,
+        {Buffer::ParticlePos, Buffer::ParticleVel, Buffer::ParticleBody, Buffer::ParticleMaterial,
+         Buffer::GridOrder, Buffer::GridCellStart, Buffer::SortedPos, Buffer::SortedVel,
          Buffer::SortedBody, Buffer::SortedMaterial, Buffer::ContactLaws, Buffer::Planes}));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleVel, w.particles.vel));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleBody, w.particles.body));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleMaterial, w.particles.material));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::GridOrder, g.order));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::GridCellStart, g.cell_start));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::SortedPos, g.sorted_pos));
