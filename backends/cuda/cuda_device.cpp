@@ -213,8 +213,10 @@ BodyBuffers CudaDevice::body_buffers() const {
 }
 
 void CudaDevice::update_fusable() {
-  // Bodies of up to this many particles take the fused pass (one thread per body).
-  constexpr shared::uint kFusedBodyParticles = 64;
+  // Bodies of up to this many particles take the fused pass (one thread per body, looping over
+  // its particles). Measured on an H100: a win for free spheres (W1), a loss for 15-particle
+  // dominoes (W2), whose particles a thread then reads 240 bytes apart from its neighbours'.
+  constexpr shared::uint kFusedBodyParticles = 4;
   bodies_fusable_ = false;
   const std::size_t bodies = sizes_.bodies;
   if (host_first_.size() != bodies + 1 || host_body_.size() != sizes_.particles) return;

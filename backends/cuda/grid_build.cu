@@ -1,8 +1,8 @@
 // grid_build: bucket of every particle, stable sort by (bucket, particle id), bucket starts and the
 // particle data in grid order. CUB's LSD radix sort on only the key bits the table needs is stable,
 // so sorting (bucket, id) pairs that start in id order gives the canonical order of every backend.
-// Three launches: hash, CUB's sort, then one pass that writes the bucket starts and the sorted
-// copies together.
+// Three launches: hash, CUB's sort, then one pass that writes the sorted copies and the bucket
+// starts together.
 #include <cub/device/device_radix_sort.cuh>
 
 #include <bit>
@@ -27,9 +27,11 @@ __global__ void grid_hash_kernel(shared::StepParams p, const vec4* __restrict__ 
                                   shared::grid_cell_coord(x.z, p.inv_cell_size), p.table_mask);
 }
 
-/// Sorted slot s: copies particle order[s] to slot s, and writes the start of every bucket from
-/// the one after the previous slot's bucket up to its own (the last slot also closes the table),
-/// so each of the T + 1 starts is written exactly once.
+/// Sorted slot s: copies particle order[s] to slot s. Bucket starts: a block of slots
+/// [s0, s1) owns the buckets after slot s0-1's bucket up to slot s1-1's (the last block up to the
+/// end of the table), a contiguous range that its threads write side by side, each start found by
+/// binary search among the block's keys (first slot whose bucket is >= b). So each of the T + 1
+/// starts is written exactly once, and with coalesced stores however sparse the table.
 __global__ void grid_reorder_kernel(shared::StepParams p, const uint* __restrict__ keys,
                                     const uint* __restrict__ order, const vec4* __restrict__ pos,
                                     const vec4* __restrict__ vel, const uint* __restrict__ body,
@@ -37,20 +39,35 @@ __global__ void grid_reorder_kernel(shared::StepParams p, const uint* __restrict
                                     uint* __restrict__ cell_start, vec4* __restrict__ spos,
                                     vec4* __restrict__ svel, uint* __restrict__ sbody,
                                     uint* __restrict__ smat) {
-  const std::uint64_t s = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
+  __shared__ uint block_keys[CudaDevice::kBlock];
   const uint n = p.particle_count;
-  if (s >= n) return;
-  const uint i = order[s];
-  spos[s] = pos[i];
-  svel[s] = vel[i];
-  sbody[s] = body[i];
-  smat[s] = material[i];
-  const uint key = keys[s];
-  const std::uint64_t lo = s == 0 ? 0 : std::uint64_t{keys[s - 1]} + 1;
-  for (std::uint64_t b = lo; b <= key; ++b) cell_start[b] = static_cast<uint>(s);
-  if (s + 1 == n) {
-    const std::uint64_t table = std::uint64_t{p.table_mask} + 1;
-    for (std::uint64_t b = std::uint64_t{key} + 1; b <= table; ++b) cell_start[b] = n;
+  const std::uint64_t s0 = std::uint64_t{blockIdx.x} * blockDim.x;
+  const std::uint64_t s = s0 + threadIdx.x;
+  if (s < n) {
+    const uint i = order[s];
+    spos[s] = pos[i];
+    svel[s] = vel[i];
+    sbody[s] = body[i];
+    smat[s] = material[i];
+    block_keys[threadIdx.x] = keys[s];
+  }
+  __syncthreads();
+  const auto count = static_cast<uint>(min(std::uint64_t{blockDim.x}, n - s0));
+  const std::uint64_t first = s0 == 0 ? 0 : std::uint64_t{keys[s0 - 1]} + 1;
+  const bool last_block = s0 + count == n;
+  const std::uint64_t end =
+      last_block ? std::uint64_t{p.table_mask} + 2 : std::uint64_t{block_keys[count - 1]} + 1;
+  for (std::uint64_t b = first + threadIdx.x; b < end; b += blockDim.x) {
+    uint lo = 0, hi = count;  // first k in [0, count) with block_keys[k] >= b, else count
+    while (lo < hi) {
+      const uint mid = (lo + hi) / 2;
+      if (block_keys[mid] < b) {
+        lo = mid + 1;
+      } else {
+        hi = mid;
+      }
+    }
+    cell_start[b] = static_cast<uint>(s0 + lo);
   }
 }
 
