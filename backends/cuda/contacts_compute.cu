@@ -51,8 +51,8 @@ struct ParticleInputs {
   const uint* __restrict__ material;
 };
 
-__global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
-                                        ParticleInputs own, const uint* __restrict__ cell_start,
+__global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in, ParticleInputs own,
+                                        const uint* __restrict__ cell_start,
                                         const shared::PlaneData* __restrict__ planes,
                                         vec4* __restrict__ force) {
   const std::uint64_t i = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
@@ -115,8 +115,8 @@ void CudaDevice::launch_contacts_compute(const shared::StepParams& p) {
   const ParticleInputs own{buf<vec4>(Buffer::ParticlePos), buf<vec4>(Buffer::ParticleVel),
                            buf<uint>(Buffer::ParticleBody), buf<uint>(Buffer::ParticleMaterial)};
   contacts_compute_kernel<<<blocks_for(p.particle_count), kBlock, 0, stream_>>>(
-      p, in, own, buf<uint>(Buffer::GridCellStart),
-      buf<shared::PlaneData>(Buffer::Planes), buf<vec4>(Buffer::ParticleForce));
+      p, in, own, buf<uint>(Buffer::GridCellStart), buf<shared::PlaneData>(Buffer::Planes),
+      buf<vec4>(Buffer::ParticleForce));
 }
 
 }  // namespace motes::cuda

@@ -8,7 +8,8 @@
 # Usage: scripts/gpu/run-suite.sh [conformance|sanitize|bench|all]...   (default all)
 #   MOTES_BENCH_RUNS="cuda:falling cuda:dominoes cuda:dense vulkan:falling ..."   what is measured
 #   MOTES_GPU_SIZES, MOTES_GPU_DENSE_SIZES   W1 sizes of the falling and dense phases
-#   LIMIT_CONFORMANCE, LIMIT_SANITIZE, LIMIT_RACECHECK, LIMIT_FALLING, LIMIT_DENSE, LIMIT_DOMINOES   seconds
+#   MOTES_SANITIZE_TOOLS="memcheck racecheck"   compute-sanitizer tools
+#   LIMIT_CONFORMANCE, LIMIT_SANITIZE, LIMIT_FALLING, LIMIT_DENSE, LIMIT_DOMINOES   seconds
 set -uo pipefail
 parts=${*:-all}
 out=${OUT:-gpu-out}
@@ -48,11 +49,13 @@ if want sanitize; then
   sanitizer=$(command -v compute-sanitizer || echo /usr/local/cuda/bin/compute-sanitizer)
   # Every CUDA case under memcheck; racecheck (much slower) leaves out the one-second domino
   # chain (83,000 steps of the same kernels that the other scene cases run).
-  MOTES_CONFORMANCE_BACKENDS=cuda part "${LIMIT_SANITIZE:-200}" sanitize "$sanitizer" \
-    --tool memcheck --error-exitcode 1 motes_conformance_tests --gtest_brief=1 || status=1
-  MOTES_CONFORMANCE_BACKENDS=cuda part "${LIMIT_RACECHECK:-300}" sanitize "$sanitizer" \
-    --tool racecheck --error-exitcode 1 motes_conformance_tests --gtest_brief=1 \
-    --gtest_filter=-*DominoChain* || status=1
+  for tool in ${MOTES_SANITIZE_TOOLS:-memcheck racecheck}; do
+    filter=*
+    [ "$tool" = racecheck ] && filter=-*DominoChain*
+    MOTES_CONFORMANCE_BACKENDS=cuda part "${LIMIT_SANITIZE:-300}" sanitize "$sanitizer" \
+      --tool "$tool" --error-exitcode 1 motes_conformance_tests --gtest_brief=1 \
+      --gtest_filter="$filter" || status=1
+  done
 fi
 if want bench; then
   mkdir -p bench-cache "${TMPDIR:-/tmp}/motes-bench"
