@@ -58,6 +58,43 @@ Eigen::Vector3d read_vector_or_zero(const Node& body, std::string_view key) {
   return Eigen::Vector3d::Zero();
 }
 
+/// A body's colour for pictures: [r, g, b] with each from 0 to 1 (sRGB), or "#rrggbb".
+Eigen::Vector3d read_color(const Node& node) {
+  const std::string expected = "must be a colour: [r, g, b] with each from 0 to 1, or \"#rrggbb\"";
+  if (node.json().is_string()) {
+    const std::string text = node.json().get<std::string>();
+    const auto hex = [](char c) {
+      if (c >= '0' && c <= '9') return c - '0';
+      if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+      if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+      return -1;
+    };
+    Eigen::Vector3d rgb;
+    bool ok = text.size() == 7 && text[0] == '#';
+    for (int i = 0; ok && i < 3; ++i) {
+      const int hi = hex(text[static_cast<std::size_t>(1 + 2 * i)]);
+      const int lo = hex(text[static_cast<std::size_t>(2 + 2 * i)]);
+      ok = hi >= 0 && lo >= 0;
+      rgb[i] = (16 * hi + lo) / 255.0;
+    }
+    if (!ok) node.fail(fmt::format("{}, got {}", expected, scene_detail::describe(node.json())));
+    return rgb;
+  }
+  if (!node.json().is_array() || node.size() != 3) {
+    node.fail(fmt::format("{}, got {}", expected, scene_detail::describe(node.json())));
+  }
+  Eigen::Vector3d rgb;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const Node c = node.at(i);
+    rgb[static_cast<int>(i)] = c.number(Sign::NonNegative);
+    if (rgb[static_cast<int>(i)] > 1.0) {
+      c.fail(fmt::format("must be from 0 to 1 (a colour component), got {}",
+                         scene_detail::describe(c.json())));
+    }
+  }
+  return rgb;
+}
+
 }  // namespace
 
 int find_material(const Node& where, const std::vector<Material>& materials) {
@@ -79,7 +116,7 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const Node body = bodies.at(i);
     body.expect_object({"name", "kind", "shape", "material", "position", "rotation", "velocity",
-                        "angular_velocity", "repeat"});
+                        "angular_velocity", "repeat", "color"});
     BodySpec spec;
     spec.name = body.has("name") ? body.at("name").string() : fmt::format("body{}", i);
     if (auto kind = body.find("kind")) {
@@ -90,6 +127,7 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
         kind->fail(fmt::format("must be \"dynamic\" or \"static\", got \"{}\"", k));
       }
     }
+    if (auto color = body.find("color")) spec.color = read_color(*color);
     spec.material = body.has("material") ? find_material(body.at("material"), scene.materials) : 0;
     spec.position = read_vector_or_zero(body, "position");
     if (auto rot = body.find("rotation")) spec.rotation = read_rotation(*rot);

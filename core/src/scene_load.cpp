@@ -129,6 +129,38 @@ void read_plane(const Node& node, std::size_t index, Scene& scene) {
   if (closed) add("top", -Eigen::Vector3d::UnitY(), hi);
 }
 
+/// The optional camera: position and target required, up and fov optional.
+CameraSpec read_camera(const Node& node) {
+  node.expect_object({"position", "target", "up", "fov"});
+  CameraSpec c;
+  c.position = node.at("position").vec3();
+  const Node target = node.at("target");
+  c.target = target.vec3();
+  const Eigen::Vector3d view = c.target - c.position;
+  if (!(view.norm() > 0.0))
+    target.fail("must differ from /camera/position (the camera looks from position to target)");
+  if (auto up = node.find("up")) {
+    const Eigen::Vector3d u = up->vec3();
+    if (!(u.norm() > 0.0)) up->fail("must be a non-zero vector");
+    c.up = u.normalized();
+    if (c.up.cross(view.normalized()).norm() < 1e-6) {
+      up->fail("must not be parallel to the view direction (target - position)");
+    }
+  } else if (c.up.cross(view.normalized()).norm() < 1e-6) {
+    target.fail("looks straight up or down: give /camera/up, a direction not parallel to the view");
+  }
+  if (auto fov = node.find("fov")) {
+    c.fov = fov->number(Sign::Positive);
+    if (!(c.fov < 180.0)) {
+      fov->fail(
+          fmt::format("must be a vertical field of view in degrees between 0 and 180 "
+                      "(exclusive), got {}",
+                      scene_detail::describe(fov->json())));
+    }
+  }
+  return c;
+}
+
 /// Every material a body or plane uses needs a stiffness (from itself or settings.contact).
 void check_stiffness(const Scene& scene, const std::vector<std::string>& paths) {
   std::vector<bool> used(scene.materials.size(), false);
@@ -149,7 +181,7 @@ void check_stiffness(const Scene& scene, const std::vector<std::string>& paths) 
 
 Scene read_scene(const Json& doc, const std::string& source, const std::string& base_dir) {
   const Node root(doc, "", source);
-  root.expect_object({"description", "settings", "materials", "bodies", "planes"});
+  root.expect_object({"description", "settings", "materials", "bodies", "planes", "camera"});
   if (auto d = root.find("description")) (void)d->string();
 
   Scene scene;
@@ -172,6 +204,8 @@ Scene read_scene(const Json& doc, const std::string& source, const std::string& 
   cache.max_particles = max_particles;
   std::vector<scene_detail::BodyEntry> entries;
   read_bodies(root.at("bodies"), cache, scene, entries);
+
+  if (auto camera = root.find("camera")) scene.camera = read_camera(*camera);
 
   check_stiffness(scene, material_paths);
   scene_detail::check_stability(scene, entries);

@@ -147,6 +147,38 @@ TEST(SceneExamples, BuiltInSceneIsTheDominoChain) {
 
 // ---- defaults, repeats, shapes and planes ----
 
+TEST(SceneLoad, CameraIsOptionalAndReadWithDefaults) {
+  const std::string base =
+      R"({"settings": {"contact": {"stiffness": 1000}}, "bodies": [{"shape": {"type": "particle"}}])";
+  Result<Scene> none = load_scene_text(base + "}", "s", "");
+  ASSERT_TRUE(none) << none.message();
+  EXPECT_FALSE(none->camera.has_value());
+  Result<Scene> some = load_scene_text(
+      base + R"(, "camera": {"position": [1, 2, 3], "target": [0, 0.5, 0], "up": [0, 0, 2]}})", "s",
+      "");
+  ASSERT_TRUE(some) << some.message();
+  ASSERT_TRUE(some->camera.has_value());
+  EXPECT_EQ(some->camera->position, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(some->camera->target, Eigen::Vector3d(0, 0.5, 0));
+  EXPECT_EQ(some->camera->up, Eigen::Vector3d(0, 0, 1));  // normalized
+  EXPECT_EQ(some->camera->fov, CameraSpec{}.fov);
+}
+
+TEST(SceneLoad, BodyColorIsOptionalAsNumbersOrHex) {
+  Result<Scene> s = load_scene_text(
+      R"({"settings": {"contact": {"stiffness": 1000}}, "bodies": [
+          {"shape": {"type": "particle"}, "color": [1, 0.5, 0]},
+          {"shape": {"type": "particle"}, "position": [1, 0, 0], "color": "#00FF80"},
+          {"shape": {"type": "particle"}, "position": [2, 0, 0]}]})",
+      "s", "");
+  ASSERT_TRUE(s) << s.message();
+  ASSERT_TRUE(s->bodies[0].color.has_value());
+  EXPECT_EQ(*s->bodies[0].color, Eigen::Vector3d(1, 0.5, 0));
+  ASSERT_TRUE(s->bodies[1].color.has_value());
+  EXPECT_EQ(*s->bodies[1].color, Eigen::Vector3d(0, 1, 128 / 255.0));
+  EXPECT_FALSE(s->bodies[2].color.has_value());
+}
+
 TEST(SceneLoad, DefaultsAreApplied) {
   const Scene s = load_or_fail(data("defaults.json"));
   const Settings def;
@@ -350,7 +382,7 @@ const BadCase kBadCases[] = {
     {"not_object.json", {": /: must be an object, got an array of 3 values"}},
     {"unknown_top_key.json",
      {": /bodys: unknown key \"bodys\"",
-      "(allowed: description, settings, materials, bodies, planes)"}},
+      "(allowed: description, settings, materials, bodies, planes, camera)"}},
     {"unknown_body_key.json", {": /bodies/0/colour: unknown key \"colour\"", "angular_velocity"}},
     {"unknown_settings_key.json", {": /settings/timestep: unknown key \"timestep\"", "dt"}},
     {"unknown_repeat_key.json", {": /bodies/0/repeat/offsets: unknown key \"offsets\""}},
@@ -403,6 +435,18 @@ const BadCase kBadCases[] = {
     {"shape_too_small.json", {": /bodies/0/shape: ", "no particle fits"}},
     {"zero_axis.json", {": /bodies/0/rotation/axis: must be a non-zero vector"}},
     {"bad_kind.json", {": /bodies/0/kind: must be \"dynamic\" or \"static\", got \"kinematic\""}},
+    {"camera_same_point.json", {": /camera/target: must differ from /camera/position"}},
+    {"camera_bad_fov.json",
+     {": /camera/fov: must be a vertical field of view in degrees between 0 and 180", "got 200"}},
+    {"camera_up_parallel.json",
+     {": /camera/up: must not be parallel to the view direction (target - position)"}},
+    {"camera_unknown_key.json",
+     {": /camera/look_at: unknown key \"look_at\" (allowed: position, target, up, fov)"}},
+    {"camera_missing_target.json", {": /camera: missing required key \"target\""}},
+    {"bad_color.json", {": /bodies/0/color/1: must be from 0 to 1 (a colour component), got 1.5"}},
+    {"bad_color_text.json",
+     {": /bodies/0/color: must be a colour: [r, g, b] with each from 0 to 1, or \"#rrggbb\", "
+      "got \"red\""}},
 };
 
 INSTANTIATE_TEST_SUITE_P(Bad, SceneErrors, ::testing::ValuesIn(kBadCases),

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,7 @@ struct BodySpec {
   Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< rad/s, world frame
+  std::optional<Eigen::Vector3d> color;  ///< sRGB, each 0..1, for pictures (docs/rendering.md)
 };
 
 /// A static analytic half-space: solid below the plane (opposite to the normal).
@@ -57,12 +59,21 @@ struct PlaneSpec {
   int material = 0;
 };
 
+/// Where pictures of the scene are taken from (`motes run --render`, docs/rendering.md).
+struct CameraSpec {
+  Eigen::Vector3d position{0.0, 0.0, 1.0};           ///< the eye (m)
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();  ///< the point in the image centre (m)
+  Eigen::Vector3d up{0.0, 1.0, 0.0};  ///< unit vector; the image's up is its part across the view
+  double fov = 40.0;                  ///< vertical field of view (degrees, 0 < fov < 180)
+};
+
 struct Scene {
   std::string source;  ///< file it was loaded from (or "<built-in>")
   Settings settings;
   std::vector<Material> materials;
   std::vector<BodySpec> bodies;
   std::vector<PlaneSpec> planes;
+  std::optional<CameraSpec> camera;  ///< none: pictures fit a camera to the particles
 
   [[nodiscard]] std::size_t particle_count() const;
 };
