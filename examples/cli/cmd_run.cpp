@@ -16,6 +16,7 @@
 #include "motes/scene.h"
 #include "motes/simulation.h"
 #include "progress.h"
+#include "render_args.h"
 
 namespace motes::cli {
 
@@ -33,6 +34,8 @@ struct RunArgs {
   std::string out = "out";
   std::uint64_t every = 0;
   std::string format = "vtu";
+  std::string render_dir;
+  RenderArgs render;
   CLI::Option* steps_option = nullptr;
   CLI::Option* duration_option = nullptr;
   CLI::Option* every_option = nullptr;
@@ -134,16 +137,33 @@ class Runner {
         static_cast<double>(total_) * s.dt, every_,
         writer_ ? fmt::format(" to {}", writer_->main_path()) : " (not written: --format none)");
     std::fflush(stdout);
+    if (!args_.render_dir.empty()) setup_render(scene.value());
+  }
+
+  /// Pictures of every frame: the scene's camera or one fitted to the initial particles.
+  void setup_render(const Scene& scene) {
+    Result<Snapshot> first = sim_->snapshot();
+    if (!first) fail(first.message());
+    render::RenderSettings settings = render_settings(args_.render, render::look_from_scene(scene),
+                                                      scene.camera, first->particle_pos);
+    const double interval = static_cast<double>(every_) * sim_->settings().dt;
+    render_ = open_render_output(args_.render, std::move(settings), args_.render_dir, interval,
+                                 scene.camera.has_value());
   }
 
   /// Checks the state and writes it as the next frame.
   void output_frame() {
     const Clock::time_point start = Clock::now();
     if (Status s = sim_->check_finite(); !s) fail(s.message());
-    if (writer_) {
+    if (writer_ || render_) {
       Result<Snapshot> snapshot = sim_->snapshot();
       if (!snapshot) fail(snapshot.message());
-      if (Status s = writer_->write_frame(snapshot.value()); !s) fail(s.message());
+      if (writer_) {
+        if (Status s = writer_->write_frame(snapshot.value()); !s) fail(s.message());
+      }
+      if (render_) {
+        if (Status s = render_->add_frame(snapshot.value()); !s) fail(s.message());
+      }
     }
     last_output_step_ = sim_->steps();
     output_seconds_ += seconds_since(start);
@@ -166,6 +186,9 @@ class Runner {
     wall_seconds_ = seconds_since(start);
     if (writer_) {
       if (Status s = writer_->finish(); !s) fail(s.message());
+    }
+    if (render_) {
+      if (Status s = render_->finish(); !s) fail(s.message());
     }
   }
 
@@ -222,6 +245,7 @@ class Runner {
     } else {
       fmt::print("  {:<16}none written (--format none)\n", "frames");
     }
+    if (render_) fmt::print("  {:<16}{}\n", "pictures", render_summary(*render_));
     std::fflush(stdout);
   }
 
@@ -229,6 +253,7 @@ class Runner {
   std::string scene_name_;
   std::unique_ptr<Simulation> sim_;
   std::unique_ptr<FrameWriter> writer_;
+  std::unique_ptr<render::RenderOutput> render_;
   std::uint64_t total_ = 0;
   std::uint64_t every_ = 1;
   std::uint64_t last_output_step_ = 0;
@@ -268,6 +293,10 @@ void add_run_command(CLI::App& app) {
   sub->add_option("--threads", args->threads,
                   "OpenMP backend threads (default: OMP_NUM_THREADS or every core)")
       ->check(CLI::PositiveNumber);
+  sub->add_option("--render", args->render_dir,
+                  "also draw every frame as a PNG in this directory, and an MP4 when ffmpeg is "
+                  "installed (docs/rendering.md)");
+  add_render_options(sub, args->render);
   sub->callback([args] { Runner(*args).run(); });
 }
 

@@ -13,5 +13,9 @@ void add_devices_command(CLI::App& app);
 void add_voxelize_command(CLI::App& app);
 /// `motes bench`: the fixed benchmark workloads (cmd_bench.cpp).
 void add_bench_command(CLI::App& app);
+/// `motes render RESULTS`: pictures and video of frames written by motes run (cmd_render.cpp).
+void add_render_command(CLI::App& app);
+/// `motes render-bench`: times the renderer on a block of particles (cmd_render_bench.cpp).
+void add_render_bench_command(CLI::App& app);
 
 }  // namespace motes::cli

@@ -1,4 +1,5 @@
-// The motes command: `motes run`, `motes devices`, `motes voxelize`, `motes bench`.
+// The motes command: `motes run`, `motes devices`, `motes voxelize`, `motes bench`,
+// `motes render`.
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
@@ -17,6 +18,8 @@ int main(int argc, char** argv) {
   motes::cli::add_devices_command(app);
   motes::cli::add_voxelize_command(app);
   motes::cli::add_bench_command(app);
+  motes::cli::add_render_command(app);
+  motes::cli::add_render_bench_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
