@@ -11,7 +11,7 @@ packages=(build-essential cmake ninja-build pkg-config git
   libeigen3-dev libassimp-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev python3 python3-meshio clang-format
   glslang-tools spirv-tools libvulkan-dev libvulkan-volk-dev libvulkan1 mesa-vulkan-drivers
-  vulkan-validationlayers)
+  vulkan-validationlayers libstb-dev ffmpeg)
 
 if [ "${MOTES_SKIP_INSTALL:-0}" != 1 ]; then
   missing=()
