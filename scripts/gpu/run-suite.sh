@@ -4,7 +4,8 @@
 # (openmp, cuda, vulkan with the validation layer on), compute-sanitizer's memcheck and racecheck
 # over the suite's CUDA cases, and the benchmarks, each part under its own time limit so that one
 # slow part cannot lose the others' results. Results go to ${OUT:-gpu-out}/ (at most 8 files come
-# back from the GPU machine): conformance.txt, conformance.md, sanitize.txt, bench.txt, bench.json.
+# back from the GPU machine): conformance.txt, conformance.md, sanitize.txt, bench.txt, bench.json,
+# bench.md (scripts/gpu/bench-tables.py).
 # Usage: scripts/gpu/run-suite.sh [conformance|sanitize|bench|all]...   (default all)
 #   MOTES_BENCH_RUNS="cuda:falling cuda:dominoes cuda:dense vulkan:falling ..."   what is measured
 #   MOTES_GPU_SIZES, MOTES_GPU_DENSE_SIZES   W1 sizes of the falling and dense phases
@@ -76,7 +77,7 @@ if want bench; then
           --phase dense --sizes "${MOTES_GPU_DENSE_SIZES:-16384,65536,262144,1048576}" --json "$j" ;;
     esac
   done
-  # Every JSON result in one file.
+  # Every JSON result in one file, and the tables of docs/benchmarks.md made from it.
   python3 - "$out/bench.json" "${TMPDIR:-/tmp}"/motes-bench/*.json <<'PY'
 import json, sys
 rows = []
@@ -87,5 +88,7 @@ for path in sys.argv[2:]:
         print(f"{path}: {e}", file=sys.stderr)
 json.dump(rows, open(sys.argv[1], "w"), indent=1)
 PY
+  python3 "$(dirname "$0")/bench-tables.py" "$out/bench.json" --floors "$out/bench.txt" \
+    --out "$out/bench.md"
 fi
 exit "$status"
