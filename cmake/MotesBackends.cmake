@@ -52,8 +52,10 @@ if(NOT MOTES_WITH_VULKAN STREQUAL "OFF")
 endif()
 
 # CUDA: nvcc (CMake's CUDA language; /usr/local/cuda/bin/nvcc is tried when it is not on PATH) and
-# the CUDA toolkit with CUB. Compiled for sm_90 (H100, H200) plus PTX for it; CMAKE_CUDA_ARCHITECTURES
-# overrides. `native` is never the default: it fails on machines without a GPU, CI among them.
+# the CUDA toolkit with CUB. Compiled for sm_90 (H100, H200) plus PTX for it, and PTX for
+# compute_75 so that Turing, Ampere and Ada GPUs run it too (the driver compiles it at first use;
+# about a minute more of build time); CMAKE_CUDA_ARCHITECTURES overrides. `native` is never the
+# default: it fails on machines without a GPU, CI among them.
 # Runs need only the NVIDIA driver (static runtime); without one, `motes devices` says why.
 set(MOTES_CUDA OFF)
 set(MOTES_CUDA_STATUS "not built: MOTES_WITH_CUDA=OFF")
@@ -68,7 +70,7 @@ if(NOT MOTES_WITH_CUDA STREQUAL "OFF")
   check_language(CUDA)
   if(CMAKE_CUDA_COMPILER)
     if(NOT DEFINED CMAKE_CUDA_ARCHITECTURES)
-      set(CMAKE_CUDA_ARCHITECTURES 90-real 90-virtual)
+      set(CMAKE_CUDA_ARCHITECTURES 75-virtual 90-real 90-virtual)
     endif()
     enable_language(CUDA)
     find_package(CUDAToolkit)
