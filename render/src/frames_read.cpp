@@ -17,9 +17,6 @@ namespace fs = std::filesystem;
 
 namespace detail {
 
-namespace {
-
-/// The value of attribute `name` in the XML tag `tag`, or empty.
 std::string attribute(const std::string& tag, const std::string& name) {
   const std::string key = " " + name + "=\"";
   const std::size_t at = tag.find(key);
@@ -28,8 +25,6 @@ std::string attribute(const std::string& tag, const std::string& name) {
   const std::size_t end = tag.find('"', start);
   return end == std::string::npos ? std::string() : tag.substr(start, end - start);
 }
-
-}  // namespace
 
 Result<std::vector<std::string>> read_pvd(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -17,6 +17,9 @@ Result<std::unique_ptr<FrameReader>> open_vtu_frames(std::string source,
 Result<std::unique_ptr<FrameReader>> open_csv_frames(const std::string& path, double radius);
 /// The files a .pvd collection lists, in order, with paths relative to the .pvd's directory.
 Result<std::vector<std::string>> read_pvd(const std::string& path);
+
+/// The value of attribute `name` in the XML tag `tag` (the text from '<' to '>'), or empty.
+std::string attribute(const std::string& tag, const std::string& name);
 /// Half the typical (median of a sample) distance from a particle to its nearest neighbour.
 float typical_radius(const std::vector<shared::vec4>& particles);
 

@@ -13,15 +13,6 @@ namespace motes::render::detail {
 
 namespace {
 
-std::string attribute(const std::string& tag, const std::string& name) {
-  const std::string key = " " + name + "=\"";
-  const std::size_t at = tag.find(key);
-  if (at == std::string::npos) return {};
-  const std::size_t start = at + key.size();
-  const std::size_t end = tag.find('"', start);
-  return end == std::string::npos ? std::string() : tag.substr(start, end - start);
-}
-
 /// One VTU file in memory, its arrays found by name.
 class VtuFile {
  public:

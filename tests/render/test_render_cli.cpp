@@ -15,6 +15,7 @@
 #include <stb/stb_image.h>
 
 #include "motes/render_output.h"
+#include "unit/cli_support.h"
 #include "unit/test_support.h"
 
 namespace fs = std::filesystem;
@@ -27,47 +28,16 @@ const std::string kSmallScene = std::string(MOTES_TEST_DATA_DIR) + "/cli/small.j
 // small.json: 0.05 s with a frame every 0.01 s: frames 0 to 5.
 constexpr std::size_t kSmallFrames = 6;
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using motes_test::contains;
+using motes_test::describe;
+using motes_test::Outcome;
+using motes_test::quote;
+using motes_test::read_text;
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct Outcome {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-/// Runs `ENV motes ARGS` (ENV: "VAR=value ..." or empty) with stdout and stderr captured.
-Outcome run_motes(const TempDir& tmp, const std::vector<std::string>& args,
-                  const std::string& env = "") {
-  std::string cmd;
-  if (!env.empty()) cmd.append("env ").append(env).append(" ");
-  cmd.append("timeout 300 ").append(quote(MOTES_CLI_PATH));
-  for (const std::string& a : args) cmd.append(" ").append(quote(a));
-  const std::string out = tmp / "stdout.txt", err = tmp / "stderr.txt";
-  cmd.append(" >").append(quote(out)).append(" 2>").append(quote(err)).append(" </dev/null");
-  const int status = std::system(cmd.c_str());
-  Outcome o;
-  o.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  o.out = read_text(out);
-  o.err = read_text(err);
-  return o;
-}
-
-std::string describe(const Outcome& o) {
-  return "exit " + std::to_string(o.exit_code) + "\n--- stdout\n" + o.out + "--- stderr\n" + o.err;
-}
-
-bool contains(const std::string& haystack, const std::string& needle) {
-  return haystack.find(needle) != std::string::npos;
+/// Rendering runs get more time than the CLI tests' default (slow under the sanitizers).
+Outcome run_rendering(const TempDir& tmp, const std::vector<std::string>& args,
+                      const std::string& env = "") {
+  return motes_test::run_motes(tmp, args, env, 300);
 }
 
 std::vector<fs::path> pngs_in(const fs::path& dir) {
@@ -109,8 +79,8 @@ std::size_t distinct_colors(const Decoded& d) {
 TEST(RenderCli, RunWritesOnePngPerFrame) {
   TempDir tmp;
   const std::string dir = tmp / "frames";
-  const Outcome o = run_motes(tmp, {"run", kSmallScene, "--format", "none", "--render", dir,
-                                    "--size", "320x180", "--no-video"});
+  const Outcome o = run_rendering(tmp, {"run", kSmallScene, "--format", "none", "--render", dir,
+                                        "--size", "320x180", "--no-video"});
   ASSERT_EQ(o.exit_code, 0) << describe(o);
   EXPECT_TRUE(contains(o.out, "pictures        6 PNG frames in " + dir)) << o.out;
   const std::vector<fs::path> files = pngs_in(dir);
@@ -137,8 +107,8 @@ TEST(RenderCli, RunWritesAnH264Mp4WhenFfmpegIsInstalled) {
   }
   TempDir tmp;
   const std::string dir = tmp / "frames";
-  const Outcome o =
-      run_motes(tmp, {"run", kSmallScene, "--format", "none", "--render", dir, "--size", "161x91"});
+  const Outcome o = run_rendering(
+      tmp, {"run", kSmallScene, "--format", "none", "--render", dir, "--size", "161x91"});
   ASSERT_EQ(o.exit_code, 0) << describe(o);
   const std::string video = (fs::path(dir) / "video.mp4").string();
   EXPECT_TRUE(contains(o.out, "video " + video + " at 60 fps (")) << o.out;
@@ -161,9 +131,9 @@ TEST(RenderCli, RunWritesAnH264Mp4WhenFfmpegIsInstalled) {
 TEST(RenderCli, WithoutFfmpegTheMessageSaysHowToGetItAndPngsStay) {
   TempDir tmp;
   const std::string dir = tmp / "frames";
-  const Outcome o =
-      run_motes(tmp, {"run", kSmallScene, "--format", "none", "--render", dir, "--size", "64x64"},
-                "MOTES_FFMPEG=");
+  const Outcome o = run_rendering(
+      tmp, {"run", kSmallScene, "--format", "none", "--render", dir, "--size", "64x64"},
+      "MOTES_FFMPEG=");
   ASSERT_EQ(o.exit_code, 0) << describe(o);
   EXPECT_TRUE(contains(o.out, "ffmpeg was not found")) << o.out;
   EXPECT_TRUE(contains(o.out, "apt-get install ffmpeg")) << o.out;
@@ -174,10 +144,10 @@ TEST(RenderCli, WithoutFfmpegTheMessageSaysHowToGetItAndPngsStay) {
 TEST(RenderCli, RenderCommandDrawsVtuResultsAsRunDid) {
   TempDir tmp;
   const std::string results = tmp / "results", frames = tmp / "frames";
-  const Outcome run = run_motes(tmp, {"run", kSmallScene, "--out", results, "--render", frames,
-                                      "--size", "200x120", "--no-video"});
+  const Outcome run = run_rendering(tmp, {"run", kSmallScene, "--out", results, "--render", frames,
+                                          "--size", "200x120", "--no-video"});
   ASSERT_EQ(run.exit_code, 0) << describe(run);
-  const Outcome render = run_motes(
+  const Outcome render = run_rendering(
       tmp, {"render", results, "--scene", kSmallScene, "--size", "200x120", "--no-video"});
   ASSERT_EQ(render.exit_code, 0) << describe(render);
   EXPECT_TRUE(contains(render.out, "6 frames of 108 particles")) << render.out;
@@ -194,10 +164,10 @@ TEST(RenderCli, RenderCommandDrawsVtuResultsAsRunDid) {
 TEST(RenderCli, RenderCommandDrawsCsvResults) {
   TempDir tmp;
   const std::string results = tmp / "results", out = tmp / "pictures";
-  const Outcome run = run_motes(tmp, {"run", kSmallScene, "--out", results, "--format", "csv"});
+  const Outcome run = run_rendering(tmp, {"run", kSmallScene, "--out", results, "--format", "csv"});
   ASSERT_EQ(run.exit_code, 0) << describe(run);
-  const Outcome render = run_motes(tmp, {"render", results, "--out", out, "--size", "96x64",
-                                         "--no-video", "--color-by", "speed"});
+  const Outcome render = run_rendering(tmp, {"render", results, "--out", out, "--size", "96x64",
+                                             "--no-video", "--color-by", "speed"});
   ASSERT_EQ(render.exit_code, 0) << describe(render);
   const std::vector<fs::path> files = pngs_in(out);
   ASSERT_EQ(files.size(), kSmallFrames);
@@ -207,11 +177,13 @@ TEST(RenderCli, RenderCommandDrawsCsvResults) {
 TEST(RenderCli, BadSizeAndColourModeAreUsageErrors) {
   TempDir tmp;
   for (const char* size : {"12x", "0x100", "big", "1280x720x2"}) {
-    const Outcome o = run_motes(tmp, {"run", kSmallScene, "--render", tmp / "f", "--size", size});
+    const Outcome o =
+        run_rendering(tmp, {"run", kSmallScene, "--render", tmp / "f", "--size", size});
     EXPECT_EQ(o.exit_code, 105) << describe(o);
     EXPECT_TRUE(contains(o.err, std::string("invalid size '") + size + "'")) << o.err;
   }
-  const Outcome color = run_motes(tmp, {"render", tmp.path().string(), "--color-by", "rainbow"});
+  const Outcome color =
+      run_rendering(tmp, {"render", tmp.path().string(), "--color-by", "rainbow"});
   EXPECT_EQ(color.exit_code, 105) << describe(color);
   EXPECT_TRUE(contains(color.err, "unknown colour mode 'rainbow' (expected one of: body, speed"))
       << color.err;
@@ -220,29 +192,29 @@ TEST(RenderCli, BadSizeAndColourModeAreUsageErrors) {
 TEST(RenderCli, UnreadableResultsAreErrorsNamingThePath) {
   TempDir tmp;
   const std::string missing = tmp / "no_such_results";
-  Outcome o = run_motes(tmp, {"render", missing});
+  Outcome o = run_rendering(tmp, {"render", missing});
   EXPECT_EQ(o.exit_code, 2) << describe(o);
   EXPECT_TRUE(contains(o.err, "motes: error: cannot read results '" + missing + "'")) << o.err;
 
   const std::string empty = tmp / "empty";
   fs::create_directories(empty);
-  o = run_motes(tmp, {"render", empty});
+  o = run_rendering(tmp, {"render", empty});
   EXPECT_EQ(o.exit_code, 2) << describe(o);
   EXPECT_TRUE(contains(o.err, "no particles.pvd, particles_*.vtu or particles.csv in it")) << o.err;
 
   // A truncated frame: the error names the file.
   const std::string results = tmp / "results";
-  ASSERT_EQ(run_motes(tmp, {"run", kSmallScene, "--out", results}).exit_code, 0);
+  ASSERT_EQ(run_rendering(tmp, {"run", kSmallScene, "--out", results}).exit_code, 0);
   const fs::path frame = fs::path(results) / "particles_000003.vtu";
   fs::resize_file(frame, fs::file_size(frame) / 2);
-  o = run_motes(tmp, {"render", results, "--no-video"});
+  o = run_rendering(tmp, {"render", results, "--no-video"});
   EXPECT_EQ(o.exit_code, 2) << describe(o);
   EXPECT_TRUE(contains(o.err, frame.string() + "': ")) << o.err;
   EXPECT_TRUE(contains(o.err, "truncated")) << o.err;
 
   const std::string csv = tmp / "bad.csv";
   std::ofstream(csv) << "x,y,z\n1,2,3\n";
-  o = run_motes(tmp, {"render", csv});
+  o = run_rendering(tmp, {"render", csv});
   EXPECT_EQ(o.exit_code, 2) << describe(o);
   EXPECT_TRUE(contains(o.err, csv + "':1: expected the header")) << o.err;
 }

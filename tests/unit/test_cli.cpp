@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "motes/devices.h"
+#include "unit/cli_support.h"
 #include "unit/test_support.h"
 
 namespace fs = std::filesystem;
@@ -26,49 +27,12 @@ const std::string kBunny = std::string(MOTES_SOURCE_DIR) + "/examples/assets/bun
 
 using motes_test::TempDir;
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-struct Outcome {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-/// Runs `motes ARGS` with stdout and stderr captured; a run that hangs is killed after 120 s.
-Outcome run_motes(const TempDir& tmp, const std::vector<std::string>& args) {
-  std::string cmd = "timeout 120 ";
-  cmd += quote(MOTES_CLI_PATH);
-  for (const std::string& a : args) {
-    cmd += ' ';
-    cmd += quote(a);
-  }
-  const std::string out = tmp / "stdout.txt", err = tmp / "stderr.txt";
-  cmd.append(" >").append(quote(out)).append(" 2>").append(quote(err)).append(" </dev/null");
-  const int status = std::system(cmd.c_str());
-  Outcome o;
-  o.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  o.out = read_text(out);
-  o.err = read_text(err);
-  return o;
-}
-
-std::string describe(const Outcome& o) {
-  return "exit " + std::to_string(o.exit_code) + "\n--- stdout\n" + o.out + "--- stderr\n" + o.err;
-}
-
-bool contains(const std::string& haystack, const std::string& needle) {
-  return haystack.find(needle) != std::string::npos;
-}
+using motes_test::contains;
+using motes_test::describe;
+using motes_test::Outcome;
+using motes_test::quote;
+using motes_test::read_text;
+using motes_test::run_motes;
 
 std::vector<std::string> files_with_extension(const fs::path& dir, const std::string& ext) {
   std::vector<std::string> names;
