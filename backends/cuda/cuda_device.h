@@ -78,9 +78,9 @@ class CudaDevice final : public Device {
   Status run_timed(const std::vector<KernelCall>& calls);
   Status run_graphs(const std::vector<KernelCall>& cycle, std::size_t reps);
   Result<cudaGraphExec_t> graph_for(const std::vector<KernelCall>& cycle, std::size_t copies);
-  /// Launches calls[i] (and, when they allow it, fuses it with the calls after it); returns how
-  /// many calls it consumed.
-  std::size_t launch(const std::vector<KernelCall>& calls, std::size_t i);
+  /// Launches calls[i] (and, when `fuse` and they allow it, fuses it with the calls after it);
+  /// returns how many calls it consumed.
+  std::size_t launch(const std::vector<KernelCall>& calls, std::size_t i, bool fuse = true);
 
   // One file per kernel family launches it on stream_ (grid_build.cu, contacts_compute.cu...).
   void launch_grid_build(const shared::StepParams& p);

@@ -44,7 +44,7 @@ void CudaDevice::enqueue(Kernel k, const shared::StepParams& p) {
   pending_.push_back({k, p});
 }
 
-std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t i) {
+std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t i, bool fuse) {
   const shared::StepParams& p = calls[i].params;
   switch (calls[i].kernel) {
     case Kernel::GridBuild:
@@ -54,7 +54,7 @@ std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t
       launch_contacts_compute(p);
       return 1;
     case Kernel::BodiesReduce:
-      if (bodies_fusable_ && p.body_count == sizes_.bodies &&
+      if (fuse && bodies_fusable_ && p.body_count == sizes_.bodies &&
           p.particle_count == sizes_.particles && i + 2 < calls.size() &&
           same_call(calls[i + 1], {Kernel::BodiesIntegrate, p}) &&
           same_call(calls[i + 2], {Kernel::ParticlesUpdate, p})) {
@@ -144,9 +144,7 @@ Status CudaDevice::run_timed(const std::vector<KernelCall>& calls) {
     for (std::size_t i = start; i < end; ++i) {
       const std::size_t e = 2 * (i - start);
       cudaEventRecord(events_[e], stream_);
-      // Unfused: the time of every family on its own.
-      const std::vector<KernelCall> one(1, calls[i]);
-      launch(one, 0);
+      launch(calls, i, false);  // unfused: the time of every family on its own
       cudaEventRecord(events_[e + 1], stream_);
     }
     if (Status s = check(cudaGetLastError(), "a kernel launch"); !s) return s;

@@ -55,7 +55,7 @@ class CsvWriter final : public FrameWriter {
 }  // namespace
 
 Result<std::unique_ptr<FrameWriter>> open_csv_writer(const std::string& dir) {
-  if (Status s = output::create_directory(dir); !s) return s;
+  if (Status s = create_output_directory(dir); !s) return s;
   auto opened = OutputFile::create((std::filesystem::path(dir) / "particles.csv").string());
   if (!opened) return opened.status();
   OutputFile file = std::move(opened).value();

@@ -76,20 +76,30 @@ Status OutputFile::close() {
   return Status::ok();
 }
 
-Status create_directory(const std::string& dir) {
+}  // namespace motes::output
+
+namespace motes {
+
+Status create_output_directory(const std::string& dir, const std::string& purpose) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path p(dir);
   if (fs::is_directory(p, ec)) return Status::ok();
   fs::create_directories(p, ec);
   if (ec) {
-    return Status::error(fmt::format("cannot create output directory '{}': {}", dir, ec.message()));
+    return Status::error(
+        fmt::format("cannot create {} directory '{}': {}", purpose, dir, ec.message()));
   }
   if (!fs::is_directory(p, ec)) {
-    return Status::error(fmt::format("cannot create output directory '{}': not a directory", dir));
+    return Status::error(
+        fmt::format("cannot create {} directory '{}': not a directory", purpose, dir));
   }
   return Status::ok();
 }
+
+}  // namespace motes
+
+namespace motes::output {
 
 Status replace_file(const std::string& from, const std::string& to) {
   std::error_code ec;

@@ -41,9 +41,6 @@ class OutputFile {
   std::string path_;
 };
 
-/// Creates `dir` and its parents if missing; an error if it cannot, or if it is not a directory.
-Status create_directory(const std::string& dir);
-
 /// Renames `from` to `to`, replacing `to` atomically.
 Status replace_file(const std::string& from, const std::string& to);
 

@@ -201,7 +201,7 @@ class VtuWriter final : public FrameWriter {
 }  // namespace
 
 Result<std::unique_ptr<FrameWriter>> open_vtu_writer(const std::string& dir) {
-  if (Status s = output::create_directory(dir); !s) return s;
+  if (Status s = create_output_directory(dir); !s) return s;
   auto writer = std::make_unique<VtuWriter>(dir);
   // An empty collection at once: a bad directory fails here, before any step runs.
   if (Status s = writer->write_collection(); !s) return s;

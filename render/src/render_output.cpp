@@ -6,27 +6,10 @@
 #include <system_error>
 #include <utility>
 
+#include "motes/output.h"
 #include "motes/render_output.h"
 
 namespace motes::render {
-
-namespace {
-
-Status create_directory(const std::string& dir) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::is_directory(dir, ec)) return Status::ok();
-  fs::create_directories(dir, ec);
-  if (ec) {
-    return Status::error(fmt::format("cannot create render directory '{}': {}", dir, ec.message()));
-  }
-  if (!fs::is_directory(dir, ec)) {
-    return Status::error(fmt::format("cannot create render directory '{}': not a directory", dir));
-  }
-  return Status::ok();
-}
-
-}  // namespace
 
 RenderOutput::RenderOutput(RenderSettings settings, OutputOptions options)
     : renderer_(std::move(settings)), options_(std::move(options)) {}
@@ -35,7 +18,7 @@ RenderOutput::~RenderOutput() { (void)finish(); }
 
 Result<std::unique_ptr<RenderOutput>> RenderOutput::open(RenderSettings settings,
                                                          OutputOptions options) {
-  if (Status s = create_directory(options.dir); !s) return s;
+  if (Status s = create_output_directory(options.dir, "render"); !s) return s;
   const Size size = settings.size;
   auto out = std::unique_ptr<RenderOutput>(new RenderOutput(std::move(settings), options));
   if (!options.video) {

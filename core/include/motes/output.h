@@ -68,4 +68,8 @@ Status write_points_csv(const std::string& path, const std::vector<Eigen::Vector
 /// for writing a particle set with write_vtu_file.
 Snapshot particle_set_snapshot(const std::vector<Eigen::Vector3f>& points, double diameter);
 
+/// Creates `dir` and its parents if missing; an error naming it as the `purpose` directory
+/// ("output", "render") if it cannot, or if it is not a directory.
+Status create_output_directory(const std::string& dir, const std::string& purpose = "output");
+
 }  // namespace motes
