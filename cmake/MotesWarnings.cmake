@@ -13,6 +13,15 @@ function(motes_target_warnings target)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
                                              -fno-sanitize-recover=all -Wno-maybe-uninitialized)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+    # Executables keep every shared library loaded until exit, so that LeakSanitizer can name the
+    # library of an allocation (tests/sanitizers/keep_libraries_loaded.cpp says why). The symbol
+    # must be in the dynamic table: the Vulkan loader, which calls dlclose, is itself dlopen'ed.
+    get_target_property(type ${target} TYPE)
+    if(type STREQUAL "EXECUTABLE")
+      target_sources(${target} PRIVATE
+                     ${PROJECT_SOURCE_DIR}/tests/sanitizers/keep_libraries_loaded.cpp)
+      target_link_options(${target} PRIVATE LINKER:--export-dynamic-symbol=dlclose)
+    endif()
   endif()
   if(MOTES_STRICT_FP)
     target_compile_options(${target} PRIVATE $<$<COMPILE_LANGUAGE:CXX>:-ffp-contract=off>)
