@@ -1,8 +1,9 @@
 // The sanitizer stage's proof that leak checking still bites (ctest Sanitizers.LeakCanary, only in
 // MOTES_SANITIZE builds): it runs the default scene on each backend named on its command line
-// (vulkan, i.e. lavapipe in CI, and openmp), tears everything down properly, and then leaks one 48-byte block from planted_leak(). The test
-// passes only when LeakSanitizer reports exactly that block, named by its function, and nothing
-// else: the Vulkan driver's memory is not reported, and a leak in motes's code is.
+// (vulkan, i.e. lavapipe in CI, and openmp), tears everything down properly, and then leaks one
+// 48-byte block from planted_leak(). The test passes only when LeakSanitizer reports exactly that
+// block, named by its function, and nothing else: the Vulkan driver's memory is not reported, and a
+// leak in motes's code is.
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -17,7 +18,7 @@ bool run_default_scene(const char* backend) {
   auto device = motes::open_device(backend);
   if (!scene || !device) {
     std::fprintf(stderr, "leak canary: %s unavailable: %s\n", backend,
-                device ? scene.message().c_str() : device.message().c_str());
+                 device ? scene.message().c_str() : device.message().c_str());
     return false;
   }
   auto sim = motes::Simulation::create(scene.value(), std::move(device).value());
