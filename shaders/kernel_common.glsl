@@ -37,11 +37,16 @@ layout(std430, binding = B_SORTED_POS) buffer SortedPosBuf { vec4 sorted_pos[]; 
 layout(std430, binding = B_SORTED_VEL) buffer SortedVelBuf { vec4 sorted_vel[]; };
 layout(std430, binding = B_SORTED_BODY) buffer SortedBodyBuf { uint sorted_body[]; };
 layout(std430, binding = B_SORTED_MATERIAL) buffer SortedMaterialBuf { uint sorted_material[]; };
+layout(std430, binding = B_NEIGHBOUR_LIST) buffer NeighbourListBuf { uint neighbour_list[]; };
+layout(std430, binding = B_NEIGHBOUR_COUNT) buffer NeighbourCountBuf { uint neighbour_count[]; };
+layout(std430, binding = B_NEIGHBOUR_REF_POS) buffer NeighbourRefPosBuf { vec4 neighbour_ref_pos[]; };
+layout(std430, binding = B_NEIGHBOUR_STATE) buffer NeighbourStateBuf { uint neighbour_state[]; };
 layout(std430, binding = B_CONTACT_LAWS) readonly buffer ContactLawsBuf { ContactLaw contact_laws[]; };
 layout(std430, binding = B_PLANES) readonly buffer PlanesBuf { PlaneData planes[]; };
 layout(std430, binding = B_GRID_ARRIVAL) buffer GridArrivalBuf { uint grid_arrival[]; };
 layout(std430, binding = B_GRID_UNSORTED) buffer GridUnsortedBuf { uint grid_unsorted[]; };
 layout(std430, binding = B_SCAN_SCRATCH) buffer ScanScratchBuf { uint scan_scratch[]; };
+layout(std430, binding = B_INDIRECT_ARGS) buffer IndirectArgsBuf { uint indirect_args[]; };
 
 // Workgroups beyond 65,535 are dispatched as a 2D grid (x, y); this is the flat index.
 uint flat_group() { return gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x; }

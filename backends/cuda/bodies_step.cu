@@ -12,12 +12,17 @@ namespace {
 
 __global__ void bodies_step_kernel(shared::StepParams p, BodyBuffers d) {
   const std::uint64_t t = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
-  if (t >= p.body_count) return;
-  const auto b = static_cast<shared::uint>(t);
-  body_reduce(d, b);
-  body_step(d, b, p.gravity_dt);
-  const shared::uint end = d.first[b + 1];
-  for (shared::uint i = d.first[b]; i < end; ++i) particle_update(d, i, b);
+  bool moved = false;
+  if (t < p.body_count) {
+    const auto b = static_cast<shared::uint>(t);
+    body_reduce(d, b);
+    body_step(d, b, p.gravity_dt);
+    const shared::uint end = d.first[b + 1];
+    for (shared::uint i = d.first[b]; i < end; ++i) {
+      moved = particle_update(d, i, b, p.neighbour_skin) || moved;
+    }
+  }
+  ask_rebuild_if(d, moved);
 }
 
 }  // namespace

@@ -21,6 +21,8 @@ struct BodyBuffers {
   const shared::vec4* __restrict__ inv_inertia;
   shared::vec4* body_force;
   shared::vec4* body_torque;
+  const shared::vec4* __restrict__ ref;  // NeighbourRefPos
+  shared::uint* state;                   // NeighbourState
 };
 
 }  // namespace motes::cuda

@@ -91,10 +91,14 @@ Result<std::unique_ptr<Device>> CudaDevice::open(int ordinal) {
     return s;
   }
   d->info_ = describe(ordinal, prop);
-  if (Status s = d->check(cudaStreamCreateWithFlags(&d->stream_, cudaStreamNonBlocking),
-                          "cudaStreamCreate");
-      !s) {
-    return s;
+  const char* host_rebuild = std::getenv("MOTES_CUDA_HOST_REBUILD");
+  d->host_rebuild_ = host_rebuild != nullptr && std::strcmp(host_rebuild, "1") == 0;
+  for (cudaStream_t* stream : {&d->stream_, &d->body_stream_}) {
+    if (Status s =
+            d->check(cudaStreamCreateWithFlags(stream, cudaStreamNonBlocking), "cudaStreamCreate");
+        !s) {
+      return s;
+    }
   }
   std::unique_ptr<Device> out = std::move(d);
   return out;
@@ -107,6 +111,7 @@ CudaDevice::~CudaDevice() {
   release_buffers();
   for (cudaEvent_t e : events_) cudaEventDestroy(e);
   if (stream_ != nullptr) cudaStreamDestroy(stream_);
+  if (body_stream_ != nullptr) cudaStreamDestroy(body_stream_);
 }
 
 Status CudaDevice::check(cudaError_t e, const char* what) {
@@ -132,6 +137,30 @@ void CudaDevice::release_buffers() {
   sort_temp_ = nullptr;
   sort_temp_bytes_ = 0;
   allocated_ = false;
+}
+
+std::uint64_t CudaDevice::required_bytes(const Sizes& sizes) const {
+  // Every buffer and its guard bytes, the sort's ids and keys, and CUB's temporary storage (about
+  // the keys and values again, plus its histograms).
+  const std::uint64_t n = sizes.particles;
+  return buffers_bytes(sizes) + kBufferCount * (kGuardBytes + 256) + n * 8 + n * 8 + (8u << 20);
+}
+
+std::uint64_t CudaDevice::available_bytes() const {
+  std::size_t free_bytes = 0;
+  std::size_t total_bytes = 0;
+  if (cudaSetDevice(ordinal_) != cudaSuccess ||
+      cudaMemGetInfo(&free_bytes, &total_bytes) != cudaSuccess) {
+    cudaGetLastError();
+    return UINT64_MAX;  // unknown: let the allocation itself decide
+  }
+  // What this device already holds is given back before allocate() allocates again.
+  std::uint64_t held = 0;
+  if (allocated_) {
+    for (std::size_t b : bytes_) held += b + kGuardBytes;
+    held += sort_temp_bytes_ + 2 * std::uint64_t{sizes_.particles} * sizeof(shared::uint);
+  }
+  return free_bytes + held;
 }
 
 Status CudaDevice::allocate(const Sizes& sizes) {
@@ -203,13 +232,14 @@ Status CudaDevice::allocate(const Sizes& sizes) {
 }
 
 BodyBuffers CudaDevice::body_buffers() const {
-  return {buf<shared::uint>(Buffer::BodyFirst),     buf<shared::uint>(Buffer::ParticleBody),
-          buf<shared::vec4>(Buffer::ParticleLocal), buf<shared::vec4>(Buffer::ParticleForce),
-          buf<shared::vec4>(Buffer::ParticlePos),   buf<shared::vec4>(Buffer::ParticleVel),
-          buf<shared::vec4>(Buffer::BodyPos),       buf<shared::vec4>(Buffer::BodyQuat),
-          buf<shared::vec4>(Buffer::BodyVel),       buf<shared::vec4>(Buffer::BodyAngMom),
-          buf<shared::vec4>(Buffer::BodyAngVel),    buf<shared::vec4>(Buffer::BodyInvInertia),
-          buf<shared::vec4>(Buffer::BodyForce),     buf<shared::vec4>(Buffer::BodyTorque)};
+  return {buf<shared::uint>(Buffer::BodyFirst),       buf<shared::uint>(Buffer::ParticleBody),
+          buf<shared::vec4>(Buffer::ParticleLocal),   buf<shared::vec4>(Buffer::ParticleForce),
+          buf<shared::vec4>(Buffer::ParticlePos),     buf<shared::vec4>(Buffer::ParticleVel),
+          buf<shared::vec4>(Buffer::BodyPos),         buf<shared::vec4>(Buffer::BodyQuat),
+          buf<shared::vec4>(Buffer::BodyVel),         buf<shared::vec4>(Buffer::BodyAngMom),
+          buf<shared::vec4>(Buffer::BodyAngVel),      buf<shared::vec4>(Buffer::BodyInvInertia),
+          buf<shared::vec4>(Buffer::BodyForce),       buf<shared::vec4>(Buffer::BodyTorque),
+          buf<shared::vec4>(Buffer::NeighbourRefPos), buf<shared::uint>(Buffer::NeighbourState)};
 }
 
 void CudaDevice::update_fusable() {
@@ -220,10 +250,10 @@ void CudaDevice::update_fusable() {
   bodies_fusable_ = false;
   const std::size_t bodies = sizes_.bodies;
   if (host_first_.size() != bodies + 1 || host_body_.size() != sizes_.particles) return;
-  if (host_first_[0] != 0 || host_first_[bodies] != sizes_.particles) return;
+  if (host_first_[0] != 0 || host_first_[bodies] != sizes_.rigid_particles) return;
   for (std::size_t b = 0; b < bodies; ++b) {
     const shared::uint lo = host_first_[b], hi = host_first_[b + 1];
-    if (hi < lo || hi - lo > kFusedBodyParticles || hi > sizes_.particles) return;
+    if (hi < lo || hi - lo > kFusedBodyParticles || hi > sizes_.rigid_particles) return;
     for (shared::uint i = lo; i < hi; ++i) {
       if (host_body_[i] != b) return;
     }

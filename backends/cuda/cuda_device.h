@@ -31,11 +31,19 @@ class CudaDevice final : public Device {
   ~CudaDevice() override;
 
   [[nodiscard]] const DeviceInfo& info() const override { return info_; }
+  [[nodiscard]] std::uint64_t required_bytes(const Sizes& sizes) const override;
+  [[nodiscard]] std::uint64_t available_bytes() const override;
   Status allocate(const Sizes& sizes) override;
   Status write(Buffer b, const void* src, std::size_t bytes) override;
   Status read(Buffer b, void* dst, std::size_t bytes) override;
 
+  void neighbours_update(const shared::StepParams& p) override {
+    enqueue(Kernel::NeighboursUpdate, p);
+  }
   void grid_build(const shared::StepParams& p) override { enqueue(Kernel::GridBuild, p); }
+  void neighbours_build(const shared::StepParams& p) override {
+    enqueue(Kernel::NeighboursBuild, p);
+  }
   void contacts_compute(const shared::StepParams& p) override {
     enqueue(Kernel::ContactsCompute, p);
   }
@@ -45,6 +53,9 @@ class CudaDevice final : public Device {
   }
   void particles_update(const shared::StepParams& p) override {
     enqueue(Kernel::ParticlesUpdate, p);
+  }
+  void particles_integrate(const shared::StepParams& p) override {
+    enqueue(Kernel::ParticlesIntegrate, p);
   }
 
   Status synchronize() override;
@@ -76,14 +87,21 @@ class CudaDevice final : public Device {
   /// Runs every queued call: captured graphs when timing is off, timed launches when on.
   Status flush();
   Status run_timed(const std::vector<KernelCall>& calls);
+  /// Launches `calls` (none a NeighboursUpdate) one by one between events and adds their times.
+  Status time_calls(const std::vector<KernelCall>& calls);
   Status run_graphs(const std::vector<KernelCall>& cycle, std::size_t reps);
   Result<cudaGraphExec_t> graph_for(const std::vector<KernelCall>& cycle, std::size_t copies);
   /// Launches calls[i] (and, when `fuse` and they allow it, fuses it with the calls after it);
-  /// returns how many calls it consumed.
+  /// returns how many calls it consumed. A NeighboursUpdate is only launched while a graph is
+  /// captured: a kernel sets the condition of an IF node that holds the rebuild.
   std::size_t launch(const std::vector<KernelCall>& calls, std::size_t i, bool fuse = true);
 
   // One file per kernel family launches it on stream_ (grid_build.cu, contacts_compute.cu...).
+  void launch_neighbours_update(const shared::StepParams& p);
+  void launch_neighbours_decide(cudaGraphConditionalHandle handle);
   void launch_grid_build(const shared::StepParams& p);
+  void launch_neighbours_build(const shared::StepParams& p);
+  void launch_particles_integrate(const shared::StepParams& p);
   void launch_contacts_compute(const shared::StepParams& p);
   void launch_bodies_reduce(const shared::StepParams& p);
   void launch_bodies_integrate(const shared::StepParams& p);
@@ -100,7 +118,9 @@ class CudaDevice final : public Device {
 
   DeviceInfo info_;
   int ordinal_ = 0;
-  cudaStream_t stream_ = nullptr;
+  cudaStream_t stream_ = nullptr;  ///< every launch goes here
+  /// A second stream, swapped into stream_ while the body of a conditional rebuild is captured.
+  cudaStream_t body_stream_ = nullptr;
   Sizes sizes_;
   bool allocated_ = false;
   std::array<void*, kBufferCount> buffers_{};
@@ -119,6 +139,7 @@ class CudaDevice final : public Device {
 
   std::vector<KernelCall> pending_;
   std::vector<Graph> graphs_;
+  bool host_rebuild_ = false;  ///< MOTES_CUDA_HOST_REBUILD=1: calls launched one by one
   std::vector<cudaEvent_t> events_;
   Status error_;
   bool timing_ = false;

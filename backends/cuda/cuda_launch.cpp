@@ -1,8 +1,9 @@
 // Queueing, graphs and timing. Kernel calls are queued; flush() finds the shortest cycle the queue
-// repeats (a step: the five families, once per substep), captures it once into a CUDA graph (and
+// repeats (a step: its kernel families, once per substep), captures it once into a CUDA graph (and
 // a graph of kGraphCycles repetitions of it), caches both, and launches them as many times as the
-// cycle repeats: no host synchronization or allocation per step. Timing launches the calls one by
-// one between CUDA events instead.
+// cycle repeats: no host synchronization or allocation per step. The neighbour-list rebuild sits
+// in an IF node of the graph whose condition a kernel sets from NeighbourState. Timing launches
+// the calls one by one between CUDA events instead, deciding the rebuild on the host.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -32,13 +33,17 @@ void CudaDevice::enqueue(Kernel k, const shared::StepParams& p) {
   // Every kernel indexes its buffers by these counts: refuse any the allocation cannot hold.
   if (p.particle_count > sizes_.particles || p.body_count > sizes_.bodies ||
       std::uint64_t{p.table_mask} + 1 > sizes_.table || p.plane_count > sizes_.planes ||
-      p.material_count > sizes_.materials) {
+      p.material_count > sizes_.materials || p.rigid_particle_count > sizes_.rigid_particles ||
+      p.rigid_particle_count > p.particle_count ||
+      p.neighbour_capacity > sizes_.neighbour_capacity) {
     error_ = Status::error(fmt::format(
-        "cuda: {} launched with {} particles, {} bodies, {} buckets, {} planes and {} materials "
-        "on buffers allocated for {}, {}, {}, {} and {}",
-        kernel_name(k), p.particle_count, p.body_count, std::uint64_t{p.table_mask} + 1,
-        p.plane_count, p.material_count, sizes_.particles, sizes_.bodies, sizes_.table,
-        sizes_.planes, sizes_.materials));
+        "cuda: {} launched with {} particles ({} rigid), {} bodies, {} buckets, {} planes, {} "
+        "materials and {} list entries per particle on buffers allocated for {} ({}), {}, {}, "
+        "{}, {} and {}",
+        kernel_name(k), p.particle_count, p.rigid_particle_count, p.body_count,
+        std::uint64_t{p.table_mask} + 1, p.plane_count, p.material_count, p.neighbour_capacity,
+        sizes_.particles, sizes_.rigid_particles, sizes_.bodies, sizes_.table, sizes_.planes,
+        sizes_.materials, sizes_.neighbour_capacity));
     return;
   }
   pending_.push_back({k, p});
@@ -47,15 +52,21 @@ void CudaDevice::enqueue(Kernel k, const shared::StepParams& p) {
 std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t i, bool fuse) {
   const shared::StepParams& p = calls[i].params;
   switch (calls[i].kernel) {
+    case Kernel::NeighboursUpdate:
+      launch_neighbours_update(p);
+      return 1;
     case Kernel::GridBuild:
       launch_grid_build(p);
+      return 1;
+    case Kernel::NeighboursBuild:
+      launch_neighbours_build(p);
       return 1;
     case Kernel::ContactsCompute:
       launch_contacts_compute(p);
       return 1;
     case Kernel::BodiesReduce:
       if (fuse && bodies_fusable_ && p.body_count == sizes_.bodies &&
-          p.particle_count == sizes_.particles && i + 2 < calls.size() &&
+          p.rigid_particle_count == sizes_.rigid_particles && i + 2 < calls.size() &&
           same_call(calls[i + 1], {Kernel::BodiesIntegrate, p}) &&
           same_call(calls[i + 2], {Kernel::ParticlesUpdate, p})) {
         launch_bodies_step(p);
@@ -69,10 +80,73 @@ std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t
     case Kernel::ParticlesUpdate:
       launch_particles_update(p);
       return 1;
+    case Kernel::ParticlesIntegrate:
+      launch_particles_integrate(p);
+      return 1;
     case Kernel::Count:
       break;
   }
   return 1;
+}
+
+void CudaDevice::launch_neighbours_update(const shared::StepParams& p) {
+  // Only ever called while stream_ is being captured (flush: graphs; run_timed decides on the
+  // host). A kernel sets the condition of an IF node from NeighbourState; the node's body, captured
+  // on a second stream, is grid_build then neighbours_build.
+  cudaStreamCaptureStatus status = cudaStreamCaptureStatusNone;
+  cudaGraph_t graph = nullptr;
+  const cudaGraphNode_t* deps = nullptr;
+  const cudaGraphEdgeData* edges = nullptr;
+  std::size_t dep_count = 0;
+  if (!check(cudaStreamGetCaptureInfo(stream_, &status, nullptr, &graph),
+             "cudaStreamGetCaptureInfo")) {
+    return;
+  }
+  if (status != cudaStreamCaptureStatusActive) {
+    check(cudaErrorStreamCaptureUnsupported, "neighbours_update outside a graph capture");
+    return;
+  }
+  cudaGraphConditionalHandle handle{};
+  if (!check(cudaGraphConditionalHandleCreate(&handle, graph, 0, 0),
+             "cudaGraphConditionalHandleCreate")) {
+    return;
+  }
+  launch_neighbours_decide(handle);
+  if (!check(cudaStreamGetCaptureInfo(stream_, &status, nullptr, &graph, &deps, &edges, &dep_count),
+             "cudaStreamGetCaptureInfo")) {
+    return;
+  }
+  cudaGraphNodeParams params{};
+  params.type = cudaGraphNodeTypeConditional;
+  params.conditional.handle = handle;
+  params.conditional.type = cudaGraphCondTypeIf;
+  params.conditional.size = 1;
+  cudaGraphNode_t node = nullptr;
+  if (!check(cudaGraphAddNode(&node, graph, deps, edges, dep_count, &params),
+             "cudaGraphAddNode (conditional)")) {
+    return;
+  }
+  if (!check(cudaStreamUpdateCaptureDependencies(stream_, &node, nullptr, 1,
+                                                 cudaStreamSetCaptureDependencies),
+             "cudaStreamUpdateCaptureDependencies")) {
+    return;
+  }
+  cudaGraph_t body = params.conditional.phGraph_out[0];
+  if (!check(cudaStreamBeginCaptureToGraph(body_stream_, body, nullptr, nullptr, 0,
+                                           cudaStreamCaptureModeThreadLocal),
+             "cudaStreamBeginCaptureToGraph")) {
+    return;
+  }
+  std::swap(stream_, body_stream_);  // the launches below go to the body's stream
+  launch_grid_build(p);
+  launch_neighbours_build(p);
+  std::swap(stream_, body_stream_);
+  const cudaError_t launched = cudaGetLastError();
+  cudaGraph_t captured = nullptr;
+  const cudaError_t ended = cudaStreamEndCapture(body_stream_, &captured);
+  if (check(launched, "a kernel launch in the conditional rebuild")) {
+    check(ended, "cudaStreamEndCapture (conditional rebuild)");
+  }
 }
 
 void CudaDevice::release_graphs() {
@@ -131,6 +205,34 @@ Status CudaDevice::run_graphs(const std::vector<KernelCall>& cycle, std::size_t 
 }
 
 Status CudaDevice::run_timed(const std::vector<KernelCall>& calls) {
+  // A NeighboursUpdate is decided on the host: the calls before it run, NeighbourState is read,
+  // and grid_build and neighbours_build are timed as themselves when a rebuild is due.
+  std::vector<KernelCall> batch;
+  for (const KernelCall& call : calls) {
+    if (call.kernel != Kernel::NeighboursUpdate) {
+      batch.push_back(call);
+      continue;
+    }
+    if (Status s = time_calls(batch); !s) return s;
+    batch.clear();
+    shared::uint rebuild = 0;
+    if (Status s = check(cudaMemcpyAsync(&rebuild, buf<shared::uint>(Buffer::NeighbourState),
+                                         sizeof rebuild, cudaMemcpyDeviceToHost, stream_),
+                         "reading NeighbourState");
+        !s) {
+      return s;
+    }
+    if (Status s = check(cudaStreamSynchronize(stream_), "reading NeighbourState"); !s) return s;
+    times_.launches[static_cast<std::size_t>(Kernel::NeighboursUpdate)] += 1;
+    if (rebuild != 0) {
+      batch.push_back({Kernel::GridBuild, call.params});
+      batch.push_back({Kernel::NeighboursBuild, call.params});
+    }
+  }
+  return time_calls(batch);
+}
+
+Status CudaDevice::time_calls(const std::vector<KernelCall>& calls) {
   if (events_.size() < 2 * kTimedBatch) {
     events_.reserve(2 * kTimedBatch);
     while (events_.size() < 2 * kTimedBatch) {
@@ -176,7 +278,9 @@ Status CudaDevice::flush() {
   std::vector<KernelCall> calls;
   calls.swap(pending_);
   cudaSetDevice(ordinal_);
-  if (timing_) return run_timed(calls);
+  // MOTES_CUDA_HOST_REBUILD=1: no graphs, the rebuild decided on the host (as with timing on),
+  // for tools that cannot follow conditional graph nodes (compute-sanitizer: gpu/run-suite.sh).
+  if (timing_ || host_rebuild_) return run_timed(calls);
   const std::size_t period = repeating_period(calls);
   const std::vector<KernelCall> cycle(calls.begin(),
                                       calls.begin() + static_cast<std::ptrdiff_t>(period));

@@ -76,6 +76,25 @@ OpenMPDevice::OpenMPDevice(int threads, int min_parallel)
   info_ = describe(threads_);
 }
 
+std::uint64_t OpenMPDevice::required_bytes(const Sizes& sizes) const {
+  // Every buffer with its padding, and the radix sort's keys, ids and per-thread histograms.
+  return buffers_bytes(sizes) + kBufferCount * AlignedBuffer::kPadding +
+         std::uint64_t{sizes.particles} * 3 * sizeof(std::uint32_t) +
+         static_cast<std::uint64_t>(threads_) * 2048 * sizeof(std::uint32_t);
+}
+
+std::uint64_t OpenMPDevice::available_bytes() const {
+  // MemAvailable of /proc/meminfo: what the kernel can give without swapping.
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  std::uint64_t kib = 0;
+  std::string unit;
+  while (in >> key >> kib >> unit) {
+    if (key == "MemAvailable:") return kib * 1024;
+  }
+  return UINT64_MAX;  // unknown: let the allocation itself decide
+}
+
 Status OpenMPDevice::allocate(const Sizes& sizes) {
   if (sizes.table < 64 || (sizes.table & (sizes.table - 1)) != 0) {
     return Status::error(

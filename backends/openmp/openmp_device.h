@@ -44,15 +44,20 @@ class OpenMPDevice final : public Device {
   static constexpr int kDefaultMinParallel = 2048;
 
   [[nodiscard]] const DeviceInfo& info() const override { return info_; }
+  [[nodiscard]] std::uint64_t required_bytes(const Sizes& sizes) const override;
+  [[nodiscard]] std::uint64_t available_bytes() const override;
   Status allocate(const Sizes& sizes) override;
   Status write(Buffer b, const void* src, std::size_t bytes) override;
   Status read(Buffer b, void* dst, std::size_t bytes) override;
 
+  void neighbours_update(const shared::StepParams& p) override;
   void grid_build(const shared::StepParams& p) override;
+  void neighbours_build(const shared::StepParams& p) override;
   void contacts_compute(const shared::StepParams& p) override;
   void bodies_reduce(const shared::StepParams& p) override;
   void bodies_integrate(const shared::StepParams& p) override;
   void particles_update(const shared::StepParams& p) override;
+  void particles_integrate(const shared::StepParams& p) override;
 
   Status synchronize() override { return Status::ok(); }
   Status check_guards() override;

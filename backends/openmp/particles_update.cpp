@@ -1,9 +1,11 @@
-// particles_update: particle positions and velocities follow their body's pose.
+// particles_update: the rigid particles' positions and velocities follow their body's pose; a
+// neighbour-list rebuild is asked for when one has moved too far since the last build.
 #include <chrono>
 #include <cstdint>
 
 #include "openmp_device.h"
 #include "shared/body_math.h"
+#include "shared/neighbours.h"
 
 namespace motes::openmp {
 
@@ -12,7 +14,8 @@ using shared::vec4;
 
 void OpenMPDevice::particles_update(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
-  const auto n = static_cast<std::int64_t>(p.particle_count);
+  const auto n = static_cast<std::int64_t>(p.rigid_particle_count);
+  const vec4* ref = buf<vec4>(Buffer::NeighbourRefPos);
   const uint* body = buf<uint>(Buffer::ParticleBody);
   const vec4* local = buf<vec4>(Buffer::ParticleLocal);
   const vec4* body_pos = buf<vec4>(Buffer::BodyPos);
@@ -22,12 +25,18 @@ void OpenMPDevice::particles_update(const shared::StepParams& p) {
   vec4* pos = buf<vec4>(Buffer::ParticlePos);
   vec4* vel = buf<vec4>(Buffer::ParticleVel);
 
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
+  uint moved = 0;
+
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n)) \
+    reduction(|                                                                  \
+              : moved)
   for (std::int64_t i = 0; i < n; ++i) {
     const uint b = body[i];
     pos[i] = vec4(shared::particle_position(body_pos[b], quat[b], local[i]), pos[i].w);
     vel[i] = vec4(shared::particle_velocity(quat[b], body_vel[b], angvel[b], local[i]), vel[i].w);
+    moved |= shared::neighbour_moved_too_far(pos[i], ref[i], p.neighbour_skin) ? 1u : 0u;
   }
+  if (moved != 0) buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_REBUILD] = 1;
   record(Kernel::ParticlesUpdate, start);
 }
 

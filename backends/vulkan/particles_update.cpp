@@ -4,7 +4,7 @@
 namespace motes::vulkan {
 
 void VulkanDevice::record_particles_update(VkCommandBuffer cb, const shared::StepParams& p) const {
-  dispatch(cb, Pipeline::ParticlesUpdate, p, p.particle_count);
+  dispatch(cb, Pipeline::ParticlesUpdate, p, p.rigid_particle_count);
 }
 
 }  // namespace motes::vulkan

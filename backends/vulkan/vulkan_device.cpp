@@ -22,15 +22,19 @@ static_assert(B_BODY_FIRST == static_cast<int>(Buffer::BodyFirst));
 static_assert(B_GRID_BUCKET == static_cast<int>(Buffer::GridBucket));
 static_assert(B_GRID_CELL_START == static_cast<int>(Buffer::GridCellStart));
 static_assert(B_SORTED_MATERIAL == static_cast<int>(Buffer::SortedMaterial));
+static_assert(B_NEIGHBOUR_LIST == static_cast<int>(Buffer::NeighbourList));
+static_assert(B_NEIGHBOUR_STATE == static_cast<int>(Buffer::NeighbourState));
+static_assert(B_CONTACT_LAWS == static_cast<int>(Buffer::ContactLaws));
 static_assert(B_PLANES == static_cast<int>(Buffer::Planes));
 static_assert(B_GRID_ARRIVAL == static_cast<int>(Buffer::Count));
 
 namespace {
 
 constexpr const char* kPipelineShaders[kPipelineCount] = {
-    "grid_build_count",   "grid_build_scan_block", "grid_build_scan_add",
-    "grid_build_scatter", "grid_build_place",      "contacts_compute",
-    "bodies_reduce",      "bodies_integrate",      "particles_update"};
+    "neighbours_decide",   "grid_build_clear",   "grid_build_count", "grid_build_scan_block",
+    "grid_build_scan_add", "grid_build_scatter", "grid_build_place", "neighbours_begin",
+    "neighbours_build",    "contacts_compute",   "bodies_reduce",    "bodies_integrate",
+    "particles_update",    "particles_integrate"};
 
 const char* binding_name(std::uint32_t binding) {
   if (binding < kBufferCount) return buffer_name(static_cast<Buffer>(binding));
@@ -41,6 +45,8 @@ const char* binding_name(std::uint32_t binding) {
       return "GridUnsorted (scratch)";
     case B_SCAN_SCRATCH:
       return "ScanScratch (scratch)";
+    case B_INDIRECT_ARGS:
+      return "IndirectArgs (scratch)";
     default:
       return "?";
   }
@@ -240,7 +246,9 @@ Status VulkanDevice::create_buffer(GpuBuffer& out, VkDeviceSize data_bytes, bool
   info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
   info.size = padded(data_bytes) + kGuardBytes;
   info.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  if (!host_visible) info.usage |= VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  if (!host_visible) {
+    info.usage |= VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
+  }
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   if (info.size > physical_.max_allocation && physical_.max_allocation != 0) {
     return Status::error(fmt::format(
@@ -348,12 +356,27 @@ Status VulkanDevice::allocate(const Sizes& sizes) {
   }
   const std::uint32_t scratch_words = next;
 
+  // The passes of a conditional rebuild, for the allocated sizes: their indirect arguments.
+  shared::StepParams whole{};
+  whole.particle_count = sizes.particles;
+  whole.table_mask = sizes.table - 1;
+  std::vector<Pass> rebuild = grid_build_passes(whole);
+  for (const Pass& pass : neighbours_build_passes(whole)) rebuild.push_back(pass);
+  rebuild_passes_ = static_cast<std::uint32_t>(rebuild.size());
+  std::vector<std::uint32_t> rebuild_args;  // the template: (x, y, z, 0) per pass
+  for (const Pass& pass : rebuild) {
+    const std::array<std::uint32_t, 3> grid = group_grid(pass.groups);
+    rebuild_args.insert(rebuild_args.end(), {grid[0], grid[1], grid[2], 0u});
+  }
+
   for (std::uint32_t i = 0; i < kBindingCount; ++i) {
     VkDeviceSize bytes = 0;
     if (i < kBufferCount) {
       bytes = buffer_layout(static_cast<Buffer>(i), sizes).bytes();
     } else if (i == B_SCAN_SCRATCH) {
       bytes = VkDeviceSize{scratch_words} * 4;
+    } else if (i == B_INDIRECT_ARGS) {
+      bytes = VkDeviceSize{rebuild_passes_} * 2 * 16;
     } else {
       bytes = VkDeviceSize{sizes.particles} * 4;
     }
@@ -384,13 +407,38 @@ Status VulkanDevice::allocate(const Sizes& sizes) {
   }
   vkUpdateDescriptorSets(device_, kBindingCount, writes.data(), 0, nullptr);
 
-  // Zero every buffer and write the guard words after it.
+  // Zero every buffer and write the guard words after it; then the rebuild's template.
+  const VkDeviceSize template_bytes = rebuild_args.size() * 4;
+  if (Status s = ensure_staging(template_bytes); !s) return s;
+  std::memcpy(staging_.mapped, rebuild_args.data(), template_bytes);
   return run_once([&](VkCommandBuffer cb) {
     for (const GpuBuffer& b : buffers_) {
       vkCmdFillBuffer(cb, b.buffer, 0, padded(b.data_bytes), 0);
       vkCmdFillBuffer(cb, b.buffer, padded(b.data_bytes), kGuardBytes, kGuardWord);
     }
+    barrier(cb, Sync::All);
+    const VkBufferCopy region{0, template_bytes, template_bytes};
+    vkCmdCopyBuffer(cb, staging_.buffer, buffer(B_INDIRECT_ARGS), 1, &region);
   });
+}
+
+std::uint64_t VulkanDevice::required_bytes(const Sizes& sizes) const {
+  // Every motes buffer, the grid build's scratch (2 N words, the scan's block sums), the rebuild's
+  // indirect arguments, guard words and alignment.
+  const std::uint64_t scan = (std::uint64_t{sizes.table} + 1) / (SCAN_BLOCK - 1) + 64;
+  return buffers_bytes(sizes) + std::uint64_t{sizes.particles} * 8 + scan * 4 + 1024 +
+         kBindingCount * (kGuardBytes + 16);
+}
+
+std::uint64_t VulkanDevice::available_bytes() const {
+  // The largest device-local heap (the driver may keep a little of it for itself).
+  std::uint64_t largest = 0;
+  for (std::uint32_t h = 0; h < memory_.memoryHeapCount; ++h) {
+    if ((memory_.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) != 0) {
+      largest = std::max<std::uint64_t>(largest, memory_.memoryHeaps[h].size);
+    }
+  }
+  return largest == 0 ? UINT64_MAX : largest;
 }
 
 Status VulkanDevice::write(Buffer b, const void* src, std::size_t bytes) {
@@ -475,7 +523,13 @@ Status VulkanDevice::validation_status() {
   return Status::error(text);
 }
 
+void VulkanDevice::neighbours_update(const shared::StepParams& p) {
+  enqueue(Kernel::NeighboursUpdate, p);
+}
 void VulkanDevice::grid_build(const shared::StepParams& p) { enqueue(Kernel::GridBuild, p); }
+void VulkanDevice::neighbours_build(const shared::StepParams& p) {
+  enqueue(Kernel::NeighboursBuild, p);
+}
 void VulkanDevice::contacts_compute(const shared::StepParams& p) {
   enqueue(Kernel::ContactsCompute, p);
 }
@@ -485,6 +539,9 @@ void VulkanDevice::bodies_integrate(const shared::StepParams& p) {
 }
 void VulkanDevice::particles_update(const shared::StepParams& p) {
   enqueue(Kernel::ParticlesUpdate, p);
+}
+void VulkanDevice::particles_integrate(const shared::StepParams& p) {
+  enqueue(Kernel::ParticlesIntegrate, p);
 }
 
 Listing list_devices() {

@@ -23,15 +23,20 @@ namespace motes::vulkan {
 
 /// The compute pipelines, one per shader in shaders/*.comp.
 enum class Pipeline : std::uint32_t {
+  NeighboursDecide,
+  GridBuildClear,
   GridBuildCount,
   GridBuildScanBlock,
   GridBuildScanAdd,
   GridBuildScatter,
   GridBuildPlace,
+  NeighboursBegin,
+  NeighboursBuild,
   ContactsCompute,
   BodiesReduce,
   BodiesIntegrate,
   ParticlesUpdate,
+  ParticlesIntegrate,
   Count
 };
 constexpr std::size_t kPipelineCount = static_cast<std::size_t>(Pipeline::Count);
@@ -42,7 +47,7 @@ struct PushConstants {
   shared::StepParams params;
   std::uint32_t args[4];
 };
-static_assert(sizeof(PushConstants) == 64, "PushConstants layout");
+static_assert(sizeof(PushConstants) == 80, "PushConstants layout");
 
 class VulkanDevice final : public Device {
  public:
@@ -55,15 +60,20 @@ class VulkanDevice final : public Device {
   ~VulkanDevice() override;
 
   [[nodiscard]] const DeviceInfo& info() const override { return info_; }
+  [[nodiscard]] std::uint64_t required_bytes(const Sizes& sizes) const override;
+  [[nodiscard]] std::uint64_t available_bytes() const override;
   Status allocate(const Sizes& sizes) override;
   Status write(Buffer b, const void* src, std::size_t bytes) override;
   Status read(Buffer b, void* dst, std::size_t bytes) override;
 
+  void neighbours_update(const shared::StepParams& p) override;
   void grid_build(const shared::StepParams& p) override;
+  void neighbours_build(const shared::StepParams& p) override;
   void contacts_compute(const shared::StepParams& p) override;
   void bodies_reduce(const shared::StepParams& p) override;
   void bodies_integrate(const shared::StepParams& p) override;
   void particles_update(const shared::StepParams& p) override;
+  void particles_integrate(const shared::StepParams& p) override;
 
   Status synchronize() override;
   Status check_guards() override;
@@ -81,6 +91,12 @@ class VulkanDevice final : public Device {
     VkDeviceMemory memory = VK_NULL_HANDLE;
     VkDeviceSize data_bytes = 0;  ///< what the kernels may touch; the guard words follow
     void* mapped = nullptr;       ///< host-visible buffers only (staging)
+  };
+  /// One dispatch: a pipeline, its workgroups and the pass's own arguments.
+  struct Pass {
+    Pipeline pipeline;
+    std::uint64_t groups;
+    std::uint32_t args[4];
   };
   /// A recorded command buffer and the calls it runs.
   struct Recording {
@@ -103,8 +119,12 @@ class VulkanDevice final : public Device {
   Status flush();
   /// A new primary command buffer, begun with `usage`.
   Result<VkCommandBuffer> begin_commands(VkCommandBufferUsageFlags usage);
-  /// Records `ops` (with timestamps when `timing`) into a new primary command buffer.
-  Result<VkCommandBuffer> record(const std::vector<Op>& ops, bool timing);
+  /// Records `ops` (with timestamps when `timing`) into a new primary command buffer. With
+  /// timing, `spans` receives the kernel family of each pair of timestamps, in order.
+  Result<VkCommandBuffer> record(const std::vector<Op>& ops, bool timing,
+                                 std::vector<Kernel>* spans = nullptr);
+  /// Timestamps a timed recording of `ops` writes (NeighboursUpdate: three pairs).
+  static std::uint32_t timestamps_for(const std::vector<Op>& ops);
   Status submit_and_wait(const VkCommandBuffer* commands, std::uint32_t count);
   /// Runs a one-off command buffer filled by `fill` and waits for it.
   Status run_once(const std::function<void(VkCommandBuffer)>& fill);
@@ -113,16 +133,34 @@ class VulkanDevice final : public Device {
   void free_recordings();
 
   // Recording helpers shared by the kernel files.
-  void barrier(VkCommandBuffer cb) const;
+  /// What a barrier makes visible: compute writes to the next dispatch (between passes), also to
+  /// the indirect arguments read by the next dispatches (after neighbours_decide), or everything
+  /// to everything, transfers and the host included (where a command buffer starts and ends).
+  enum class Sync { Compute, Indirect, All };
+  void barrier(VkCommandBuffer cb, Sync sync = Sync::Compute) const;
   void dispatch(VkCommandBuffer cb, Pipeline pipeline, const shared::StepParams& p,
                 std::uint64_t threads, std::uint32_t a0 = 0, std::uint32_t a1 = 0,
                 std::uint32_t a2 = 0, std::uint32_t a3 = 0) const;
   void dispatch_groups(VkCommandBuffer cb, Pipeline pipeline, const shared::StepParams& p,
                        std::uint64_t groups, const std::uint32_t args[4]) const;
+  /// Workgroups of a dispatch as (x, y, 1): more than max_groups_x_ go as a 2D grid.
+  [[nodiscard]] std::array<std::uint32_t, 3> group_grid(std::uint64_t groups) const;
+  /// Records passes with a barrier between each two; `indirect_first` >= 0: dispatched
+  /// indirectly from B_INDIRECT_ARGS, pass k from slot indirect_first + k (a conditional rebuild).
+  void record_passes(VkCommandBuffer cb, const std::vector<Pass>& passes,
+                     const shared::StepParams& p, int indirect_first = -1) const;
+  /// The passes of grid_build and of neighbours_build for these parameters.
+  [[nodiscard]] std::vector<Pass> grid_build_passes(const shared::StepParams& p) const;
+  [[nodiscard]] std::vector<Pass> neighbours_build_passes(const shared::StepParams& p) const;
   VkBuffer buffer(std::uint32_t binding) const { return buffers_[binding].buffer; }
 
-  // One per kernel family, each in the file of the family's name.
+  // One per kernel family, each in the file of the family's name. record_neighbours_update
+  // records timestamps around its parts when `spans` is given (timing).
+  void record_neighbours_update(VkCommandBuffer cb, const shared::StepParams& p,
+                                std::vector<Kernel>* spans, std::uint32_t& query) const;
   void record_grid_build(VkCommandBuffer cb, const shared::StepParams& p) const;
+  void record_neighbours_build(VkCommandBuffer cb, const shared::StepParams& p) const;
+  void record_particles_integrate(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_contacts_compute(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_bodies_reduce(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_bodies_integrate(VkCommandBuffer cb, const shared::StepParams& p) const;
@@ -153,6 +191,9 @@ class VulkanDevice final : public Device {
     std::uint32_t in_scratch, offset, count, sums_offset;
   };
   std::vector<ScanLevel> scan_levels_;
+  /// Passes of a conditional rebuild (grid_build then neighbours_build, for the allocated sizes):
+  /// slots of B_INDIRECT_ARGS, whose template follows them.
+  std::uint32_t rebuild_passes_ = 0;
 
   /// Workgroups per dispatch dimension: 65,535 (Vulkan's guaranteed minimum), or less when
   /// MOTES_VULKAN_MAX_GROUPS_X says so (tests use it to exercise the 2D dispatch on small sizes).

@@ -30,17 +30,52 @@ void VulkanDevice::enqueue(Kernel k, const shared::StepParams& p) {
   pending_.push_back({k, p});
 }
 
-void VulkanDevice::barrier(VkCommandBuffer cb) const {
+void VulkanDevice::barrier(VkCommandBuffer cb, Sync sync) const {
   VkMemoryBarrier b{};
   b.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-  b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-  b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT |
-                    VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT |
-                    VK_ACCESS_HOST_READ_BIT;
-  const VkPipelineStageFlags stages =
-      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
-  vkCmdPipelineBarrier(cb, stages, stages | VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &b, 0, nullptr, 0,
-                       nullptr);
+  b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  VkPipelineStageFlags src = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+  VkPipelineStageFlags dst = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+  if (sync == Sync::Indirect) {
+    b.dstAccessMask |= VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
+    dst |= VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT;
+  } else if (sync == Sync::All) {
+    b.srcAccessMask |= VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask |= VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT |
+                       VK_ACCESS_HOST_READ_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
+    src |= VK_PIPELINE_STAGE_TRANSFER_BIT;
+    dst |= VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT |
+           VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT;
+  }
+  vkCmdPipelineBarrier(cb, src, dst, 0, 1, &b, 0, nullptr, 0, nullptr);
+}
+
+std::array<std::uint32_t, 3> VulkanDevice::group_grid(std::uint64_t groups) const {
+  if (groups == 0) return {0, 0, 0};
+  const std::uint64_t x = std::min<std::uint64_t>(groups, max_groups_x_);
+  const std::uint64_t y = (groups + x - 1) / x;
+  return {static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), 1};
+}
+
+void VulkanDevice::record_passes(VkCommandBuffer cb, const std::vector<Pass>& passes,
+                                 const shared::StepParams& p, int indirect_first) const {
+  for (std::size_t k = 0; k < passes.size(); ++k) {
+    const Pass& pass = passes[k];
+    if (k > 0) barrier(cb);
+    if (indirect_first < 0) {
+      dispatch_groups(cb, pass.pipeline, p, pass.groups, pass.args);
+    } else {
+      PushConstants push{};
+      push.params = p;
+      std::copy(pass.args, pass.args + 4, push.args);
+      vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE,
+                        pipelines_[static_cast<std::size_t>(pass.pipeline)]);
+      vkCmdPushConstants(cb, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+      const auto slot = static_cast<VkDeviceSize>(indirect_first) + k;
+      vkCmdDispatchIndirect(cb, buffer(B_INDIRECT_ARGS), slot * 16);
+    }
+  }
 }
 
 void VulkanDevice::dispatch_groups(VkCommandBuffer cb, Pipeline pipeline,
@@ -55,9 +90,8 @@ void VulkanDevice::dispatch_groups(VkCommandBuffer cb, Pipeline pipeline,
   vkCmdPushConstants(cb, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
   // More than 65,535 workgroups (the smallest limit Vulkan allows per dimension) go as a 2D grid;
   // shaders flatten it (kernel_common.glsl: flat_group) and skip the padding groups.
-  const std::uint64_t x = std::min<std::uint64_t>(groups, max_groups_x_);
-  const std::uint64_t y = (groups + x - 1) / x;
-  vkCmdDispatch(cb, static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), 1);
+  const std::array<std::uint32_t, 3> grid = group_grid(groups);
+  vkCmdDispatch(cb, grid[0], grid[1], grid[2]);
 }
 
 void VulkanDevice::dispatch(VkCommandBuffer cb, Pipeline pipeline, const shared::StepParams& p,
@@ -88,22 +122,39 @@ Result<VkCommandBuffer> VulkanDevice::begin_commands(VkCommandBufferUsageFlags u
   return cb;
 }
 
-Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool timing) {
+std::uint32_t VulkanDevice::timestamps_for(const std::vector<Op>& ops) {
+  std::uint32_t count = 0;
+  for (const Op& op : ops) count += op.kernel == Kernel::NeighboursUpdate ? 6 : 2;
+  return count;
+}
+
+Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool timing,
+                                             std::vector<Kernel>* spans) {
   // A replayed cycle is listed several times in one submission.
   Result<VkCommandBuffer> began = begin_commands(VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT);
   if (!began) return began;
   VkCommandBuffer cb = began.value();
-  if (timing) vkCmdResetQueryPool(cb, queries_, 0, static_cast<std::uint32_t>(2 * ops.size()));
+  if (timing) vkCmdResetQueryPool(cb, queries_, 0, timestamps_for(ops));
   vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set_, 0,
                           nullptr);
-  barrier(cb);
+  barrier(cb, Sync::All);
+  std::uint32_t q = 0;
   for (std::size_t i = 0; i < ops.size(); ++i) {
-    const auto q = static_cast<std::uint32_t>(2 * i);
-    if (timing) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, queries_, q);
     const shared::StepParams& p = ops[i].params;
+    if (ops[i].kernel == Kernel::NeighboursUpdate) {  // its own barriers and timestamps
+      record_neighbours_update(cb, p, timing ? spans : nullptr, q);
+      continue;
+    }
+    if (timing) {
+      vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, queries_, q++);
+      if (spans != nullptr) spans->push_back(ops[i].kernel);
+    }
     switch (ops[i].kernel) {
       case Kernel::GridBuild:
         record_grid_build(cb, p);
+        break;
+      case Kernel::NeighboursBuild:
+        record_neighbours_build(cb, p);
         break;
       case Kernel::ContactsCompute:
         record_contacts_compute(cb, p);
@@ -117,12 +168,17 @@ Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool ti
       case Kernel::ParticlesUpdate:
         record_particles_update(cb, p);
         break;
+      case Kernel::ParticlesIntegrate:
+        record_particles_integrate(cb, p);
+        break;
+      case Kernel::NeighboursUpdate:
       case Kernel::Count:
         break;
     }
     barrier(cb);
-    if (timing) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, queries_, q + 1);
+    if (timing) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, queries_, q++);
   }
+  barrier(cb, Sync::All);
   if (Status s = check(vkEndCommandBuffer(cb), "vkEndCommandBuffer"); !s) {
     vkFreeCommandBuffers(device_, pool_, 1, &cb);
     return s;
@@ -145,9 +201,9 @@ Status VulkanDevice::run_once(const std::function<void(VkCommandBuffer)>& fill) 
   Result<VkCommandBuffer> began = begin_commands(VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT);
   if (!began) return began.status();
   VkCommandBuffer cb = began.value();
-  barrier(cb);
+  barrier(cb, Sync::All);
   fill(cb);
-  barrier(cb);
+  barrier(cb, Sync::All);
   Status s = check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
   if (s) s = submit_and_wait(&cb, 1);
   vkFreeCommandBuffers(device_, pool_, 1, &cb);
@@ -183,7 +239,7 @@ Status VulkanDevice::flush() {
       std::vector<Op> batch;
       batch.reserve(k * period);
       for (std::size_t r = 0; r < k; ++r) batch.insert(batch.end(), cycle.begin(), cycle.end());
-      const auto queries = static_cast<std::uint32_t>(2 * batch.size());
+      const std::uint32_t queries = timestamps_for(batch);
       if (stamps && queries > query_capacity_) {
         if (queries_ != VK_NULL_HANDLE) vkDestroyQueryPool(device_, queries_, nullptr);
         VkQueryPoolCreateInfo qi{};
@@ -197,7 +253,8 @@ Status VulkanDevice::flush() {
         }
         query_capacity_ = queries;
       }
-      Result<VkCommandBuffer> cb = record(batch, stamps);
+      std::vector<Kernel> spans;
+      Result<VkCommandBuffer> cb = record(batch, stamps, &spans);
       if (!cb) return cb.status();
       Status s = submit_and_wait(&cb.value(), 1);
       if (s && stamps) {
@@ -208,9 +265,9 @@ Status VulkanDevice::flush() {
         const std::uint64_t mask = physical_.timestamp_bits >= 64
                                        ? ~std::uint64_t{0}
                                        : (std::uint64_t{1} << physical_.timestamp_bits) - 1;
-        for (std::size_t i = 0; s && i < batch.size(); ++i) {
+        for (std::size_t i = 0; s && i < spans.size(); ++i) {
           const std::uint64_t ticks = (t[2 * i + 1] - t[2 * i]) & mask;
-          const auto kernel = static_cast<std::size_t>(batch[i].kernel);
+          const auto kernel = static_cast<std::size_t>(spans[i]);
           times_.seconds[kernel] += static_cast<double>(ticks) *
                                     static_cast<double>(physical_.timestamp_period_ns) * 1e-9;
           times_.launches[kernel] += 1;

@@ -1,7 +1,8 @@
 // Checkpoints: the dynamic state of a Simulation in one binary file.
 // Layout: header {magic "MOTESCK1", version, particles, bodies, step, time, payload bytes}, then
-// BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel (B vec4 each), ParticlePos, ParticleVel
-// (N vec4 each), then an FNV-1a 64 hash of the payload.
+// the body positions, orientations, velocities, angular momenta and angular velocities (B vec4
+// each, the scene's bodies in the scene's order, as in a Snapshot), the particle positions and
+// velocities (N vec4 each, the scene's order), then an FNV-1a 64 hash of the payload.
 #include <fmt/format.h>
 
 #include <array>
@@ -29,9 +30,11 @@ struct Header {
   std::uint64_t payload_bytes;
 };
 
-constexpr Buffer kBodyBuffers[] = {Buffer::BodyPos, Buffer::BodyQuat, Buffer::BodyVel,
-                                   Buffer::BodyAngMom, Buffer::BodyAngVel};
-constexpr Buffer kParticleBuffers[] = {Buffer::ParticlePos, Buffer::ParticleVel};
+/// The snapshot's arrays in the order the payload stores them.
+std::array<std::vector<shared::vec4>*, 7> payload_arrays(Snapshot& s) {
+  return {&s.body_pos,    &s.body_quat,    &s.body_vel,    &s.body_angmom,
+          &s.body_angvel, &s.particle_pos, &s.particle_vel};
+}
 
 std::uint64_t hash_bytes(const std::vector<unsigned char>& v) {
   std::uint64_t h = 14695981039346656037ull;
@@ -45,23 +48,21 @@ std::uint64_t hash_bytes(const std::vector<unsigned char>& v) {
 }  // namespace
 
 Status Simulation::save_state(const std::string& path) {
-  const std::size_t b_bytes = std::size_t{sizes_.bodies} * 16;
+  Result<Snapshot> snap = snapshot();
+  if (!snap) return snap.status();
+  const std::size_t b_bytes = bodies_.size() * 16;
   const std::size_t p_bytes = std::size_t{sizes_.particles} * 16;
   std::vector<unsigned char> payload(5 * b_bytes + 2 * p_bytes);
   std::size_t at = 0;
-  for (Buffer b : kBodyBuffers) {
-    if (Status s = device_->read(b, payload.data() + at, b_bytes); !s) return s;
-    at += b_bytes;
-  }
-  for (Buffer b : kParticleBuffers) {
-    if (Status s = device_->read(b, payload.data() + at, p_bytes); !s) return s;
-    at += p_bytes;
+  for (const std::vector<shared::vec4>* v : payload_arrays(snap.value())) {
+    std::memcpy(payload.data() + at, v->data(), v->size() * 16);
+    at += v->size() * 16;
   }
   Header h{};
   h.magic = kMagic;
   h.version = kVersion;
   h.particles = sizes_.particles;
-  h.bodies = sizes_.bodies;
+  h.bodies = static_cast<std::uint32_t>(bodies_.size());
   h.step = steps_;
   h.time = time_;
   h.payload_bytes = payload.size();
@@ -93,12 +94,12 @@ Status Simulation::load_state(const std::string& path) {
     return Status::error(
         fmt::format("{}: checkpoint version {} (this motes reads {})", path, h.version, kVersion));
   }
-  if (h.particles != sizes_.particles || h.bodies != sizes_.bodies) {
+  if (h.particles != sizes_.particles || h.bodies != bodies_.size()) {
     return Status::error(fmt::format(
         "{}: checkpoint of {} particles and {} bodies does not fit this scene ({} and {})", path,
-        h.particles, h.bodies, sizes_.particles, sizes_.bodies));
+        h.particles, h.bodies, sizes_.particles, bodies_.size()));
   }
-  const std::size_t b_bytes = std::size_t{sizes_.bodies} * 16;
+  const std::size_t b_bytes = bodies_.size() * 16;
   const std::size_t p_bytes = std::size_t{sizes_.particles} * 16;
   if (h.payload_bytes != 5 * b_bytes + 2 * p_bytes) {
     return Status::error(fmt::format("{}: corrupt checkpoint (payload size)", path));
@@ -113,18 +114,19 @@ Status Simulation::load_state(const std::string& path) {
   if (hash != hash_bytes(payload)) {
     return Status::error(fmt::format("{}: corrupt checkpoint (hash mismatch)", path));
   }
+  Snapshot state;
   std::size_t at = 0;
-  for (Buffer b : kBodyBuffers) {
-    if (Status s = device_->write(b, payload.data() + at, b_bytes); !s) return s;
-    at += b_bytes;
+  for (std::vector<shared::vec4>* v : payload_arrays(state)) {
+    const std::size_t bytes =
+        v == &state.particle_pos || v == &state.particle_vel ? p_bytes : b_bytes;
+    v->resize(bytes / 16);
+    std::memcpy(v->data(), payload.data() + at, bytes);
+    at += bytes;
   }
-  for (Buffer b : kParticleBuffers) {
-    if (Status s = device_->write(b, payload.data() + at, p_bytes); !s) return s;
-    at += p_bytes;
-  }
+  if (Status s = restore(state); !s) return s;
   steps_ = h.step;
   time_ = h.time;
-  return device_->synchronize();
+  return Status::ok();
 }
 
 }  // namespace motes

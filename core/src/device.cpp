@@ -51,6 +51,14 @@ const char* buffer_name(Buffer b) {
       return "SortedBody";
     case Buffer::SortedMaterial:
       return "SortedMaterial";
+    case Buffer::NeighbourList:
+      return "NeighbourList";
+    case Buffer::NeighbourCount:
+      return "NeighbourCount";
+    case Buffer::NeighbourRefPos:
+      return "NeighbourRefPos";
+    case Buffer::NeighbourState:
+      return "NeighbourState";
     case Buffer::ContactLaws:
       return "ContactLaws";
     case Buffer::Planes:
@@ -63,8 +71,12 @@ const char* buffer_name(Buffer b) {
 
 const char* kernel_name(Kernel k) {
   switch (k) {
+    case Kernel::NeighboursUpdate:
+      return "neighbours_update";
     case Kernel::GridBuild:
       return "grid_build";
+    case Kernel::NeighboursBuild:
+      return "neighbours_build";
     case Kernel::ContactsCompute:
       return "contacts_compute";
     case Kernel::BodiesReduce:
@@ -73,6 +85,8 @@ const char* kernel_name(Kernel k) {
       return "bodies_integrate";
     case Kernel::ParticlesUpdate:
       return "particles_update";
+    case Kernel::ParticlesIntegrate:
+      return "particles_integrate";
     case Kernel::Count:
       break;
   }
@@ -85,18 +99,25 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
   switch (b) {
     case Buffer::ParticlePos:
     case Buffer::ParticleVel:
-    case Buffer::ParticleLocal:
     case Buffer::ParticleForce:
     case Buffer::SortedPos:
     case Buffer::SortedVel:
+    case Buffer::NeighbourRefPos:
       return {kVec4, s.particles};
+    case Buffer::ParticleLocal:
+      return {kVec4, s.rigid_particles};
     case Buffer::ParticleBody:
     case Buffer::ParticleMaterial:
     case Buffer::GridBucket:
     case Buffer::GridOrder:
     case Buffer::SortedBody:
     case Buffer::SortedMaterial:
+    case Buffer::NeighbourCount:
       return {kUint, s.particles};
+    case Buffer::NeighbourList:
+      return {kUint, std::size_t{s.neighbour_capacity} * s.particles};
+    case Buffer::NeighbourState:
+      return {kUint, 4};
     case Buffer::BodyPos:
     case Buffer::BodyQuat:
     case Buffer::BodyVel:
@@ -118,6 +139,14 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
       break;
   }
   return {};
+}
+
+std::uint64_t buffers_bytes(const Sizes& sizes) {
+  std::uint64_t total = 0;
+  for (std::size_t i = 0; i < kBufferCount; ++i) {
+    total += buffer_layout(static_cast<Buffer>(i), sizes).bytes();
+  }
+  return total;
 }
 
 std::uint32_t grid_table_size(std::uint32_t particles) {

@@ -38,7 +38,8 @@ Material read_material_fields(const Node& node, Material base) {
 
 void read_settings(const Node& node, Settings& s, std::int64_t& max_particles) {
   node.expect_object({"dt", "substeps", "gravity", "particle_diameter", "clamp_attraction",
-                      "duration", "output_interval", "max_particles", "contact"});
+                      "duration", "output_interval", "max_particles", "neighbour_skin",
+                      "neighbour_capacity", "contact"});
   if (auto v = node.find("dt")) s.dt = v->number(Sign::Positive);
   if (auto v = node.find("substeps")) s.substeps = static_cast<int>(v->integer(1, 1'000'000));
   if (auto v = node.find("gravity")) s.gravity = v->vec3();
@@ -46,6 +47,10 @@ void read_settings(const Node& node, Settings& s, std::int64_t& max_particles) {
   if (auto v = node.find("clamp_attraction")) s.clamp_attraction = v->boolean();
   if (auto v = node.find("duration")) s.duration = v->number(Sign::Positive);
   if (auto v = node.find("output_interval")) s.output_interval = v->number(Sign::Positive);
+  if (auto v = node.find("neighbour_skin")) s.neighbour_skin = v->number(Sign::NonNegative);
+  if (auto v = node.find("neighbour_capacity")) {
+    s.neighbour_capacity = static_cast<int>(v->integer(1, 1024));
+  }
   if (auto v = node.find("max_particles")) {
     max_particles = v->integer(1, scene_detail::kParticleLimit);
   }

@@ -10,6 +10,7 @@
 
 #include "contact_laws.h"
 #include "shared/body_math.h"
+#include "shared/neighbours.h"
 
 namespace motes {
 
@@ -56,44 +57,84 @@ Status Simulation::upload(const Scene& scene) {
                                      scene.source, settings_.dt, settings_.substeps));
   }
   if (scene.materials.empty()) return Status::error(scene.source + ": the scene has no material");
+  if (settings_.neighbour_capacity < 1) {
+    return Status::error(fmt::format("{}: neighbour_capacity must be at least 1 (got {})",
+                                     scene.source, settings_.neighbour_capacity));
+  }
 
-  // Count first, so an impossible size is refused before anything is allocated.
+  // Count first, so an impossible size is refused before anything is allocated. Free spheres
+  // (dynamic one-particle bodies without spin) go after every rigid body's particles.
   std::uint64_t n = 0;
+  std::uint64_t rigid_particles = 0;
+  std::uint64_t rigid_bodies = 0;
   double max_diameter = 0.0;
+  const auto is_free_sphere = [](const BodySpec& b) {
+    return b.kind == BodyKind::Dynamic && b.shape->points.size() == 1 &&
+           b.angular_velocity.isZero(0.0);
+  };
   for (const BodySpec& b : scene.bodies) {
     if (!b.shape || b.shape->points.empty()) {
       return Status::error(fmt::format("{}: body '{}' has no particles", scene.source, b.name));
     }
     n += b.shape->points.size();
+    if (!is_free_sphere(b)) {
+      rigid_particles += b.shape->points.size();
+      ++rigid_bodies;
+    }
     max_diameter = std::max(max_diameter, b.shape->diameter);
   }
   if (n > std::numeric_limits<std::uint32_t>::max() / 2) {
     return Status::error(
         fmt::format("{}: {} particles is more than motes supports (2^31)", scene.source, n));
   }
+  const double skin =
+      settings_.neighbour_skin >= 0.0 ? settings_.neighbour_skin : 0.1 * max_diameter;
   sizes_.particles = static_cast<std::uint32_t>(n);
-  sizes_.bodies = static_cast<std::uint32_t>(scene.bodies.size());
+  sizes_.rigid_particles = static_cast<std::uint32_t>(rigid_particles);
+  sizes_.bodies = static_cast<std::uint32_t>(rigid_bodies);
   sizes_.table = grid_table_size(sizes_.particles);
   sizes_.materials = static_cast<std::uint32_t>(scene.materials.size());
   sizes_.planes = static_cast<std::uint32_t>(scene.planes.size());
+  sizes_.neighbour_capacity = static_cast<std::uint32_t>(settings_.neighbour_capacity);
+
+  Device& d = *device_;
+  // Device memory: refuse before allocating anything, with both numbers.
+  const std::uint64_t need = d.required_bytes(sizes_);
+  const std::uint64_t have = d.available_bytes();
+  if (need > have) {
+    const double per_particle =
+        static_cast<double>(need) / static_cast<double>(std::max<std::uint64_t>(n, 1));
+    return Status::error(fmt::format(
+        "{}: {} particles need {:.2f} GiB on {} device {} ({}), which has {:.2f} GiB available; "
+        "at {:.0f} bytes per particle about {} particles fit",
+        scene.source, n, static_cast<double>(need) / 1073741824.0, d.info().backend, d.info().index,
+        d.info().name, static_cast<double>(have) / 1073741824.0, per_particle,
+        static_cast<std::uint64_t>(static_cast<double>(have) / per_particle)));
+  }
 
   std::vector<vec4> ppos, pvel, plocal, bpos, bquat, bvel, bangmom, bangvel, binertia;
-  std::vector<std::uint32_t> pbody, pmat, bfirst;
+  std::vector<std::uint32_t> pbody, pmat;
   try {
-    ppos.reserve(n);
-    pvel.reserve(n);
-    plocal.reserve(n);
-    pbody.reserve(n);
-    pmat.reserve(n);
+    ppos.resize(n);
+    pvel.resize(n);
+    plocal.reserve(rigid_particles);
+    pbody.resize(n);
+    pmat.resize(n);
+    device_index_.assign(scene.bodies.size(), 0);
   } catch (const std::bad_alloc&) {
     return Status::error(fmt::format("{}: out of host memory for {} particles", scene.source, n));
   }
+  rigid_first_.clear();
+  sphere_turns_.clear();
 
   bodies_.clear();
   bodies_.reserve(scene.bodies.size());
   const ParticleSet* last_shape = nullptr;
   int last_material = -1;
   MassProperties mp;
+  std::uint32_t scene_particle = 0;
+  std::uint32_t next_rigid = 0;                                  // device particles
+  auto next_free = static_cast<std::uint32_t>(rigid_particles);  // device particles
   for (std::size_t bi = 0; bi < scene.bodies.size(); ++bi) {
     const BodySpec& spec = scene.bodies[bi];
     if (spec.material < 0 || static_cast<std::size_t>(spec.material) >= scene.materials.size()) {
@@ -112,54 +153,74 @@ Status Simulation::upload(const Scene& scene) {
                                        spec.name, mat.density));
     }
     const bool dynamic = spec.kind == BodyKind::Dynamic;
+    const bool free = is_free_sphere(spec);
     // Body frame = principal axes: orientation = rotation * (principal -> shape frame).
     const Eigen::Quaterniond orient =
         (spec.rotation.normalized() * mp.principal_frame).normalized();
     const Eigen::Matrix3d to_body = mp.principal_frame.toRotationMatrix().transpose();
     const Eigen::Matrix3d rot = orient.toRotationMatrix();
-    const Eigen::Vector3d inv_moments = mp.principal_moments.cwiseInverse();
-    const Eigen::Vector3d omega = dynamic ? spec.angular_velocity : Eigen::Vector3d::Zero();
     const Eigen::Vector3d vel = dynamic ? spec.velocity : Eigen::Vector3d::Zero();
-    const Eigen::Vector3d angmom =
-        rot * mp.principal_moments.asDiagonal() * rot.transpose() * omega;
 
     BodyInfo info;
     info.name = spec.name;
     info.kind = spec.kind;
     info.mass = mp.mass;
-    info.first_particle = static_cast<std::uint32_t>(ppos.size());
+    info.first_particle = scene_particle;
     info.particle_count = static_cast<std::uint32_t>(spec.shape->points.size());
+    info.free_sphere = free;
     bodies_.push_back(info);
+    scene_particle += info.particle_count;
 
-    bfirst.push_back(info.first_particle);
+    const double radius = 0.5 * spec.shape->diameter;
+    const double inv_pm = dynamic ? 1.0 / mp.particle_mass : 0.0;
+    if (free) {
+      // The particle is the body: its state is the body's; it never turns.
+      const std::uint32_t i = next_free++;
+      device_index_[bi] = i;
+      const vec4 q = to_quat(orient);
+      if (q.x != 0.0f || q.y != 0.0f || q.z != 0.0f || q.w != 1.0f) {
+        sphere_turns_.emplace_back(static_cast<std::uint32_t>(bi), q);
+      }
+      const Eigen::Vector3d local = to_body * (spec.shape->points[0].cast<double>() - mp.center);
+      ppos[i] = to_vec4(spec.position + rot * local, radius);
+      pvel[i] = to_vec4(vel, inv_pm);
+      pbody[i] = sizes_.bodies + (i - sizes_.rigid_particles);
+      pmat[i] = static_cast<std::uint32_t>(spec.material);
+      continue;
+    }
+    const auto b = static_cast<std::uint32_t>(rigid_first_.size());
+    device_index_[bi] = b;
+    rigid_first_.push_back(next_rigid);
+    const Eigen::Vector3d inv_moments = mp.principal_moments.cwiseInverse();
+    const Eigen::Vector3d omega = dynamic ? spec.angular_velocity : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d angmom =
+        rot * mp.principal_moments.asDiagonal() * rot.transpose() * omega;
     bpos.push_back(to_vec4(spec.position, dynamic ? 1.0 / mp.mass : 0.0));
     bquat.push_back(to_quat(orient));
     bvel.push_back(to_vec4(vel, 0.0));
     bangmom.push_back(to_vec4(angmom, 0.0));
     bangvel.push_back(to_vec4(omega, 0.0));
     binertia.push_back(dynamic ? to_vec4(inv_moments, 0.0) : vec4(0.0f));
-
-    const double radius = 0.5 * spec.shape->diameter;
-    const double inv_pm = dynamic ? 1.0 / mp.particle_mass : 0.0;
     for (const Eigen::Vector3f& pt : spec.shape->points) {
       const Eigen::Vector3d local = to_body * (pt.cast<double>() - mp.center);
+      const std::uint32_t i = next_rigid++;
       plocal.push_back(to_vec4(local, 0.0));
       // Positions and velocities are recomputed on the device by particles_update below.
-      ppos.push_back(to_vec4(spec.position + rot * local, radius));
-      pvel.push_back(to_vec4(Eigen::Vector3d::Zero(), inv_pm));
-      pbody.push_back(static_cast<std::uint32_t>(bi));
-      pmat.push_back(static_cast<std::uint32_t>(spec.material));
+      ppos[i] = to_vec4(spec.position + rot * local, radius);
+      pvel[i] = to_vec4(Eigen::Vector3d::Zero(), inv_pm);
+      pbody[i] = b;
+      pmat[i] = static_cast<std::uint32_t>(spec.material);
     }
   }
-  bfirst.push_back(static_cast<std::uint32_t>(ppos.size()));
+  rigid_first_.push_back(next_rigid);
 
   std::vector<shared::PlaneData> planes;
   for (const PlaneSpec& pl : scene.planes) {
     const Eigen::Vector3d nrm = pl.normal.normalized();
-    shared::PlaneData d{};
-    d.normal_offset = to_vec4(nrm, nrm.dot(pl.point));
-    d.material = static_cast<std::uint32_t>(pl.material);
-    planes.push_back(d);
+    shared::PlaneData pd{};
+    pd.normal_offset = to_vec4(nrm, nrm.dot(pl.point));
+    pd.material = static_cast<std::uint32_t>(pl.material);
+    planes.push_back(pd);
   }
   const std::vector<shared::ContactLaw> laws = contact_law_table(scene.materials);
 
@@ -169,12 +230,16 @@ Status Simulation::upload(const Scene& scene) {
   params_.body_count = sizes_.bodies;
   params_.table_mask = sizes_.table - 1;
   params_.plane_count = sizes_.planes;
-  params_.cell_size = static_cast<float>(max_diameter);
-  params_.inv_cell_size = static_cast<float>(1.0 / max_diameter);
+  // Cells hold every pair a list can hold: cell edge = largest diameter + skin.
+  params_.cell_size = static_cast<float>(max_diameter + skin);
+  params_.inv_cell_size = static_cast<float>(1.0 / (max_diameter + skin));
   params_.material_count = sizes_.materials;
   params_.flags = settings_.clamp_attraction ? MOTES_FLAG_CLAMP_ATTRACTION : 0u;
+  params_.rigid_particle_count = sizes_.rigid_particles;
+  params_.neighbour_capacity = sizes_.neighbour_capacity;
+  params_.neighbour_skin = static_cast<float>(skin);
 
-  Device& d = *device_;
+  const std::uint32_t neighbour_state[4] = {1u, 0u, 0u, 0u};  // build at the first step
   Status s = d.allocate(sizes_);
   if (s) s = write_vector(d, Buffer::ParticlePos, ppos);
   if (s) s = write_vector(d, Buffer::ParticleVel, pvel);
@@ -187,24 +252,31 @@ Status Simulation::upload(const Scene& scene) {
   if (s) s = write_vector(d, Buffer::BodyAngMom, bangmom);
   if (s) s = write_vector(d, Buffer::BodyAngVel, bangvel);
   if (s) s = write_vector(d, Buffer::BodyInvInertia, binertia);
-  if (s) s = write_vector(d, Buffer::BodyFirst, bfirst);
+  if (s) s = write_vector(d, Buffer::BodyFirst, rigid_first_);
+  if (s) s = write_vector(d, Buffer::NeighbourRefPos, ppos);
+  if (s) s = d.write(Buffer::NeighbourState, neighbour_state, sizeof neighbour_state);
   if (s) s = write_vector(d, Buffer::ContactLaws, laws);
   if (s) s = write_vector(d, Buffer::Planes, planes);
   if (!s) return s;
-  // Particles take their pose from the bodies with the device's own arithmetic.
-  d.particles_update(params_);
+  // Rigid particles take their pose from the bodies with the device's own arithmetic.
+  if (sizes_.rigid_particles > 0) d.particles_update(params_);
   return d.synchronize();
 }
 
 Status Simulation::step(std::uint64_t count) {
   Device& d = *device_;
+  const bool rigid = sizes_.bodies > 0;
+  const bool free = sizes_.particles > sizes_.rigid_particles;
   for (std::uint64_t k = 0; k < count; ++k) {
     for (int sub = 0; sub < settings_.substeps; ++sub) {
-      d.grid_build(params_);
+      d.neighbours_update(params_);
       d.contacts_compute(params_);
-      d.bodies_reduce(params_);
-      d.bodies_integrate(params_);
-      d.particles_update(params_);
+      if (rigid) {
+        d.bodies_reduce(params_);
+        d.bodies_integrate(params_);
+        d.particles_update(params_);
+      }
+      if (free) d.particles_integrate(params_);
     }
     ++steps_;
     time_ = static_cast<double>(steps_) * settings_.dt;
@@ -213,22 +285,100 @@ Status Simulation::step(std::uint64_t count) {
 }
 
 Result<Snapshot> Simulation::snapshot() {
+  Device& d = *device_;
+  const std::size_t n = sizes_.particles;
+  const std::size_t nb = sizes_.bodies;
+  std::vector<vec4> ppos, pvel, bpos, bquat, bvel, bangmom, bangvel;
+  Status st = read_vector(d, Buffer::ParticlePos, ppos, n);
+  if (st) st = read_vector(d, Buffer::ParticleVel, pvel, n);
+  if (st) st = read_vector(d, Buffer::BodyPos, bpos, nb);
+  if (st) st = read_vector(d, Buffer::BodyQuat, bquat, nb);
+  if (st) st = read_vector(d, Buffer::BodyVel, bvel, nb);
+  if (st) st = read_vector(d, Buffer::BodyAngMom, bangmom, nb);
+  if (st) st = read_vector(d, Buffer::BodyAngVel, bangvel, nb);
+  if (!st) return st;
+
   Snapshot s;
   s.time = time_;
   s.step = steps_;
+  const std::size_t scene_bodies = bodies_.size();
+  s.particle_pos.resize(n);
+  s.particle_vel.resize(n);
+  s.particle_body.resize(n);
+  s.body_pos.resize(scene_bodies);
+  s.body_quat.assign(scene_bodies, vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  s.body_vel.resize(scene_bodies);
+  s.body_angmom.resize(scene_bodies);
+  s.body_angvel.resize(scene_bodies);
+  for (std::size_t b = 0; b < scene_bodies; ++b) {
+    const BodyInfo& info = bodies_[b];
+    const std::uint32_t at = device_index_[b];
+    const std::uint32_t first = info.free_sphere ? at : rigid_first_[at];
+    for (std::uint32_t k = 0; k < info.particle_count; ++k) {
+      s.particle_pos[info.first_particle + k] = ppos[first + k];
+      s.particle_vel[info.first_particle + k] = pvel[first + k];
+      s.particle_body[info.first_particle + k] = static_cast<std::uint32_t>(b);
+    }
+    if (info.free_sphere) {
+      const vec4 p = ppos[at];
+      const vec4 v = pvel[at];
+      s.body_pos[b] = vec4(p.x, p.y, p.z, v.w);  // a one-particle body's inverse mass
+      s.body_vel[b] = vec4(v.x, v.y, v.z, 0.0f);
+      s.body_angmom[b] = vec4(0.0f);
+      s.body_angvel[b] = vec4(0.0f);
+      continue;
+    }
+    s.body_pos[b] = bpos[at];
+    s.body_quat[b] = bquat[at];
+    s.body_vel[b] = bvel[at];
+    s.body_angmom[b] = bangmom[at];
+    s.body_angvel[b] = bangvel[at];
+  }
+  for (const auto& [b, q] : sphere_turns_) s.body_quat[b] = q;
+  return s;
+}
+
+Status Simulation::restore(const Snapshot& state) {
   Device& d = *device_;
   const std::size_t n = sizes_.particles;
-  const std::size_t b = sizes_.bodies;
-  Status st = read_vector(d, Buffer::ParticlePos, s.particle_pos, n);
-  if (st) st = read_vector(d, Buffer::ParticleVel, s.particle_vel, n);
-  if (st) st = read_vector(d, Buffer::ParticleBody, s.particle_body, n);
-  if (st) st = read_vector(d, Buffer::BodyPos, s.body_pos, b);
-  if (st) st = read_vector(d, Buffer::BodyQuat, s.body_quat, b);
-  if (st) st = read_vector(d, Buffer::BodyVel, s.body_vel, b);
-  if (st) st = read_vector(d, Buffer::BodyAngMom, s.body_angmom, b);
-  if (st) st = read_vector(d, Buffer::BodyAngVel, s.body_angvel, b);
-  if (!st) return st;
-  return s;
+  const std::size_t nb = sizes_.bodies;
+  std::vector<vec4> ppos(n), pvel(n), bpos(nb), bquat(nb), bvel(nb), bangmom(nb), bangvel(nb);
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    const BodyInfo& info = bodies_[b];
+    const std::uint32_t at = device_index_[b];
+    const std::uint32_t first = info.free_sphere ? at : rigid_first_[at];
+    for (std::uint32_t k = 0; k < info.particle_count; ++k) {
+      ppos[first + k] = state.particle_pos[info.first_particle + k];
+      pvel[first + k] = state.particle_vel[info.first_particle + k];
+    }
+    if (info.free_sphere) continue;
+    bpos[at] = state.body_pos[b];
+    bquat[at] = state.body_quat[b];
+    bvel[at] = state.body_vel[b];
+    bangmom[at] = state.body_angmom[b];
+    bangvel[at] = state.body_angvel[b];
+  }
+  const std::uint32_t neighbour_state[4] = {1u, 0u, 0u, 0u};  // rebuild at the next step
+  Status s = write_vector(d, Buffer::ParticlePos, ppos);
+  if (s) s = write_vector(d, Buffer::ParticleVel, pvel);
+  if (s) s = write_vector(d, Buffer::BodyPos, bpos);
+  if (s) s = write_vector(d, Buffer::BodyQuat, bquat);
+  if (s) s = write_vector(d, Buffer::BodyVel, bvel);
+  if (s) s = write_vector(d, Buffer::BodyAngMom, bangmom);
+  if (s) s = write_vector(d, Buffer::BodyAngVel, bangvel);
+  if (s) s = d.write(Buffer::NeighbourState, neighbour_state, sizeof neighbour_state);
+  if (!s) return s;
+  return d.synchronize();
+}
+
+Result<NeighbourStats> Simulation::neighbour_stats() {
+  std::uint32_t words[4] = {};
+  if (Status s = device_->read(Buffer::NeighbourState, words, sizeof words); !s) return s;
+  NeighbourStats out;
+  out.builds = words[MOTES_NEIGHBOUR_BUILDS];
+  out.over_capacity = words[MOTES_NEIGHBOUR_OVER_CAPACITY];
+  out.max_count = words[MOTES_NEIGHBOUR_MAX_COUNT];
+  return out;
 }
 
 namespace {

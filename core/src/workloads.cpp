@@ -168,9 +168,10 @@ bool settle_dimensions(std::uint64_t particles, int& nx, int& ny, int& nz) {
     std::uint64_t n;
     int x, y, z;
   };
-  static constexpr Dims kSizes[] = {{16384, 32, 16, 32},     {65536, 64, 32, 32},
-                                    {262144, 64, 64, 64},    {1048576, 128, 64, 128},
-                                    {4194304, 256, 64, 256}, {16777216, 256, 256, 256}};
+  static constexpr Dims kSizes[] = {{16384, 32, 16, 32},       {65536, 64, 32, 32},
+                                    {262144, 64, 64, 64},      {1048576, 128, 64, 128},
+                                    {4194304, 256, 64, 256},   {16777216, 256, 256, 256},
+                                    {67108864, 512, 256, 512}, {134217728, 512, 512, 512}};
   for (const Dims& s : kSizes) {
     if (s.n == particles) {
       nx = s.x;

@@ -43,12 +43,17 @@ struct BenchOptions {
 struct Measurement {
   std::string workload, phase;
   std::uint32_t particles = 0, bodies = 0;
+  std::uint32_t rigid_particles = 0, rigid_bodies = 0;
   std::uint32_t table = 0;
   std::uint64_t steps = 0;         // per timed repeat
   std::vector<double> seconds;     // per repeat, kernel timing off
   std::uint64_t kernel_steps = 0;  // of the run with kernel timing on
   motes::KernelTimes kernels;      // of that run
   std::string backend, device, detail;
+  std::uint64_t device_bytes = 0;    // what the simulation holds on the device
+  motes::NeighbourStats neighbours;  // after the first timed repeat
+  float skin = 0.0f;                 // neighbour skin (m)
+  std::uint32_t capacity = 0;        // list entries per particle
 };
 
 template <typename T>
@@ -96,10 +101,16 @@ Measurement measure(const motes::Scene& scene, const BenchOptions& o, std::uint6
     if (r == 0) {
       m.particles = sim->particle_count();
       m.bodies = sim->body_count();
+      m.rigid_particles = sim->sizes().rigid_particles;
+      m.rigid_bodies = sim->sizes().bodies;
       m.table = sim->sizes().table;
       m.backend = sim->device().info().backend;
       m.device = sim->device().info().name;
       m.detail = sim->device().info().detail;
+      m.device_bytes = sim->device_bytes();
+      m.neighbours = must(sim->neighbour_stats());
+      m.skin = sim->step_params().neighbour_skin;
+      m.capacity = sim->step_params().neighbour_capacity;
     }
   }
   auto sim = make_sim(scene, o);
@@ -117,18 +128,28 @@ Measurement measure(const motes::Scene& scene, const BenchOptions& o, std::uint6
 /// written once; body data gathered per particle counted once per body): what "achieved bandwidth"
 /// is computed from. docs/benchmarks.md explains each term.
 double compulsory_bytes(motes::Kernel k, const Measurement& m) {
-  const double n = m.particles, b = m.bodies, t = m.table;
+  const double n = m.particles, t = m.table;
+  const double nr = m.rigid_particles, b = m.rigid_bodies, nf = n - nr;
   switch (k) {
+    case motes::Kernel::NeighboursUpdate:  // read one word
+      return 4;
     case motes::Kernel::GridBuild:  // read pos, vel, body, material; write bucket, order, 4 sorted
       return 40 * n + 8 * n + 40 * n + 4 * (t + 1);
-    case motes::Kernel::ContactsCompute:  // read the 4 sorted arrays, order, starts; write force
-      return 40 * n + 4 * n + 4 * (t + 1) + 16 * n;
+    case motes::Kernel::NeighboursBuild:  // read pos, vel, body, starts, sorted pos + body, order;
+                                          // write count and ref (the entries are not counted)
+      return 36 * n + 4 * (t + 1) + 24 * n + 20 * n;
+    case motes::Kernel::ContactsCompute:  // read own pos, vel, material, count; write force (the
+                                          // entries and the neighbours gathered are not counted)
+      return 40 * n + 16 * n;
     case motes::Kernel::BodiesReduce:  // read first, com, particle pos + force; write force, torque
-      return 4 * (b + 1) + 16 * b + 32 * n + 32 * b;
+      return 4 * (b + 1) + 16 * b + 32 * nr + 32 * b;
     case motes::Kernel::BodiesIntegrate:  // read 8 vec4, write 5 vec4 per body
       return 13 * 16 * b;
-    case motes::Kernel::ParticlesUpdate:  // read body, local, pos, vel, 4 body vec4; write pos, vel
-      return (4 + 16 + 32) * n + 64 * b + 32 * n;
+    case motes::Kernel::ParticlesUpdate:  // read body, local, pos, vel, ref, 4 body vec4; write
+                                          // pos, vel
+      return (4 + 16 + 48) * nr + 64 * b + 32 * nr;
+    case motes::Kernel::ParticlesIntegrate:  // read pos, vel, force, ref; write pos, vel
+      return 96 * nf;
     case motes::Kernel::Count:
       break;
   }
@@ -201,7 +222,16 @@ nlohmann::json to_json(const Measurement& m) {
           {"backend", m.backend},
           {"device", m.device},
           {"detail", m.detail},
-          {"neighbour_search", "hashed grid rebuilt every step"},
+          {"neighbour_search",
+           fmt::format("neighbour lists (skin {} m, {} entries per particle) from the hashed "
+                       "grid, rebuilt when a particle has moved 0.45 skin",
+                       m.skin, m.capacity)},
+          {"neighbour_builds", m.neighbours.builds},
+          {"neighbour_max_count", m.neighbours.max_count},
+          {"neighbour_over_capacity", m.neighbours.over_capacity},
+          {"device_bytes", m.device_bytes},
+          {"bytes_per_particle",
+           m.particles == 0 ? 0.0 : static_cast<double>(m.device_bytes) / m.particles},
           {"contact_model",
            "DEM: linear spring, mass-proportional dashpot, viscous tangential "
            "force with Coulomb cap; no particle rotation"}};
@@ -214,9 +244,11 @@ void print_row(const Measurement& m) {
   for (std::size_t k = 0; k < motes::kKernelCount; ++k) {
     ks += fmt::format(" {:>8.3f}", kernel_ms(m, k));
   }
-  fmt::print("{:<9} {:<8} {:>9} {:>6} {:>9.3f} {:>10.3e}{}\n", m.workload, m.phase, m.particles,
-             m.steps, per, static_cast<double>(m.particles) * static_cast<double>(m.steps) / med,
-             ks);
+  fmt::print("{:<9} {:<8} {:>9} {:>6} {:>9.3f} {:>10.3e}{} {:>6.0f} {:>6}\n", m.workload, m.phase,
+             m.particles, m.steps, per,
+             static_cast<double>(m.particles) * static_cast<double>(m.steps) / med, ks,
+             m.particles == 0 ? 0.0 : static_cast<double>(m.device_bytes) / m.particles,
+             m.neighbours.builds);
   std::fflush(stdout);
 }
 
@@ -232,7 +264,7 @@ void run_bench(const BenchOptions& o) {
     if (!motes::settle_dimensions(n, nx, ny, nz)) {
       fail(
           fmt::format("--sizes: {} is not a W1 size (16384, 65536, 262144, 1048576, 4194304, "
-                      "16777216)",
+                      "16777216, 67108864, 134217728)",
                       n));
     }
   }
@@ -244,13 +276,15 @@ void run_bench(const BenchOptions& o) {
         probe->info().backend, probe->info().index, probe->info().name, probe->info().detail,
         o.repeats);
   }
+  // Column labels of the kernel families, in motes::Kernel order (JSON has the full names).
+  constexpr const char* kLabels[motes::kKernelCount] = {
+      "nb_upd", "grid", "nb_build", "contacts", "b_reduce", "b_integr", "p_update", "p_integr"};
   std::string ks;
-  for (std::size_t k = 0; k < motes::kKernelCount; ++k) {
-    std::string name = motes::kernel_name(static_cast<motes::Kernel>(k));
-    ks += fmt::format(" {:>8}", name.substr(0, 8));
-  }
-  fmt::print("{:<9} {:<8} {:>9} {:>6} {:>9} {:>10}{}   (kernel columns: ms/step)\n", "workload",
-             "phase", "particles", "steps", "ms/step", "p-steps/s", ks);
+  for (const char* label : kLabels) ks += fmt::format(" {:>8}", label);
+  fmt::print(
+      "{:<9} {:<8} {:>9} {:>6} {:>9} {:>10}{} {:>6} {:>6}   (kernel columns: ms/step; "
+      "B/p: device bytes per particle; builds: neighbour-list builds in one repeat)\n",
+      "workload", "phase", "particles", "steps", "ms/step", "p-steps/s", ks, "B/p", "builds");
 
   std::optional<motes::Scene> lammps_state;
   if (!o.dense_from.empty()) {
@@ -259,42 +293,58 @@ void run_bench(const BenchOptions& o) {
                o.dense_from, lammps_state->bodies.size());
   }
   nlohmann::json results = nlohmann::json::array();
+  // A workload that cannot run (a size beyond the device's memory, say) is reported, and the
+  // others still run; the command then ends with the error exit code.
+  bool any_failed = false;
+  const auto attempt = [&](const auto& run) {
+    try {
+      run();
+    } catch (const CLI::RuntimeError&) {  // fail() has printed why
+      any_failed = true;
+    }
+  };
   if (o.workload != "dominoes") {
     for (std::uint64_t n : o.sizes) {
       int nx = 0, ny = 0, nz = 0;
       motes::settle_dimensions(n, nx, ny, nz);
       const motes::Scene scene = motes::settle_workload(nx, ny, nz);
       if (o.phase != "dense") {
-        Measurement m = measure(scene, o, o.falling_steps, [](motes::Simulation&) {});
-        m.workload = "settle";
-        m.phase = "falling";
-        print_row(m);
-        results.push_back(to_json(m));
+        attempt([&] {
+          Measurement m = measure(scene, o, o.falling_steps, [](motes::Simulation&) {});
+          m.workload = "settle";
+          m.phase = "falling";
+          print_row(m);
+          results.push_back(to_json(m));
+        });
       }
       if (o.phase != "falling") {
-        Measurement m;
-        if (lammps_state && lammps_state->bodies.size() == n) {
-          m = measure(*lammps_state, o, o.dense_steps, [](motes::Simulation&) {});
-          m.phase = "dense*";
-        } else {
-          const std::string path = ensure_settled(scene, o, n);
-          m = measure(scene, o, o.dense_steps,
-                      [&](motes::Simulation& s) { must(s.load_state(path)); });
-          m.phase = "dense";
-        }
-        m.workload = "settle";
-        print_row(m);
-        results.push_back(to_json(m));
+        attempt([&] {
+          Measurement m;
+          if (lammps_state && lammps_state->bodies.size() == n) {
+            m = measure(*lammps_state, o, o.dense_steps, [](motes::Simulation&) {});
+            m.phase = "dense*";
+          } else {
+            const std::string path = ensure_settled(scene, o, n);
+            m = measure(scene, o, o.dense_steps,
+                        [&](motes::Simulation& s) { must(s.load_state(path)); });
+            m.phase = "dense";
+          }
+          m.workload = "settle";
+          print_row(m);
+          results.push_back(to_json(m));
+        });
       }
     }
   }
   if (o.workload != "settle") {
-    const motes::Scene scene = motes::dominoes_workload(o.dominoes, o.domino_rows);
-    Measurement m = measure(scene, o, o.domino_steps, [](motes::Simulation&) {});
-    m.workload = "dominoes";
-    m.phase = "falling";
-    print_row(m);
-    results.push_back(to_json(m));
+    attempt([&] {
+      const motes::Scene scene = motes::dominoes_workload(o.dominoes, o.domino_rows);
+      Measurement m = measure(scene, o, o.domino_steps, [](motes::Simulation&) {});
+      m.workload = "dominoes";
+      m.phase = "falling";
+      print_row(m);
+      results.push_back(to_json(m));
+    });
   }
   if (!o.json_path.empty()) {
     std::ofstream out(o.json_path);
@@ -302,6 +352,7 @@ void run_bench(const BenchOptions& o) {
     if (!out) fail(fmt::format("{}: cannot write JSON results", o.json_path));
     fmt::print("results written to {}\n", o.json_path);
   }
+  if (any_failed) throw CLI::RuntimeError(kErrorExit);
 }
 
 }  // namespace

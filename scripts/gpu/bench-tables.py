@@ -9,13 +9,15 @@ import argparse
 import json
 import sys
 
-KERNELS = ["grid_build", "contacts_compute", "bodies_reduce", "bodies_integrate",
-           "particles_update"]
+KERNELS = ["neighbours_update", "grid_build", "neighbours_build", "contacts_compute",
+           "bodies_reduce", "bodies_integrate", "particles_update", "particles_integrate"]
 # Bytes per particle of a fused grid-DEM step (../shared/gpu/README.md): the step's floor at the
 # copy bandwidth measured in the same run.
 FUSED_FLOOR_BYTES = 200
 GOALS_MS = {("settle", "falling", 16384): 0.030, ("settle", "falling", 1048576): 0.20,
-            ("settle", "falling", 16777216): 2.5, ("dominoes", "falling", 1500000): 1.6}
+            ("settle", "falling", 16777216): 2.5, ("settle", "dense", 16384): 0.030,
+            ("settle", "dense", 1048576): 0.20, ("settle", "dense", 16777216): 2.5,
+            ("dominoes", "falling", 15000000): 1.6}
 
 
 def load_rows(paths):
@@ -62,8 +64,8 @@ def main():
     out.append(f"Device: {', '.join(devices)}.\n")
 
     out.append("| workload | N | CUDA ms/step | CUDA particle-steps/s | Vulkan ms/step | "
-               "Vulkan / CUDA | goal (ms) |")
-    out.append("|---|---:|---:|---:|---:|---:|---:|")
+               "Vulkan / CUDA | goal (ms) | device B/particle | list builds |")
+    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for k in order:
         c, v = by[k].get("cuda"), by[k].get("vulkan")
         cm = f"{c['median_ms_per_step']:.3f}" if c else "-"
@@ -72,20 +74,26 @@ def main():
         ratio = (f"{v['median_ms_per_step'] / c['median_ms_per_step']:.2f}"
                  if c and v else "-")
         goal = GOALS_MS.get(k)
+        any_row = c or v
+        bpp = f"{any_row.get('bytes_per_particle', 0):.0f}" if any_row else "-"
+        builds = (f"{any_row.get('neighbour_builds', 0)} in {any_row['steps']}"
+                  if any_row else "-")
         out.append(f"| {k[0]} {k[1]} | {k[2]:,} | {cm} | {cp} | {vm} | {ratio} | "
-                   f"{goal if goal else ''} |")
+                   f"{goal if goal else ''} | {bpp} | {builds} |")
 
     out.append("\nCUDA kernel families, from the extra run with kernel timing on (each family "
-               "launched alone between CUDA events, the body passes unfused): ms per step, and in "
-               "brackets the compulsory bytes of `motes bench` over that time (GB/s).\n")
+               "launched alone between CUDA events, the body passes unfused, the neighbour-list "
+               "rebuild decided on the host): ms per step (grid_build and neighbours_build: their "
+               "time over all steps, so the rebuilds' share), and in brackets the compulsory bytes "
+               "of `motes bench` over that time (GB/s).\n")
     out.append("| workload | N | " + " | ".join(KERNELS) + " |")
     out.append("|---|---:|" + "---:|" * len(KERNELS))
     for k in order:
         c = by[k].get("cuda")
         if not c:
             continue
-        cells = [f"{c['kernel_ms_per_step'][n]:.3f} ({c['kernel_compulsory_gb_per_s'][n]:.0f})"
-                 for n in KERNELS]
+        cells = [f"{c['kernel_ms_per_step'].get(n, 0):.3f} "
+                 f"({c['kernel_compulsory_gb_per_s'].get(n, 0):.0f})" for n in KERNELS]
         out.append(f"| {k[0]} {k[1]} | {k[2]:,} | " + " | ".join(cells) + " |")
 
     if floors:
@@ -93,21 +101,19 @@ def main():
                    "device-to-device copy bandwidth, CUB `DeviceRadixSort::SortPairs` of N pairs "
                    "on the grid's key bits; the fused-step floor is "
                    f"{FUSED_FLOOR_BYTES} B/particle at that bandwidth.\n")
-        out.append("| N | copy GB/s | CUB sort ms (bits) | CUDA grid_build ms | CUB / grid_build "
-                   "| fused floor ms | CUDA falling ms/step | x floor |")
+        out.append("| N | copy GB/s | CUB sort ms (bits) | fused floor ms | CUDA falling ms/step "
+                   "| x floor | CUDA dense ms/step | x floor |")
         out.append("|---:|---:|---:|---:|---:|---:|---:|---:|")
         for n in sorted(floors):
             f = floors[n]
-            c = by.get(("settle", "falling", n), {}).get("cuda")
             floor_ms = FUSED_FLOOR_BYTES * n / (f["copy_gb_per_s"] * 1e6)
-            gb = c["kernel_ms_per_step"]["grid_build"] if c else None
-            ms = c["median_ms_per_step"] if c else None
-            out.append(
-                f"| {n:,} | {f['copy_gb_per_s']:.0f} | {f['cub_sort_pairs_ms']:.3f} "
-                f"({f['key_bits']}) | {gb:.3f} | {f['cub_sort_pairs_ms'] / gb:.2f} | "
-                f"{floor_ms:.3f} | {ms:.3f} | {ms / floor_ms:.1f} |" if c else
-                f"| {n:,} | {f['copy_gb_per_s']:.0f} | {f['cub_sort_pairs_ms']:.3f} "
-                f"({f['key_bits']}) | - | - | {floor_ms:.3f} | - | - |")
+            cells = []
+            for phase in ("falling", "dense"):
+                c = by.get(("settle", phase, n), {}).get("cuda")
+                ms = c["median_ms_per_step"] if c else None
+                cells += [f"{ms:.3f}", f"{ms / floor_ms:.1f}"] if c else ["-", "-"]
+            out.append(f"| {n:,} | {f['copy_gb_per_s']:.0f} | {f['cub_sort_pairs_ms']:.3f} "
+                       f"({f['key_bits']}) | {floor_ms:.3f} | " + " | ".join(cells) + " |")
     text = "\n".join(out) + "\n"
     if a.out:
         with open(a.out, "w") as f:

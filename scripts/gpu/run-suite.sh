@@ -8,9 +8,12 @@
 # bench.md (scripts/gpu/bench-tables.py).
 # Usage: scripts/gpu/run-suite.sh [conformance|sanitize|bench|all]...   (default all)
 #   MOTES_BENCH_RUNS="cuda:falling cuda:dominoes cuda:dense vulkan:falling ..."   what is measured
+#     (also BACKEND:huge: W1 at 67 M and 134 M particles, one short repeat; BACKEND:dominoes-1m:
+#     W2 with 1,000,000 dominoes; openmp:scaling: W1 at 1 M on 1, 2, 4, 8 and 16 threads)
 #   MOTES_GPU_SIZES, MOTES_GPU_DENSE_SIZES   W1 sizes of the falling and dense phases
 #   MOTES_SANITIZE_TOOLS="memcheck racecheck"   compute-sanitizer tools
-#   LIMIT_CONFORMANCE, LIMIT_SANITIZE, LIMIT_FALLING, LIMIT_DENSE, LIMIT_DOMINOES   seconds
+#   LIMIT_CONFORMANCE, LIMIT_SANITIZE, LIMIT_FALLING, LIMIT_DENSE, LIMIT_DOMINOES, LIMIT_HUGE,
+#   LIMIT_SCALING   seconds
 set -uo pipefail
 parts=${*:-all}
 out=${OUT:-gpu-out}
@@ -38,7 +41,7 @@ if want conformance; then
   # the scan without subgroup arithmetic.
   MOTES_VULKAN_VALIDATION=1 MOTES_VULKAN_MAX_GROUPS_X=3 MOTES_VULKAN_NO_SUBGROUPS=1 \
     MOTES_CONFORMANCE_BACKENDS=vulkan \
-    part 60 conformance motes_conformance_tests --gtest_brief=1 --gtest_filter=-*Scenes* ||
+    part "${LIMIT_2D:-150}" conformance motes_conformance_tests --gtest_brief=1 --gtest_filter=-*Scenes* ||
     status=1
   # The README's main job, on each GPU backend.
   for backend in cuda vulkan; do
@@ -50,12 +53,14 @@ if want sanitize; then
   sanitizer=$(command -v compute-sanitizer || echo /usr/local/cuda/bin/compute-sanitizer)
   # Every CUDA case under memcheck; racecheck (much slower) leaves out the one-second domino
   # chain (83,000 steps of the same kernels that the other scene cases run).
+  # The rebuild goes through the host (MOTES_CUDA_HOST_REBUILD=1: no graph, no conditional node),
+  # which compute-sanitizer 13.0 follows; the kernels are the same.
   for tool in ${MOTES_SANITIZE_TOOLS:-memcheck racecheck}; do
     filter=*
     [ "$tool" = racecheck ] && filter=-*DominoChain*
-    MOTES_CONFORMANCE_BACKENDS=cuda part "${LIMIT_SANITIZE:-300}" sanitize "$sanitizer" \
-      --tool "$tool" --error-exitcode 1 motes_conformance_tests --gtest_brief=1 \
-      --gtest_filter="$filter" || status=1
+    MOTES_CUDA_HOST_REBUILD=1 MOTES_CONFORMANCE_BACKENDS=cuda part "${LIMIT_SANITIZE:-300}" \
+      sanitize "$sanitizer" --tool "$tool" --error-exitcode 1 motes_conformance_tests \
+      --gtest_brief=1 --gtest_filter="$filter" || status=1
   done
 fi
 if want bench; then
@@ -75,6 +80,18 @@ if want bench; then
       dense)
         part "${LIMIT_DENSE:-200}" bench motes bench --backend "$backend" --workload settle \
           --phase dense --sizes "${MOTES_GPU_DENSE_SIZES:-16384,65536,262144,1048576}" --json "$j" ;;
+      dominoes-1m)
+        part "${LIMIT_DOMINOES:-60}" bench motes bench --backend "$backend" --workload dominoes \
+          --dominoes 1000000 --domino-rows 1000 --json "$j" ;;
+      huge)
+        part "${LIMIT_HUGE:-300}" bench motes bench --backend "$backend" --workload settle \
+          --phase falling --sizes 67108864,134217728 --repeats 1 --falling-steps 200 --json "$j" ;;
+      scaling)
+        for t in 1 2 4 8 16; do
+          part "${LIMIT_SCALING:-100}" bench motes bench --backend openmp --threads "$t" \
+            --workload settle --phase falling --sizes 1048576 --repeats 1 --falling-steps 100 \
+            --json "${j%.json}-$t.json"
+        done ;;
     esac
   done
   # Every JSON result in one file, and the tables of docs/benchmarks.md made from it.

@@ -47,6 +47,22 @@ MOTES_FN void body_integrate(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
   angvel = vec4(w, 0.0f);
 }
 
+/// One semi-implicit Euler step of a free particle (a one-particle body that does not spin), the
+/// linear half of body_integrate with the same arithmetic: v += dt (F/m + g); x += dt v.
+/// Static particles (vel.w, the inverse mass, == 0) are left untouched.
+MOTES_FN void particle_integrate(MOTES_INOUT(vec4) pos, MOTES_INOUT(vec4) vel, vec4 force,
+                                 vec4 gravity_dt) {
+  float inv_m = vel.w;
+  if (inv_m == 0.0f) {
+    return;
+  }
+  float dt = gravity_dt.w;
+  vec3 v = xyz(vel) + (xyz(force) * inv_m + xyz(gravity_dt)) * dt;
+  vec3 x = xyz(pos) + v * dt;
+  pos = vec4(x, pos.w);
+  vel = vec4(v, inv_m);
+}
+
 /// Torque about the centre of mass of a force applied at a particle centre.
 MOTES_FN vec3 particle_torque(vec4 particle_pos, vec4 body_pos, vec4 force) {
   return cross(xyz(particle_pos) - xyz(body_pos), xyz(force));

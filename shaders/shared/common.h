@@ -6,6 +6,9 @@
 //  - Float literals carry the f suffix (valid GLSL 4.50 and C++), so C++ never widens to double.
 //  - No pointers, templates, references or overloads that differ only by return type.
 //  - Types live in namespace motes::shared in C++ (MOTES_SHARED_BEGIN/END), globally in GLSL.
+//  - Where every backend must get bit-identical floats (the integer decisions of the neighbour
+//    lists), products go through mul_rn: a rounded product that no compiler may fuse into a
+//    multiply-add (CUDA __fmul_rn, GLSL `precise`; C++ in ISO mode does not contract).
 #ifndef MOTES_SHARED_COMMON_H
 #define MOTES_SHARED_COMMON_H
 
@@ -84,6 +87,18 @@ MOTES_FN float clamp(float x, float lo, float hi) { return min(max(x, lo), hi); 
 MOTES_FN float length(vec3 a) { return sqrt(dot(a, a)); }
 MOTES_FN vec3 xyz(vec4 v) { return vec3(v.x, v.y, v.z); }
 
+#ifdef __CUDACC__
+MOTES_FN float mul_rn(float a, float b) {
+#ifdef __CUDA_ARCH__
+  return __fmul_rn(a, b);
+#else
+  return a * b;
+#endif
+}
+#else
+MOTES_FN float mul_rn(float a, float b) { return a * b; }
+#endif
+
 MOTES_SHARED_END
 
 #else  // GLSL
@@ -94,6 +109,10 @@ MOTES_SHARED_END
 #define MOTES_SHARED_BEGIN
 #define MOTES_SHARED_END
 vec3 xyz(vec4 v) { return vec3(v.x, v.y, v.z); }
+float mul_rn(float a, float b) {
+  precise float r = a * b;
+  return r;
+}
 
 #endif
 

@@ -12,15 +12,19 @@ MOTES_SHARED_BEGIN
 
 /// Launch parameters of every kernel family; travels with the launch (push constants).
 struct StepParams {
-  vec4 gravity_dt;      // xyz: gravity (m/s^2), w: time step of this substep (s)
-  uint particle_count;  // N
-  uint body_count;      // B
-  uint table_mask;      // T - 1; the hashed grid has T = 2^k buckets
-  uint plane_count;     // P
-  float cell_size;      // grid cell edge (m) = largest particle diameter
-  float inv_cell_size;  // 1 / cell_size
-  uint material_count;  // M; pair table has M*M entries
-  uint flags;           // MOTES_FLAG_*
+  vec4 gravity_dt;            // xyz: gravity (m/s^2), w: time step of this substep (s)
+  uint particle_count;        // N
+  uint body_count;            // B: rigid bodies; they own particles [0, rigid_particle_count)
+  uint table_mask;            // T - 1; the hashed grid has T = 2^k buckets
+  uint plane_count;           // P
+  float cell_size;            // grid cell edge (m) = largest particle diameter + neighbour_skin
+  float inv_cell_size;        // 1 / cell_size
+  uint material_count;        // M; pair table has M*M entries
+  uint flags;                 // MOTES_FLAG_*
+  uint rigid_particle_count;  // Nr: particles [Nr, N) are free spheres, integrated as particles
+  uint neighbour_capacity;    // K: list entries kept per particle
+  float neighbour_skin;       // s (m): lists hold pairs closer than r_i + r_j + s
+  uint reserved;              // 0
 };
 
 /// Contact law of one pair of materials (symmetric): F_n = k d - gamma_n m* v_n,
@@ -44,9 +48,10 @@ struct PlaneData {
 MOTES_SHARED_END
 
 #ifdef __cplusplus
-static_assert(sizeof(motes::shared::StepParams) == 48, "StepParams layout");
+static_assert(sizeof(motes::shared::StepParams) == 64, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, particle_count) == 16, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, flags) == 44, "StepParams layout");
+static_assert(offsetof(motes::shared::StepParams, neighbour_skin) == 56, "StepParams layout");
 static_assert(sizeof(motes::shared::ContactLaw) == 16, "ContactLaw layout");
 static_assert(sizeof(motes::shared::PlaneData) == 32, "PlaneData layout");
 #endif

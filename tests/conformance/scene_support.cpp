@@ -98,6 +98,7 @@ motes::Status capture(motes::Simulation& sim, OracleRun& out) {
   if (s) s = read_all(sim, motes::Buffer::BodyFirst, out.bodies.first);
   if (s) s = read_all(sim, motes::Buffer::ContactLaws, out.laws);
   if (s) s = read_all(sim, motes::Buffer::Planes, out.planes);
+  out.particles.rigid = sim.sizes().rigid_particles;
   out.params = sim.step_params();
   out.substeps = sim.settings().substeps;
   return s;

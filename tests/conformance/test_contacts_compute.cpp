@@ -1,7 +1,12 @@
-// contacts_compute against the O(N^2) oracle, the kernel alone: the particles (ParticlePos/Vel/
-// Body/Material), the oracle's grid (GridOrder, GridCellStart, Sorted*) and the ContactLaws and
-// Planes are written to the device, every other buffer is poisoned, and ParticleForce (indexed by
-// particle id, w = 0) is read back.
+// contacts_compute against the O(N^2) oracle, the kernel alone. The lists are the oracle's,
+// built (with its grid) at positions X0; the particles have moved since, each by 0.4 skin in a
+// random direction, as between two rebuilds. Written: ParticlePos/Vel (now), ParticleBody,
+// ParticleMaterial, the lists (NeighbourList, NeighbourCount, NeighbourRefPos = X0), the grid of
+// X0 (GridOrder, GridCellStart, SortedBody: the walk of particles with more neighbours than K),
+// ContactLaws and Planes; every other buffer is poisoned; ParticleForce (by particle id, w = 0)
+// is read back. Each case runs twice: with K = 16, and with K = 2 so that most particles walk
+// the grid instead; the two forces must be equal, value for value (the same pairs in the same
+// order), and both close to the oracle's.
 //
 // Tolerance: NMSE 1e-7 (the default). Each term comes from the same shared function and the same
 // floats; the device sums the terms in float in the canonical order, the oracle in double in id
@@ -31,12 +36,66 @@ using motes::Buffer;
 
 constexpr double kTolerance = 1.0e-7;
 
+/// The lists of `g` (built at w.particles.pos) as a NeighbourList buffer of capacity K.
+std::vector<uint> list_buffer(const motes_ref::Neighbours& nb, uint capacity) {
+  const std::size_t n = nb.count.size();
+  std::vector<uint> out(std::size_t{capacity} * n, 0xFFFFFFFFu);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t k = 0; k < std::min<std::size_t>(nb.lists[i].size(), capacity); ++k) {
+      out[k * n + i] = nb.lists[i][k];
+    }
+  }
+  return out;
+}
+
 class ContactsCompute : public DeviceTest {
  protected:
+  /// ParticleForce on the device for lists of capacity K (the world's sizes otherwise).
+  std::vector<vec4> device_force(const World& w, const motes_ref::Grid& g,
+                                 const motes_ref::Neighbours& nb, const motes_ref::Particles& now,
+                                 uint capacity) {
+    motes::Sizes sizes = w.sizes;
+    sizes.neighbour_capacity = capacity;
+    StepParams params = w.params;
+    params.neighbour_capacity = capacity;
+    std::vector<vec4> got;
+    allocate(sizes);
+    if (HasFatalFailure()) return got;
+    poison_all_but({Buffer::ParticlePos, Buffer::ParticleVel, Buffer::ParticleBody,
+                    Buffer::ParticleMaterial, Buffer::NeighbourList, Buffer::NeighbourCount,
+                    Buffer::NeighbourRefPos, Buffer::GridOrder, Buffer::GridCellStart,
+                    Buffer::SortedBody, Buffer::ContactLaws, Buffer::Planes});
+    write(Buffer::ParticlePos, now.pos);
+    write(Buffer::ParticleVel, now.vel);
+    write(Buffer::ParticleBody, now.body);
+    write(Buffer::ParticleMaterial, now.material);
+    write(Buffer::NeighbourList, list_buffer(nb, capacity));
+    write(Buffer::NeighbourCount, nb.count);
+    write(Buffer::NeighbourRefPos, nb.ref);
+    write(Buffer::GridOrder, g.order);
+    write(Buffer::GridCellStart, g.cell_start);
+    write(Buffer::SortedBody, g.sorted_body);
+    write(Buffer::ContactLaws, w.laws);
+    write(Buffer::Planes, w.planes);
+    if (HasFatalFailure()) return got;
+    device().contacts_compute(params);
+    finish_kernel();
+    if (HasFatalFailure()) return got;
+    read(Buffer::ParticleForce, got);
+    return got;
+  }
+
   void run_case(const std::string& layout, const World& w) {
     const motes_ref::Grid g = motes_ref::grid_build(w.particles, w.params);
-    const std::vector<vec4> want =
-        motes_ref::contacts_compute(w.particles, w.laws, w.planes, w.params);
+    const motes_ref::Neighbours nb = motes_ref::neighbours_build(w.particles, g, w.params);
+    // The particles now: each dynamic one moved 0.4 skin since the lists were built.
+    motes_ref::Particles now = w.particles;
+    Rng rng(static_cast<std::uint32_t>(w.particles.size()) + 5u);
+    const std::vector<vec4> moved = moved_by(rng, w.particles.pos, w.params.neighbour_skin, 0.4f);
+    for (std::size_t i = 0; i < now.size(); ++i) {
+      if (now.vel[i].w != 0.0f) now.pos[i] = moved[i];
+    }
+    const std::vector<vec4> want = motes_ref::contacts_compute(now, w.laws, w.planes, w.params);
     const std::size_t n = w.particles.size();
     // The layout must really make contacts, or the case proves little.
     std::size_t pushed = 0;
@@ -44,85 +103,84 @@ class ContactsCompute : public DeviceTest {
     if (n >= 31) {
       ASSERT_GE(pushed, n / 4) << "too few particles touch anything";
     }
+    std::size_t walking = 0;
+    for (uint c : nb.count) walking += c > 2 ? 1 : 0;
 
-    ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
-    ASSERT_NO_FATAL_FAILURE(poison_all_but(
-        {Buffer::ParticlePos, Buffer::ParticleVel, Buffer::ParticleBody, Buffer::ParticleMaterial,
-         Buffer::GridOrder, Buffer::GridCellStart, Buffer::SortedPos, Buffer::SortedVel,
-         Buffer::SortedBody, Buffer::SortedMaterial, Buffer::ContactLaws, Buffer::Planes}));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleVel, w.particles.vel));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleBody, w.particles.body));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleMaterial, w.particles.material));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::GridOrder, g.order));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::GridCellStart, g.cell_start));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::SortedPos, g.sorted_pos));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::SortedVel, g.sorted_vel));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::SortedBody, g.sorted_body));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::SortedMaterial, g.sorted_material));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::ContactLaws, w.laws));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::Planes, w.planes));
-    device().contacts_compute(w.params);
-    ASSERT_NO_FATAL_FAILURE(finish_kernel());
-    std::vector<vec4> got;
-    ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticleForce, got));
+    const std::vector<vec4> listed = device_force(w, g, nb, now, w.params.neighbour_capacity);
+    ASSERT_FALSE(HasFatalFailure());
+    const std::vector<vec4> walked = device_force(w, g, nb, now, 2);
+    ASSERT_FALSE(HasFatalFailure());
 
     // Static particles: exactly zero, whatever the sign of zero.
     std::vector<uint> static_nonzero;
     for (std::size_t i = 0; i < n; ++i) {
       if (w.particles.vel[i].w != 0.0f) continue;
-      const vec4 f = got[i];
+      const vec4 f = listed[i];
       static_nonzero.push_back(f.x != 0.0f || f.y != 0.0f || f.z != 0.0f || f.w != 0.0f ? 1 : 0);
     }
+    // The lists and the walk: the same value (-0 and +0 alike) in every component.
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < std::min(listed.size(), walked.size()); ++i) {
+      const vec4 a = listed[i], b = walked[i];
+      differ += a.x == b.x && a.y == b.y && a.z == b.z && a.w == b.w ? 0 : 1;
+    }
     begin_case("contacts_compute/" + layout, n);
-    check_close("ParticleForce", got, want, kTolerance);
+    check_close("ParticleForce", listed, want, kTolerance);
+    check_close("ParticleForce (K = 2: walks)", walked, want, kTolerance);
+    check_that("K = 2 and K = 16 give the same forces",
+               differ == 0 && listed.size() == walked.size());
+    check_that("some particles walk the grid at K = 2", n < 31 || walking > 0);
     check_identical("ParticleForce of static particles is 0", static_nonzero,
                     std::vector<uint>(static_nonzero.size(), 0u));
     end_case();
   }
 };
 
-TEST_P(ContactsCompute, Empty) { run_case("random", random_world(21, 0)); }
-TEST_P(ContactsCompute, One) { run_case("random", random_world(22, 1)); }
-TEST_P(ContactsCompute, Random31) { run_case("random", random_world(23, 31)); }
-TEST_P(ContactsCompute, Random1234) { run_case("random", random_world(24, 1234)); }
+TEST_P(ContactsCompute, Empty) { run_case("random", random_world(21, 0, 0, kTestSkin)); }
+TEST_P(ContactsCompute, One) { run_case("random", random_world(22, 1, 0, kTestSkin)); }
+TEST_P(ContactsCompute, Random31) { run_case("random", random_world(23, 31, 0, kTestSkin)); }
+TEST_P(ContactsCompute, Random1234) { run_case("random", random_world(24, 1234, 0, kTestSkin)); }
 TEST_P(ContactsCompute, Random1234Clamped) {
-  run_case("random_clamped", random_world(24, 1234, MOTES_FLAG_CLAMP_ATTRACTION));
+  run_case("random_clamped", random_world(24, 1234, MOTES_FLAG_CLAMP_ATTRACTION, kTestSkin));
 }
 TEST_P(ContactsCompute, Random20000) {
-  run_case("random_clamped", random_world(25, 20000, MOTES_FLAG_CLAMP_ATTRACTION));
+  run_case("random_clamped", random_world(25, 20000, MOTES_FLAG_CLAMP_ATTRACTION, kTestSkin));
 }
 
 TEST_P(ContactsCompute, OnCellFacesExactCell) {
-  // Exact face coordinates: many pairs at exactly rsum (no contact) or coincident (no force).
+  // Exact face coordinates (cell 0.5 + 0.125 m): many pairs at exactly the cutoff, or coincident,
+  // when the lists are built; then everything moves.
   Rng rng(26);
-  run_case("on_cell_faces_exact",
-           make_world(rng, on_cell_faces(rng, 1234, 0.25f), MOTES_FLAG_CLAMP_ATTRACTION, true));
+  run_case("on_cell_faces_exact", make_world(rng, on_cell_faces(rng, 1234, 0.25f, 0.125f),
+                                             MOTES_FLAG_CLAMP_ATTRACTION, true, 0.125f));
 }
 
 TEST_P(ContactsCompute, OnCellFacesInexactCell) {
   Rng rng(27);
-  run_case("on_cell_faces_inexact", make_world(rng, on_cell_faces(rng, 1234, 0.005f), 0, true));
+  run_case("on_cell_faces_inexact",
+           make_world(rng, on_cell_faces(rng, 1234, 0.005f, kTestSkin), 0, true, kTestSkin));
 }
 
 TEST_P(ContactsCompute, AllInOneCell) {
-  // Every pair of different bodies overlaps: ~300 terms per particle.
+  // 300 particles in one cell: many terms per particle, most lists beyond K.
   Rng rng(28);
   run_case("one_cell",
-           make_world(rng, one_cell(rng, 300, 0.005f, vec3(0.07f, -0.03f, 0.11f)), 0, true));
+           make_world(rng, one_cell(rng, 300, 0.005f, vec3(0.07f, -0.03f, 0.11f), kTestSkin), 0,
+                      true, kTestSkin));
 }
 
 TEST_P(ContactsCompute, FarFromOrigin) {
   Rng rng(29);
   const float rmax = 0.05f;
   auto pos = random_cloud(rng, 1234, rmax, dense_side(1234, rmax), vec3(1e5f, -1e5f, 1e5f));
-  run_case("far_1e5", make_world(rng, std::move(pos), MOTES_FLAG_CLAMP_ATTRACTION, false));
+  // A skin of 0.1 m: positions here round to 8 mm, and the moves must stay inside half a skin.
+  run_case("far_1e5", make_world(rng, std::move(pos), MOTES_FLAG_CLAMP_ATTRACTION, false, 0.1f));
 }
 
 TEST_P(ContactsCompute, SmallTable) {
   // T = 64 for 1234 particles: rows share buckets all the time, so a bucket visited twice (or
-  // skipped) by the 27-cell walk changes the force.
-  World w = random_world(30, 1234);
+  // skipped) by the walk changes the force.
+  World w = random_world(30, 1234, 0, kTestSkin);
   w.sizes.table = 64;
   w.params.table_mask = 63;
   run_case("table_64", w);

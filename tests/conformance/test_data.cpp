@@ -105,8 +105,8 @@ float dense_side(std::size_t n, float rmax) {
   return static_cast<float>(std::cbrt(3.53 * static_cast<double>(n))) * rmax;
 }
 
-std::vector<vec4> on_cell_faces(Rng& rng, std::size_t n, float rmax) {
-  const float cell = 2.0f * rmax;
+std::vector<vec4> on_cell_faces(Rng& rng, std::size_t n, float rmax, float skin) {
+  const float cell = 2.0f * rmax + skin;
   std::vector<vec4> out;
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t mode = rng.below(3);  // 3, 2 or 1 coordinates on a face
@@ -125,8 +125,8 @@ std::vector<vec4> on_cell_faces(Rng& rng, std::size_t n, float rmax) {
   return out;
 }
 
-std::vector<vec4> one_cell(Rng& rng, std::size_t n, float rmax, vec3 corner) {
-  const float cell = 2.0f * rmax;
+std::vector<vec4> one_cell(Rng& rng, std::size_t n, float rmax, vec3 corner, float skin) {
+  const float cell = 2.0f * rmax + skin;
   std::vector<vec4> out;
   for (std::size_t i = 0; i < n; ++i) {
     out.emplace_back(corner.x + rng.uniform(0.05f, 0.95f) * cell,
@@ -151,17 +151,20 @@ std::vector<vec4> with_huge_coordinates(Rng& rng, std::size_t n, float rmax) {
   return out;
 }
 
-World make_world(Rng& rng, std::vector<vec4> positions, std::uint32_t flags, bool tilted_plane) {
+World make_world(Rng& rng, std::vector<vec4> positions, std::uint32_t flags, bool tilted_plane,
+                 float skin) {
   World w;
   const std::size_t n = positions.size();
+  const std::size_t rigid = n - n * 3 / 10;
   motes_ref::Particles& p = w.particles;
   motes_ref::Bodies& b = w.bodies;
   p.pos = std::move(positions);
   p.vel.resize(n);
-  p.local.resize(n);
+  p.local.resize(rigid);
   p.body.resize(n);
   p.material.resize(n);
-  for (std::size_t i = 0; i < n;) {
+  p.rigid = rigid;
+  for (std::size_t i = 0; i < rigid;) {
     // Runs of 1 (60%), 2-8 (30%) or 9-64 (10%) particles make one body.
     const float kind = rng.unit();
     std::size_t len = 1;
@@ -170,7 +173,7 @@ World make_world(Rng& rng, std::vector<vec4> positions, std::uint32_t flags, boo
     } else if (kind > 0.6f) {
       len = 2 + rng.below(7);
     }
-    len = std::min(len, n - i);
+    len = std::min(len, rigid - i);
     const bool is_static = rng.chance(0.1f);
     const float inv_particle_mass = is_static ? 0.0f : rng.uniform(500.0f, 2000.0f);
     const auto body = static_cast<uint>(b.first.size());
@@ -191,7 +194,12 @@ World make_world(Rng& rng, std::vector<vec4> positions, std::uint32_t flags, boo
                    inv_particle_mass / static_cast<float>(len));
     i += len;
   }
-  b.first.push_back(static_cast<uint>(n));
+  b.first.push_back(static_cast<uint>(rigid));
+  for (std::size_t i = rigid; i < n; ++i) {  // free spheres
+    p.vel[i] = random_vec(rng, 1.0f, rng.uniform(500.0f, 2000.0f));
+    p.body[i] = static_cast<uint>(b.pos.size() + (i - rigid));
+    p.material[i] = rng.below(3);
+  }
 
   w.laws = three_materials();
   w.planes = planes_around(p.pos, tilted_plane);
@@ -199,8 +207,11 @@ World make_world(Rng& rng, std::vector<vec4> positions, std::uint32_t flags, boo
   float cell = 0.0f;
   for (const vec4& x : p.pos) cell = std::max(cell, 2.0f * x.w);
   if (n == 0) cell = 1.0f;
+  cell += skin;
   w.sizes.particles = static_cast<std::uint32_t>(n);
+  w.sizes.rigid_particles = static_cast<std::uint32_t>(rigid);
   w.sizes.bodies = static_cast<std::uint32_t>(b.pos.size());
+  w.sizes.neighbour_capacity = 16;
   w.sizes.table = motes::grid_table_size(w.sizes.particles);
   w.sizes.materials = 3;
   w.sizes.planes = static_cast<std::uint32_t>(w.planes.size());
@@ -216,6 +227,9 @@ World make_world(Rng& rng, std::vector<vec4> positions, std::uint32_t flags, boo
   sp.inv_cell_size = static_cast<float>(1.0 / static_cast<double>(cell));
   sp.material_count = w.sizes.materials;
   sp.flags = flags;
+  sp.rigid_particle_count = w.sizes.rigid_particles;
+  sp.neighbour_capacity = w.sizes.neighbour_capacity;
+  sp.neighbour_skin = skin;
   return w;
 }
 
@@ -243,12 +257,24 @@ World random_bodies(std::uint32_t seed, std::size_t bodies) {
   return w;
 }
 
-World random_world(std::uint32_t seed, std::size_t n, std::uint32_t flags) {
+std::vector<vec4> moved_by(Rng& rng, const std::vector<vec4>& pos, float skin, float fraction) {
+  std::vector<vec4> out = pos;
+  for (vec4& x : out) {
+    vec4 d = random_vec(rng, 1.0f);
+    while (d.x * d.x + d.y * d.y + d.z * d.z < 0.01f) d = random_vec(rng, 1.0f);
+    const float len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    const float s = fraction * skin / len;
+    x = vec4(x.x + d.x * s, x.y + d.y * s, x.z + d.z * s, x.w);
+  }
+  return out;
+}
+
+World random_world(std::uint32_t seed, std::size_t n, std::uint32_t flags, float skin) {
   Rng rng(seed);
   const float rmax = 0.005f;
   std::vector<vec4> pos =
       random_cloud(rng, n, rmax, dense_side(n, rmax), vec3(-0.02f, 0.01f, -0.03f));
-  return make_world(rng, std::move(pos), flags, true);
+  return make_world(rng, std::move(pos), flags, true, skin);
 }
 
 }  // namespace motes_conf

@@ -56,28 +56,37 @@ struct World {
 std::vector<vec4> random_cloud(Rng& rng, std::size_t n, float rmax, float side, vec3 origin);
 /// A cube side for random_cloud that gives about four overlapping neighbours per particle.
 float dense_side(std::size_t n, float rmax);
-/// Coordinates that are whole multiples of the cell size 2 rmax (one, two or all three of them):
-/// particles on cell faces, edges and corners, many touching or coincident.
-std::vector<vec4> on_cell_faces(Rng& rng, std::size_t n, float rmax);
-/// Every particle inside the one cell whose lowest corner is `corner`.
-std::vector<vec4> one_cell(Rng& rng, std::size_t n, float rmax, vec3 corner);
+/// Coordinates that are whole multiples of the cell size 2 rmax + skin (one, two or all three of
+/// them): particles on cell faces, edges and corners, many touching or coincident.
+std::vector<vec4> on_cell_faces(Rng& rng, std::size_t n, float rmax, float skin = 0.0f);
+/// Every particle inside the one cell (edge 2 rmax + skin) whose lowest corner is `corner`.
+std::vector<vec4> one_cell(Rng& rng, std::size_t n, float rmax, vec3 corner, float skin = 0.0f);
 /// A random cloud plus particles at huge coordinates (up to 1e30 m), where the cell index clamps.
 std::vector<vec4> with_huge_coordinates(Rng& rng, std::size_t n, float rmax);
 
-/// Builds a world around `positions`: bodies are runs of consecutive particles (one particle to
-/// 64, about 10% static with inverse mass 0), random velocities, three materials with an
-/// asymmetric law table (caps and no caps), planes touching the cloud, random body states;
-/// cell size = the largest diameter, T = motes::grid_table_size(N). The planes are a floor and a
-/// wall, plus a tilted one when `tilted_plane`: far from the origin a tilted plane's gap
-/// dot(n, x) - offset is only good to about ulp(|x|) (8 mm at 1e5 m), so fused and unfused
+/// Builds a world around `positions`: the first 70% of the particles make rigid bodies, runs of
+/// consecutive particles (one particle to 64, about 10% static with inverse mass 0), the rest are
+/// free spheres (dynamic, body B + k); random velocities, three materials with an asymmetric law
+/// table (caps and no caps), planes touching the cloud, random body states; neighbour skin `skin`,
+/// cell size = the largest diameter + skin, T = motes::grid_table_size(N), K = 16. The planes are a
+/// floor and a wall, plus a tilted one when `tilted_plane`: far from the origin a tilted plane's
+/// gap dot(n, x) - offset is only good to about ulp(|x|) (8 mm at 1e5 m), so fused and unfused
 /// arithmetic may rightly disagree there; axis-aligned planes are exact at any distance.
-World make_world(Rng& rng, std::vector<vec4> positions, std::uint32_t flags, bool tilted_plane);
+World make_world(Rng& rng, std::vector<vec4> positions, std::uint32_t flags, bool tilted_plane,
+                 float skin = 0.0f);
 
 /// `bodies` bodies without particles (N = 0), for bodies_integrate: random poses, velocities,
 /// angular momenta, inertia, forces and torques; about 10% static.
 World random_bodies(std::uint32_t seed, std::size_t bodies);
 
 /// Particles in a cloud of about `n` particles with random bodies (make_world).
-World random_world(std::uint32_t seed, std::size_t n, std::uint32_t flags = 0);
+World random_world(std::uint32_t seed, std::size_t n, std::uint32_t flags = 0, float skin = 0.0f);
+
+/// Each position moved by `fraction` * skin in a random direction (w kept): the positions of the
+/// last neighbour-list build, as seen from `pos`, or later positions as seen from a build.
+std::vector<vec4> moved_by(Rng& rng, const std::vector<vec4>& pos, float skin, float fraction);
+
+/// The skin the neighbour-list cases use with random_world's radii (rmax = 5 mm): 1 mm.
+constexpr float kTestSkin = 0.001f;
 
 }  // namespace motes_conf

@@ -1,8 +1,12 @@
 // particles_update against the oracle, the kernel alone: ParticleBody, ParticleLocal, ParticlePos
-// and ParticleVel (their w: radius and inverse mass) and the body pose (BodyPos, BodyQuat,
-// BodyVel, BodyAngVel) are written, every other buffer is poisoned; ParticlePos and ParticleVel
-// are read back. Their xyz are compared by NMSE, their w (radius, inverse mass: other quantities,
-// and kept by the kernel) bitwise.
+// and ParticleVel (their w: radius and inverse mass), the body pose (BodyPos, BodyQuat, BodyVel,
+// BodyAngVel), NeighbourRefPos and NeighbourState are written, every other buffer is poisoned;
+// ParticlePos, ParticleVel and NeighbourState are read back. Only the rigid particles [0, Nr)
+// move: the free ones must come back bitwise as written. Their xyz are compared by NMSE, their w
+// (radius, inverse mass: other quantities, and kept by the kernel) bitwise; the rebuild word of
+// NeighbourState must be set exactly when a particle ends 0.45 skin or more from its
+// NeighbourRefPos (the refs sit at 0.3 or 0.6 skin from the new positions), and nothing else of
+// NeighbourState may change.
 //
 // Tolerance: NMSE 1e-10. The same shared particle_position and particle_velocity run on the same
 // floats, so openmp matches bitwise (measures 0); a GPU's fused multiply-adds change each
@@ -15,6 +19,7 @@
 
 #include "conformance.h"
 #include "reference/reference.h"
+#include "shared/neighbours.h"
 #include "test_data.h"
 
 namespace motes_conf {
@@ -26,13 +31,27 @@ constexpr double kTolerance = 1.0e-10;
 
 class ParticlesUpdate : public DeviceTest {
  protected:
-  void run_case(const std::string& layout, const World& w) {
+  /// `far`: one rigid particle's ref sits 0.6 skin away (a rebuild is due), the others 0.3.
+  void run_case(const std::string& layout, World w, bool far) {
+    w.params.neighbour_skin = kTestSkin;
     motes_ref::Particles want = w.particles;
-    motes_ref::particles_update(w.bodies, want);
+    motes_ref::particles_update(w.bodies, want, w.params);
+    Rng rng(static_cast<std::uint32_t>(w.sizes.particles) + 99u);
+    std::vector<vec4> ref = moved_by(rng, want.pos, kTestSkin, 0.3f);
+    if (far && w.particles.rigid > 0) {
+      const std::size_t k = w.particles.rigid / 2;
+      ref[k] = moved_by(rng, {want.pos[k]}, kTestSkin, 0.6f)[0];
+    }
+    motes_ref::Particles again = w.particles;
+    const bool rebuild = motes_ref::particles_update(w.bodies, again, w.params, ref);
+    ASSERT_EQ(rebuild, far && w.particles.rigid > 0) << "the case's own premise";
+    const std::vector<uint> state_in = {0u, 7u, 3u, 5u};
+
     ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
-    ASSERT_NO_FATAL_FAILURE(poison_all_but(
-        {Buffer::ParticleBody, Buffer::ParticleLocal, Buffer::ParticlePos, Buffer::ParticleVel,
-         Buffer::BodyPos, Buffer::BodyQuat, Buffer::BodyVel, Buffer::BodyAngVel}));
+    ASSERT_NO_FATAL_FAILURE(
+        poison_all_but({Buffer::ParticleBody, Buffer::ParticleLocal, Buffer::ParticlePos,
+                        Buffer::ParticleVel, Buffer::BodyPos, Buffer::BodyQuat, Buffer::BodyVel,
+                        Buffer::BodyAngVel, Buffer::NeighbourRefPos, Buffer::NeighbourState}));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleBody, w.particles.body));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleLocal, w.particles.local));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
@@ -41,27 +60,45 @@ class ParticlesUpdate : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyQuat, w.bodies.quat));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyVel, w.bodies.vel));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyAngVel, w.bodies.angvel));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourRefPos, ref));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourState, state_in));
     device().particles_update(w.params);
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<vec4> pos;
     std::vector<vec4> vel;
+    std::vector<uint> state;
     ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticlePos, pos));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticleVel, vel));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourState, state));
+
+    const std::size_t rigid = w.particles.rigid;
+    const auto head = [&](const std::vector<vec4>& v) {
+      return std::vector<vec4>(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(rigid));
+    };
+    const auto tail = [&](const std::vector<vec4>& v) {
+      return std::vector<vec4>(v.begin() + static_cast<std::ptrdiff_t>(rigid), v.end());
+    };
+    std::vector<uint> state_want = state_in;
+    if (rebuild) state_want[MOTES_NEIGHBOUR_REBUILD] = 1u;
 
     begin_case("particles_update/" + layout, w.sizes.particles);
-    check_close("ParticlePos", pos, want.pos, kTolerance, Part::Xyz);
-    check_close("ParticleVel", vel, want.vel, kTolerance, Part::Xyz);
+    check_close("ParticlePos", head(pos), head(want.pos), kTolerance, Part::Xyz);
+    check_close("ParticleVel", head(vel), head(want.vel), kTolerance, Part::Xyz);
     check_w_identical("ParticlePos.w (radius) kept", pos, w.particles.pos);
     check_w_identical("ParticleVel.w (inverse mass) kept", vel, w.particles.vel);
+    check_identical("free particles' ParticlePos untouched", tail(pos), tail(w.particles.pos));
+    check_identical("free particles' ParticleVel untouched", tail(vel), tail(w.particles.vel));
+    check_identical("NeighbourState", state, state_want);
     end_case();
   }
 };
 
-TEST_P(ParticlesUpdate, Empty) { run_case("random", random_world(61, 0)); }
-TEST_P(ParticlesUpdate, One) { run_case("random", random_world(62, 1)); }
-TEST_P(ParticlesUpdate, Random31) { run_case("random", random_world(63, 31)); }
-TEST_P(ParticlesUpdate, Random1234) { run_case("random", random_world(64, 1234)); }
-TEST_P(ParticlesUpdate, Random65536) { run_case("random", random_world(65, 65536)); }
+TEST_P(ParticlesUpdate, Empty) { run_case("random", random_world(61, 0), false); }
+TEST_P(ParticlesUpdate, One) { run_case("random", random_world(62, 1), false); }
+TEST_P(ParticlesUpdate, Random31) { run_case("random", random_world(63, 31), true); }
+TEST_P(ParticlesUpdate, Random1234) { run_case("random", random_world(64, 1234), false); }
+TEST_P(ParticlesUpdate, Random1234Moved) { run_case("moved_far", random_world(64, 1234), true); }
+TEST_P(ParticlesUpdate, Random65536) { run_case("random", random_world(65, 65536), true); }
 
 INSTANTIATE_TEST_SUITE_P(Conformance, ParticlesUpdate, testing::ValuesIn(device_params()),
                          param_name);

@@ -9,6 +9,7 @@
 #include "shared/body_math.h"
 #include "shared/contact_force.h"
 #include "shared/grid_hash.h"
+#include "shared/neighbours.h"
 
 namespace motes_ref {
 
@@ -53,6 +54,54 @@ Grid grid_build(const Particles& particles, const StepParams& p) {
     g.sorted_material[k] = particles.material[i];
   }
   return g;
+}
+
+std::vector<uint> walk_buckets(vec4 x, const StepParams& p) {
+  using motes::shared::grid_cell_coord;
+  const int cx = grid_cell_coord(x.x, p.inv_cell_size);
+  const int cy = grid_cell_coord(x.y, p.inv_cell_size);
+  const int cz = grid_cell_coord(x.z, p.inv_cell_size);
+  std::vector<uint> seq;
+  for (int dz = -1; dz <= 1; ++dz) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const uint b = motes::shared::grid_bucket(cx + dx, cy + dy, cz + dz, p.table_mask);
+        if (std::find(seq.begin(), seq.end(), b) == seq.end()) seq.push_back(b);
+      }
+    }
+  }
+  return seq;
+}
+
+Neighbours neighbours_build(const Particles& particles, const Grid& grid, const StepParams& p) {
+  const std::size_t n = particles.size();
+  std::vector<uint> slot(n, 0u);
+  for (std::size_t s = 0; s < n; ++s) slot[grid.order[s]] = static_cast<uint>(s);
+  Neighbours out;
+  out.lists.resize(n);
+  out.count.assign(n, 0u);
+  out.ref = particles.pos;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (particles.vel[i].w == 0.0f) continue;  // static: no list
+    const std::vector<uint> walk = walk_buckets(particles.pos[i], p);
+    std::vector<std::pair<std::size_t, uint>> found;  // (place on the walk, slot) of each j
+    for (std::size_t j = 0; j < n; ++j) {
+      if (particles.body[j] == particles.body[i]) continue;  // includes j == i
+      const auto on_walk = std::find(walk.begin(), walk.end(), grid.bucket[j]);
+      if (on_walk == walk.end()) continue;
+      if (!motes::shared::neighbour_within(particles.pos[i], particles.pos[j], p.neighbour_skin)) {
+        continue;
+      }
+      found.emplace_back(static_cast<std::size_t>(on_walk - walk.begin()), slot[j]);
+    }
+    std::sort(found.begin(), found.end());
+    for (const auto& [place, s] : found) out.lists[i].push_back(grid.order[s]);
+    const auto c = static_cast<uint>(found.size());
+    out.count[i] = c;
+    out.over_capacity += c > p.neighbour_capacity ? 1u : 0u;
+    out.max_count = std::max(out.max_count, c);
+  }
+  return out;
 }
 
 std::vector<vec4> contacts_compute(const Particles& particles, const std::vector<ContactLaw>& laws,
@@ -117,8 +166,10 @@ void bodies_integrate(Bodies& bodies, const StepParams& p) {
   }
 }
 
-void particles_update(const Bodies& bodies, Particles& particles) {
-  for (std::size_t i = 0; i < particles.size(); ++i) {
+bool particles_update(const Bodies& bodies, Particles& particles, const StepParams& p,
+                      const std::vector<vec4>& ref) {
+  bool moved = false;
+  for (std::size_t i = 0; i < particles.rigid; ++i) {
     const uint b = particles.body[i];
     const vec4 local = particles.local[i];
     particles.pos[i] = vec4(motes::shared::particle_position(bodies.pos[b], bodies.quat[b], local),
@@ -126,7 +177,25 @@ void particles_update(const Bodies& bodies, Particles& particles) {
     particles.vel[i] = vec4(
         motes::shared::particle_velocity(bodies.quat[b], bodies.vel[b], bodies.angvel[b], local),
         particles.vel[i].w);
+    if (!ref.empty()) {
+      moved = motes::shared::neighbour_moved_too_far(particles.pos[i], ref[i], p.neighbour_skin) ||
+              moved;
+    }
   }
+  return moved;
+}
+
+bool particles_integrate(Particles& particles, const std::vector<vec4>& force, const StepParams& p,
+                         const std::vector<vec4>& ref) {
+  bool moved = false;
+  for (std::size_t i = particles.rigid; i < particles.size(); ++i) {
+    motes::shared::particle_integrate(particles.pos[i], particles.vel[i], force[i], p.gravity_dt);
+    if (!ref.empty()) {
+      moved = motes::shared::neighbour_moved_too_far(particles.pos[i], ref[i], p.neighbour_skin) ||
+              moved;
+    }
+  }
+  return moved;
 }
 
 void step(Particles& particles, Bodies& bodies, const std::vector<ContactLaw>& laws,
@@ -134,7 +203,8 @@ void step(Particles& particles, Bodies& bodies, const std::vector<ContactLaw>& l
   const std::vector<vec4> force = contacts_compute(particles, laws, planes, p);
   bodies_reduce(particles.pos, force, bodies);
   bodies_integrate(bodies, p);
-  particles_update(bodies, particles);
+  particles_update(bodies, particles, p);
+  particles_integrate(particles, force, p);
 }
 
 }  // namespace motes_ref

@@ -21,13 +21,15 @@ using motes::shared::StepParams;
 using motes::shared::uint;
 using motes::shared::vec4;
 
-/// Per-particle buffers (N each), as in motes::Buffer::Particle*.
+/// Per-particle buffers (N each), as in motes::Buffer::Particle*: the rigid bodies' particles
+/// [0, rigid) first, then free spheres.
 struct Particles {
   std::vector<vec4> pos;       ///< xyz, w = radius
   std::vector<vec4> vel;       ///< xyz, w = inverse mass (0 = static)
-  std::vector<vec4> local;     ///< body-frame offset from the body's centre of mass
-  std::vector<uint> body;      ///< body index
+  std::vector<vec4> local;     ///< (rigid) body-frame offset from the body's centre of mass
+  std::vector<uint> body;      ///< body index (B + k for the k-th free sphere)
   std::vector<uint> material;  ///< material index
+  std::size_t rigid = 0;       ///< Nr: particles of rigid bodies
   [[nodiscard]] std::size_t size() const { return pos.size(); }
 };
 
@@ -61,6 +63,26 @@ struct Grid {
 /// bucket starts, and copies of the particle data in that order.
 Grid grid_build(const Particles& particles, const StepParams& p);
 
+/// Outputs of neighbours_build (NeighbourList, NeighbourCount, NeighbourRefPos, NeighbourState).
+struct Neighbours {
+  std::vector<std::vector<uint>> lists;  ///< per particle, every neighbour in canonical order
+  std::vector<uint> count;               ///< N: lists[i].size()
+  std::vector<vec4> ref;                 ///< N: the positions it was built at
+  uint over_capacity = 0;                ///< particles with more than K neighbours
+  uint max_count = 0;                    ///< the largest count
+};
+
+/// The order in which the 27-cell walk from the cell of x visits buckets: the buckets of cells
+/// (cx + dx, cy + dy, cz + dz) for dz = -1..1, dy = -1..1, dx = -1..1, each at its first
+/// occurrence (the definition of docs/architecture.md, written without ranges or rows).
+std::vector<uint> walk_buckets(vec4 x, const StepParams& p);
+
+/// neighbours_build, by brute force: for every dynamic particle i, every particle j of another
+/// body whose bucket is on i's walk and that shared::neighbour_within(i, j, skin) accepts, sorted
+/// by (place of j's bucket on the walk, j's slot in grid.order); static particles get none.
+/// ref = pos. over_capacity and max_count against p.neighbour_capacity.
+Neighbours neighbours_build(const Particles& particles, const Grid& grid, const StepParams& p);
+
 /// contacts_compute, by brute force over all pairs: the force on dynamic particle i is the sum,
 /// over every particle j of another body, of shared::particle_contact_force with law
 /// laws[material_i * M + material_j], plus shared::plane_contact_force of each plane with law
@@ -79,12 +101,19 @@ void bodies_reduce(const std::vector<vec4>& particle_pos, const std::vector<vec4
 /// bodies_integrate: shared::body_integrate on every body, with p.gravity_dt.
 void bodies_integrate(Bodies& bodies, const StepParams& p);
 
-/// particles_update: ParticlePos/Vel xyz from the body pose (shared::particle_position and
-/// particle_velocity); w (radius, inverse mass) kept.
-void particles_update(const Bodies& bodies, Particles& particles);
+/// particles_update: ParticlePos/Vel xyz of the rigid particles [0, particles.rigid) from the body
+/// pose (shared::particle_position and particle_velocity); w (radius, inverse mass) kept. Returns
+/// whether one has moved too far from `ref` (shared::neighbour_moved_too_far); empty ref: false.
+bool particles_update(const Bodies& bodies, Particles& particles, const StepParams& p,
+                      const std::vector<vec4>& ref = {});
 
-/// One whole step in the core's order (grid_build is skipped: the brute-force contacts do not
-/// need it).
+/// particles_integrate: shared::particle_integrate on the free particles [particles.rigid, N)
+/// with `force`; returns whether one has moved too far from `ref` (empty ref: false).
+bool particles_integrate(Particles& particles, const std::vector<vec4>& force, const StepParams& p,
+                         const std::vector<vec4>& ref = {});
+
+/// One whole step in the core's order (the grid and the lists are skipped: the brute-force
+/// contacts do not need them).
 void step(Particles& particles, Bodies& bodies, const std::vector<ContactLaw>& laws,
           const std::vector<PlaneData>& planes, const StepParams& p);
 

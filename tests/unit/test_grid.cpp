@@ -195,6 +195,8 @@ void check_on_device(const Particles& p, std::uint32_t flags, const motes::Devic
   const std::vector<PlaneData> planes = planes_through(p);
   motes::Sizes sizes;
   sizes.particles = n;
+  sizes.rigid_particles = n;
+  sizes.neighbour_capacity = 16;
   sizes.bodies = static_cast<std::uint32_t>(p.body_first.size() - 1);
   sizes.table = motes::grid_table_size(n);
   sizes.materials = kMaterials;
@@ -234,8 +236,12 @@ void check_on_device(const Particles& p, std::uint32_t flags, const motes::Devic
   params.inv_cell_size = 1.0f / cell;
   params.material_count = kMaterials;
   params.flags = flags;
+  params.rigid_particle_count = n;
+  params.neighbour_capacity = sizes.neighbour_capacity;
+  params.neighbour_skin = 0.0f;  // lists of exactly the touching pairs
 
   dev.grid_build(params);
+  dev.neighbours_build(params);
   dev.contacts_compute(params);
   ASSERT_TRUE(dev.synchronize());
   const auto bucket = read_all<std::uint32_t>(dev, motes::Buffer::GridBucket, sizes);

@@ -33,7 +33,11 @@ struct Settings {
   bool clamp_attraction = false;             ///< forbid attractive (tensile) normal forces
   double duration = 1.0;                     ///< default simulated time for `motes run` (s)
   double output_interval = 1.0 / 60.0;       ///< simulated time between output frames (s)
-  Material contact;                          ///< defaults for materials' missing fields
+  /// Neighbour-list skin (m): lists are rebuilt when a particle has moved 0.45 of it; < 0: 10% of
+  /// the largest particle diameter. 0 rebuilds every substep.
+  double neighbour_skin = -1.0;
+  int neighbour_capacity = 16;  ///< list entries per particle; beyond, a particle walks the grid
+  Material contact;             ///< defaults for materials' missing fields
 };
 
 enum class BodyKind { Dynamic, Static };

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "motes/backend/device.h"
@@ -13,14 +14,16 @@
 
 namespace motes {
 
-/// State read back from the device (vec4 layouts as in motes::Buffer).
+/// State read back from the device (vec4 layouts as in motes::Buffer), in the scene's order: body
+/// b is the scene's b-th body and its particles are [BodyInfo::first_particle, + particle_count).
+/// A free sphere's body state is its particle's (orientation fixed, no angular momentum).
 struct Snapshot {
   double time = 0.0;
   std::uint64_t step = 0;
-  std::vector<shared::vec4> particle_pos;  ///< xyz, w = radius
-  std::vector<shared::vec4> particle_vel;  ///< xyz, w = inverse mass
-  std::vector<std::uint32_t> particle_body;
-  std::vector<shared::vec4> body_pos;  ///< centre of mass, w = inverse mass
+  std::vector<shared::vec4> particle_pos;    ///< xyz, w = radius
+  std::vector<shared::vec4> particle_vel;    ///< xyz, w = inverse mass
+  std::vector<std::uint32_t> particle_body;  ///< scene body index
+  std::vector<shared::vec4> body_pos;        ///< centre of mass, w = inverse mass
   std::vector<shared::vec4> body_quat;
   std::vector<shared::vec4> body_vel;
   std::vector<shared::vec4> body_angmom;
@@ -32,8 +35,18 @@ struct BodyInfo {
   std::string name;
   BodyKind kind = BodyKind::Dynamic;
   double mass = 0.0;
-  std::uint32_t first_particle = 0;
+  std::uint32_t first_particle = 0;  ///< in the scene's particle order (Snapshot)
   std::uint32_t particle_count = 0;
+  /// A dynamic one-particle body without spin, integrated as a particle (no body state on the
+  /// device); otherwise a rigid body.
+  bool free_sphere = false;
+};
+
+/// Neighbour-list figures since the simulation was created (NeighbourState).
+struct NeighbourStats {
+  std::uint32_t builds = 0;         ///< list builds so far (the first at the first step)
+  std::uint32_t over_capacity = 0;  ///< particles with more than K neighbours at the last build
+  std::uint32_t max_count = 0;      ///< the largest neighbour count at the last build
 };
 
 class Simulation {
@@ -51,33 +64,52 @@ class Simulation {
   Result<std::uint64_t> state_hash();
   /// Checks every body and particle for NaN or infinity; the error names step, body and particle.
   Status check_finite();
+  /// Reads the neighbour-list figures from the device.
+  Result<NeighbourStats> neighbour_stats();
 
   /// Writes the dynamic state (bodies, particles, step, time) to a checkpoint file.
   Status save_state(const std::string& path);
   /// Restores a checkpoint written by save_state for the same scene (same particle and body
   /// counts). A missing, truncated or corrupt file, or one of another scene, is refused and the
-  /// running state is left untouched.
+  /// running state is left untouched. The neighbour lists are rebuilt at the next step.
   Status load_state(const std::string& path);
 
   [[nodiscard]] double time() const { return time_; }
   [[nodiscard]] std::uint64_t steps() const { return steps_; }
   [[nodiscard]] const Settings& settings() const { return settings_; }
   [[nodiscard]] std::uint32_t particle_count() const { return sizes_.particles; }
-  [[nodiscard]] std::uint32_t body_count() const { return sizes_.bodies; }
+  /// Bodies of the scene (rigid bodies and free spheres).
+  [[nodiscard]] std::uint32_t body_count() const {
+    return static_cast<std::uint32_t>(bodies_.size());
+  }
   [[nodiscard]] const std::vector<BodyInfo>& bodies() const { return bodies_; }
+  /// The device's sizes: rigid bodies first (sizes().bodies of them), then the free spheres.
   [[nodiscard]] const Sizes& sizes() const { return sizes_; }
   [[nodiscard]] const shared::StepParams& step_params() const { return params_; }
+  /// Device memory this simulation holds (Device::required_bytes).
+  [[nodiscard]] std::uint64_t device_bytes() const { return device_->required_bytes(sizes_); }
   [[nodiscard]] Device& device() { return *device_; }
 
  private:
   Simulation() = default;
   Status upload(const Scene& scene);
+  /// Writes a scene-ordered state (a snapshot or a checkpoint's) to the device and asks for a
+  /// neighbour-list rebuild.
+  Status restore(const Snapshot& state);
 
   std::unique_ptr<Device> device_;
   Settings settings_;
   Sizes sizes_;
   shared::StepParams params_{};
   std::vector<BodyInfo> bodies_;
+  /// Per scene body: its index among the device's rigid bodies, or for a free sphere the index of
+  /// its particle on the device (the rigid bodies' particles come first).
+  std::vector<std::uint32_t> device_index_;
+  /// BodyFirst as uploaded (B + 1 entries): the first device particle of each rigid body.
+  std::vector<std::uint32_t> rigid_first_;
+  /// (scene body, orientation) of the free spheres that are not at the identity orientation; a
+  /// free sphere never turns.
+  std::vector<std::pair<std::uint32_t, shared::vec4>> sphere_turns_;
   double time_ = 0.0;
   std::uint64_t steps_ = 0;
 };

@@ -13,16 +13,19 @@
 
 namespace motes {
 
-/// Every buffer a device holds. Element types and counts: see buffer_layout().
+/// Every buffer a device holds, grouped by feature. Element types and counts: see
+/// buffer_layout().
 enum class Buffer : std::uint32_t {
-  // Particles (N), in body order: body b owns particles [BodyFirst[b], BodyFirst[b+1]).
+  // Particles (N). The rigid bodies' particles come first, in body order: body b owns particles
+  // [BodyFirst[b], BodyFirst[b+1]) and BodyFirst[B] = Nr. Particles [Nr, N) are free spheres
+  // (one-particle bodies without spin): no body state, integrated as particles.
   ParticlePos,       ///< vec4: world position xyz, w = radius
   ParticleVel,       ///< vec4: world velocity xyz, w = inverse mass (0 for static bodies)
-  ParticleLocal,     ///< vec4: offset from the body's centre of mass in the body frame
-  ParticleBody,      ///< uint: body index
+  ParticleLocal,     ///< vec4 (Nr): offset from the body's centre of mass in the body frame
+  ParticleBody,      ///< uint: body index (B + k for the k-th free sphere: unique)
   ParticleMaterial,  ///< uint: material index
   ParticleForce,     ///< vec4: contact force (output of contacts_compute)
-  // Bodies (B).
+  // Rigid bodies (B).
   BodyPos,         ///< vec4: centre of mass xyz, w = inverse mass (0 = static)
   BodyQuat,        ///< vec4: orientation (x, y, z, w), body (principal) frame to world
   BodyVel,         ///< vec4: linear velocity
@@ -31,7 +34,7 @@ enum class Buffer : std::uint32_t {
   BodyInvInertia,  ///< vec4: inverse principal moments of inertia (body frame)
   BodyForce,       ///< vec4: summed contact force (output of bodies_reduce)
   BodyTorque,      ///< vec4: summed torque about the centre of mass
-  BodyFirst,       ///< uint (B + 1): first particle of each body, then N
+  BodyFirst,       ///< uint (B + 1): first particle of each body, then Nr
   // Hashed grid (outputs of grid_build).
   GridBucket,      ///< uint (N): bucket of particle i
   GridOrder,       ///< uint (N): particle ids sorted stably by bucket
@@ -40,19 +43,28 @@ enum class Buffer : std::uint32_t {
   SortedVel,       ///< vec4 (N): ParticleVel in grid order
   SortedBody,      ///< uint (N): ParticleBody in grid order
   SortedMaterial,  ///< uint (N): ParticleMaterial in grid order
+  // Neighbour lists (outputs of neighbours_build).
+  NeighbourList,    ///< uint (K * N): entry k of particle i at k * N + i, a particle id
+  NeighbourCount,   ///< uint (N): neighbours found at the last build (may exceed K)
+  NeighbourRefPos,  ///< vec4 (N): ParticlePos at the last build
+  NeighbourState,   ///< uint (4): MOTES_NEIGHBOUR_* words (shared/neighbours.h)
   // Tables.
   ContactLaws,  ///< ContactLaw (M * M): law of material pair (a, b) at a * M + b
   Planes,       ///< PlaneData (P)
   Count
 };
 
-/// Kernel families, in the order a step runs them.
+/// Kernel families, in the order a step runs them. NeighboursUpdate is the step's decision: when
+/// NeighbourState says so, it runs GridBuild and NeighboursBuild (each timed as itself).
 enum class Kernel : std::uint32_t {
+  NeighboursUpdate,
   GridBuild,
+  NeighboursBuild,
   ContactsCompute,
   BodiesReduce,
   BodiesIntegrate,
   ParticlesUpdate,
+  ParticlesIntegrate,
   Count
 };
 
@@ -64,11 +76,13 @@ const char* kernel_name(Kernel k);
 
 /// Element counts of a simulation.
 struct Sizes {
-  std::uint32_t particles = 0;  ///< N
-  std::uint32_t bodies = 0;     ///< B
-  std::uint32_t table = 0;      ///< T, a power of two >= 64
-  std::uint32_t materials = 0;  ///< M
-  std::uint32_t planes = 0;     ///< P
+  std::uint32_t particles = 0;           ///< N
+  std::uint32_t rigid_particles = 0;     ///< Nr <= N: the rigid bodies' particles come first
+  std::uint32_t bodies = 0;              ///< B: rigid bodies
+  std::uint32_t table = 0;               ///< T, a power of two >= 64
+  std::uint32_t materials = 0;           ///< M
+  std::uint32_t planes = 0;              ///< P
+  std::uint32_t neighbour_capacity = 0;  ///< K: list entries per particle
 };
 
 /// Bytes of one element and number of elements of a buffer.
@@ -78,6 +92,8 @@ struct BufferLayout {
   [[nodiscard]] std::size_t bytes() const { return element_bytes * count; }
 };
 BufferLayout buffer_layout(Buffer b, const Sizes& sizes);
+/// Sum of buffer_layout(b).bytes() over every buffer.
+std::uint64_t buffers_bytes(const Sizes& sizes);
 
 /// Hash-table size the core uses for n particles: the power of two >= 4n, at least 64.
 std::uint32_t grid_table_size(std::uint32_t particles);
@@ -106,6 +122,11 @@ class Device {
 
   [[nodiscard]] virtual const DeviceInfo& info() const = 0;
 
+  /// Bytes this device would hold for these sizes: every buffer plus the backend's own scratch
+  /// (sort storage, guard words). The core compares it with available_bytes() before allocating.
+  [[nodiscard]] virtual std::uint64_t required_bytes(const Sizes& sizes) const = 0;
+  /// Memory the device can still give (GPU free memory, or the host's available memory).
+  [[nodiscard]] virtual std::uint64_t available_bytes() const = 0;
   /// (Re)allocates every buffer for these sizes; contents are undefined afterwards.
   virtual Status allocate(const Sizes& sizes) = 0;
   /// Copies host memory into the start of a buffer; bytes <= buffer_layout(b).bytes().
@@ -113,17 +134,32 @@ class Device {
   /// Copies the start of a buffer to host memory (waits for queued kernels).
   virtual Status read(Buffer b, void* dst, std::size_t bytes) = 0;
 
+  /// When NeighbourState[MOTES_NEIGHBOUR_REBUILD] is nonzero: grid_build, then neighbours_build;
+  /// otherwise nothing. Decided on the device, so that a queued step needs no host round trip.
+  virtual void neighbours_update(const shared::StepParams& p) = 0;
   /// Buckets, stable sort by (bucket, particle id), bucket starts, sorted copies of particles.
   virtual void grid_build(const shared::StepParams& p) = 0;
-  /// ParticleForce: each particle gathers its contacts over the 27 neighbouring cells in the
-  /// canonical order (docs/architecture.md), then the planes in order. Static particles get 0.
+  /// From the grid: every dynamic particle's list of the particles of other bodies closer than
+  /// r_i + r_j + skin (shared/neighbours.h), in the canonical order of the 27-cell walk
+  /// (docs/architecture.md), its first K entries kept and its full count written (static
+  /// particles: 0); NeighbourRefPos = ParticlePos; NeighbourState: rebuild 0, builds + 1, the
+  /// particles over capacity and the largest count.
+  virtual void neighbours_build(const shared::StepParams& p) = 0;
+  /// ParticleForce: each dynamic particle sums the contact forces of its list in order (a
+  /// particle with more than K neighbours walks the grid of the last build from the cell of its
+  /// NeighbourRefPos instead: the same pairs in the same order), then the planes in order.
+  /// Static particles get 0. Exact while no particle has moved 0.45 skin since the build.
   virtual void contacts_compute(const shared::StepParams& p) = 0;
   /// BodyForce and BodyTorque: sums over each body's particles in particle order.
   virtual void bodies_reduce(const shared::StepParams& p) = 0;
   /// Semi-implicit Euler on every dynamic body (shared/body_math.h: body_integrate).
   virtual void bodies_integrate(const shared::StepParams& p) = 0;
-  /// ParticlePos and ParticleVel xyz from their body's pose.
+  /// ParticlePos and ParticleVel xyz of the rigid particles [0, Nr) from their body's pose; asks
+  /// for a rebuild (NeighbourState) when one has moved too far from its NeighbourRefPos.
   virtual void particles_update(const shared::StepParams& p) = 0;
+  /// Semi-implicit Euler on the free particles [Nr, N) (shared/body_math.h: particle_integrate);
+  /// asks for a rebuild when one has moved too far from its NeighbourRefPos.
+  virtual void particles_integrate(const shared::StepParams& p) = 0;
 
   /// Waits for queued work; reports any error it raised.
   virtual Status synchronize() = 0;

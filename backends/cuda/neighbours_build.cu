@@ -1,0 +1,105 @@
+// neighbours_build: every dynamic particle's list of the particles of other bodies closer than
+// r_i + r_j + skin (shared/neighbours.h), in the canonical order of the 27-cell walk, its first K
+// entries kept (entry k at k * N + i) and its full count written; as
+// backends/openmp/neighbours_build.cpp. Two launches: one thread starts the build in
+// NeighbourState, then a thread per particle; the build's figures are reduced per block and added
+// with integer atomics. neighbours_decide sets the condition of the graph's IF node that holds a
+// conditional rebuild (cuda_launch.cpp).
+#include "cuda_device.h"
+#include "grid_walk.cuh"
+#include "shared/neighbours.h"
+
+namespace motes::cuda {
+
+using shared::uint;
+using shared::vec4;
+
+namespace {
+
+__global__ void neighbours_begin_kernel(uint* __restrict__ state) {
+  state[MOTES_NEIGHBOUR_REBUILD] = 0;
+  state[MOTES_NEIGHBOUR_BUILDS] += 1;
+  state[MOTES_NEIGHBOUR_OVER_CAPACITY] = 0;
+  state[MOTES_NEIGHBOUR_MAX_COUNT] = 0;
+}
+
+struct BuildInputs {
+  const vec4* __restrict__ pos;
+  const vec4* __restrict__ vel;
+  const uint* __restrict__ body;
+  const uint* __restrict__ order;
+  const uint* __restrict__ cell_start;
+  const vec4* __restrict__ spos;
+  const uint* __restrict__ sbody;
+};
+
+struct BuildOutputs {
+  uint* __restrict__ list;
+  uint* __restrict__ count;
+  vec4* __restrict__ ref;
+  uint* __restrict__ state;
+};
+
+__global__ void neighbours_build_kernel(shared::StepParams p, BuildInputs in, BuildOutputs out) {
+  __shared__ uint block_over;
+  __shared__ uint block_most;
+  if (threadIdx.x == 0) {
+    block_over = 0;
+    block_most = 0;
+  }
+  __syncthreads();
+  const std::uint64_t i = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
+  if (i < p.particle_count) {
+    const vec4 pi = in.pos[i];
+    out.ref[i] = pi;
+    uint c = 0;
+    if (in.vel[i].w != 0.0f) {  // static particles never move and get no force
+      const uint body_i = in.body[i];
+      const std::size_t stride = p.particle_count;
+      grid_walk(p, pi, in.cell_start, [&](uint lo, uint hi) {
+        for (uint t = lo; t < hi; ++t) {
+          if (in.sbody[t] == body_i ||
+              !shared::neighbour_within(pi, in.spos[t], p.neighbour_skin)) {
+            continue;
+          }
+          if (c < p.neighbour_capacity) out.list[std::size_t{c} * stride + i] = in.order[t];
+          ++c;
+        }
+      });
+    }
+    out.count[i] = c;
+    if (c > p.neighbour_capacity) atomicAdd(&block_over, 1u);
+    if (c > 0) atomicMax(&block_most, c);
+  }
+  __syncthreads();
+  if (threadIdx.x == 0) {
+    if (block_over != 0) atomicAdd(&out.state[MOTES_NEIGHBOUR_OVER_CAPACITY], block_over);
+    if (block_most != 0) atomicMax(&out.state[MOTES_NEIGHBOUR_MAX_COUNT], block_most);
+  }
+}
+
+__global__ void neighbours_decide_kernel(cudaGraphConditionalHandle handle,
+                                         const uint* __restrict__ state) {
+  cudaGraphSetConditional(handle, state[MOTES_NEIGHBOUR_REBUILD] != 0 ? 1u : 0u);
+}
+
+}  // namespace
+
+void CudaDevice::launch_neighbours_build(const shared::StepParams& p) {
+  uint* state = buf<uint>(Buffer::NeighbourState);
+  neighbours_begin_kernel<<<1, 1, 0, stream_>>>(state);
+  if (p.particle_count == 0) return;
+  const BuildInputs in{buf<vec4>(Buffer::ParticlePos),   buf<vec4>(Buffer::ParticleVel),
+                       buf<uint>(Buffer::ParticleBody),  buf<uint>(Buffer::GridOrder),
+                       buf<uint>(Buffer::GridCellStart), buf<vec4>(Buffer::SortedPos),
+                       buf<uint>(Buffer::SortedBody)};
+  const BuildOutputs out{buf<uint>(Buffer::NeighbourList), buf<uint>(Buffer::NeighbourCount),
+                         buf<vec4>(Buffer::NeighbourRefPos), state};
+  neighbours_build_kernel<<<blocks_for(p.particle_count), kBlock, 0, stream_>>>(p, in, out);
+}
+
+void CudaDevice::launch_neighbours_decide(cudaGraphConditionalHandle handle) {
+  neighbours_decide_kernel<<<1, 1, 0, stream_>>>(handle, buf<uint>(Buffer::NeighbourState));
+}
+
+}  // namespace motes::cuda

@@ -1,0 +1,77 @@
+// neighbours_build: every dynamic particle's list of the particles of other bodies closer than
+// r_i + r_j + skin, in the canonical order of the 27-cell walk over the grid that grid_build has
+// just made; and neighbours_update, which runs grid_build and this when a rebuild is due.
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+
+#include "grid_walk.h"
+#include "openmp_device.h"
+#include "shared/neighbours.h"
+
+namespace motes::openmp {
+
+using shared::uint;
+using shared::vec4;
+
+void OpenMPDevice::neighbours_update(const shared::StepParams& p) {
+  const auto start = std::chrono::steady_clock::now();
+  const bool rebuild = buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_REBUILD] != 0;
+  record(Kernel::NeighboursUpdate, start);
+  if (!rebuild) return;
+  grid_build(p);
+  neighbours_build(p);
+}
+
+void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto n = static_cast<std::int64_t>(p.particle_count);
+  const std::size_t stride = p.particle_count;
+  const uint capacity = p.neighbour_capacity;
+  const vec4* pos = buf<vec4>(Buffer::ParticlePos);
+  const vec4* vel = buf<vec4>(Buffer::ParticleVel);
+  const uint* body = buf<uint>(Buffer::ParticleBody);
+  const uint* order = buf<uint>(Buffer::GridOrder);
+  const uint* cell_start = buf<uint>(Buffer::GridCellStart);
+  const vec4* spos = buf<vec4>(Buffer::SortedPos);
+  const uint* sbody = buf<uint>(Buffer::SortedBody);
+  uint* list = buf<uint>(Buffer::NeighbourList);
+  uint* count = buf<uint>(Buffer::NeighbourCount);
+  vec4* ref = buf<vec4>(Buffer::NeighbourRefPos);
+  uint over = 0;
+  uint most = 0;
+
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n)) \
+    reduction(+ : over) reduction(max : most)
+  for (std::int64_t i = 0; i < n; ++i) {
+    const vec4 pi = pos[i];
+    ref[i] = pi;
+    if (vel[i].w == 0.0f) {  // static: never moves, never gets a force
+      count[i] = 0;
+      continue;
+    }
+    const uint body_i = body[i];
+    const GridRanges ranges = grid_walk(p, pi, cell_start);
+    uint c = 0;
+    for (int r = 0; r < ranges.count; ++r) {
+      for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
+        if (sbody[t] == body_i || !shared::neighbour_within(pi, spos[t], p.neighbour_skin)) {
+          continue;
+        }
+        if (c < capacity) list[std::size_t{c} * stride + static_cast<std::size_t>(i)] = order[t];
+        ++c;
+      }
+    }
+    count[i] = c;
+    over += c > capacity ? 1u : 0u;
+    most = std::max(most, c);
+  }
+  uint* state = buf<uint>(Buffer::NeighbourState);
+  state[MOTES_NEIGHBOUR_REBUILD] = 0;
+  state[MOTES_NEIGHBOUR_BUILDS] += 1;
+  state[MOTES_NEIGHBOUR_OVER_CAPACITY] = over;
+  state[MOTES_NEIGHBOUR_MAX_COUNT] = most;
+  record(Kernel::NeighboursBuild, start);
+}
+
+}  // namespace motes::openmp

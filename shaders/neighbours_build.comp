@@ -1,0 +1,51 @@
+#version 450
+// neighbours_build (after neighbours_begin or neighbours_decide): every dynamic particle (one thread per particle id) lists the
+// particles of other bodies closer than r_i + r_j + skin (shared/neighbours.h) in the canonical
+// order of the 27-cell walk, keeps the first K (entry k at k * N + i) and writes its full count;
+// as backends/openmp/neighbours_build.cpp. The figures of the build (particles over capacity,
+// largest count) are reduced per workgroup, then added with integer atomics.
+#extension GL_GOOGLE_include_directive : require
+#include "kernel_common.glsl"
+#include "shared/grid_hash.h"
+#include "shared/neighbours.h"
+#include "grid_walk.glsl"
+
+shared uint group_over;
+shared uint group_most;
+
+void main() {
+  uint i = thread_index();
+  if (gl_LocalInvocationID.x == 0u) {
+    group_over = 0u;
+    group_most = 0u;
+  }
+  barrier();
+  if (i < p.particle_count) {
+    vec4 pi = particle_pos[i];
+    neighbour_ref_pos[i] = pi;
+    uint c = 0u;
+    if (particle_vel[i].w != 0.0f) {  // static particles never move and get no force
+      uint body_i = particle_body[i];
+      uint lo[27];
+      uint hi[27];
+      int ranges = grid_walk(pi, lo, hi);
+      for (int r = 0; r < ranges; ++r) {
+        for (uint t = lo[r]; t < hi[r]; ++t) {
+          if (sorted_body[t] == body_i || !neighbour_within(pi, sorted_pos[t], p.neighbour_skin)) {
+            continue;
+          }
+          if (c < p.neighbour_capacity) neighbour_list[c * p.particle_count + i] = grid_order[t];
+          ++c;
+        }
+      }
+    }
+    neighbour_count[i] = c;
+    if (c > p.neighbour_capacity) atomicAdd(group_over, 1u);
+    atomicMax(group_most, c);
+  }
+  barrier();
+  if (gl_LocalInvocationID.x == 0u) {
+    if (group_over != 0u) atomicAdd(neighbour_state[MOTES_NEIGHBOUR_OVER_CAPACITY], group_over);
+    if (group_most != 0u) atomicMax(neighbour_state[MOTES_NEIGHBOUR_MAX_COUNT], group_most);
+  }
+}

@@ -1,0 +1,21 @@
+#version 450
+// neighbours_update, pass 0 (one workgroup): the rebuild's passes are dispatched indirectly; when
+// NeighbourState asks for a rebuild, their arguments are copied from the template written at
+// allocate (args.x words from args.y) and the build starts (neighbours_start), otherwise they are
+// zeroed, so that the passes do nothing.
+#extension GL_GOOGLE_include_directive : require
+#include "kernel_common.glsl"
+#include "shared/neighbours.h"
+#include "neighbours_start.glsl"
+
+shared bool rebuild_now;
+
+void main() {
+  if (gl_LocalInvocationID.x == 0u) rebuild_now = neighbour_state[MOTES_NEIGHBOUR_REBUILD] != 0u;
+  barrier();
+  bool rebuild = rebuild_now;
+  for (uint w = gl_LocalInvocationID.x; w < args.x; w += uint(WORKGROUP_SIZE)) {
+    indirect_args[w] = rebuild ? indirect_args[args.y + w] : 0u;
+  }
+  if (gl_LocalInvocationID.x == 0u && rebuild) neighbours_start();
+}

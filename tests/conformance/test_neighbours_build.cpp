@@ -1,0 +1,229 @@
+// neighbours_build and neighbours_update against the oracle: every output must be IDENTICAL.
+//
+// neighbours_build alone: the particles (ParticlePos/Vel/Body), the oracle's grid (GridOrder,
+// GridCellStart, SortedPos, SortedBody) and a NeighbourState are written, every other buffer is
+// poisoned. Read back: NeighbourCount (every particle's full count), the first min(count, K)
+// entries of each list (entry k of particle i at k * N + i; the rest is unspecified),
+// NeighbourRefPos (= ParticlePos, bitwise) and NeighbourState (rebuild 0, builds + 1, particles
+// over capacity, largest count).
+//
+// Tolerance: none. Which pairs are listed is decided by shared::neighbour_within, whose products
+// are rounded on their own on every backend (mul_rn), so that no fused multiply-add can move a
+// pair across the cutoff; the order is the canonical walk, which the oracle writes differently (as
+// the first occurrence of each bucket among the 27 cells, then grid order), by brute force.
+//
+// neighbours_update: with the rebuild word 0 nothing may be written (every grid and list buffer
+// comes back poisoned); with it set, the grid and the lists must equal the oracle's.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "conformance.h"
+#include "reference/reference.h"
+#include "shared/neighbours.h"
+#include "test_data.h"
+
+namespace motes_conf {
+namespace {
+
+using motes::Buffer;
+
+/// The first min(count, K) entries of every list, from a NeighbourList buffer (K * N).
+std::vector<uint> kept_entries(const std::vector<uint>& list, const std::vector<uint>& count,
+                               uint capacity) {
+  const std::size_t n = count.size();
+  std::vector<uint> out;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (uint k = 0; k < std::min(count[i], capacity); ++k) out.push_back(list[k * n + i]);
+  }
+  return out;
+}
+
+std::vector<uint> kept_entries(const motes_ref::Neighbours& want, uint capacity) {
+  std::vector<uint> out;
+  for (const std::vector<uint>& l : want.lists) {
+    for (std::size_t k = 0; k < std::min<std::size_t>(l.size(), capacity); ++k) out.push_back(l[k]);
+  }
+  return out;
+}
+
+constexpr uint kBuildsBefore = 41;
+
+std::vector<uint> state_after(const motes_ref::Neighbours& want) {
+  return {0u, kBuildsBefore + 1u, want.over_capacity, want.max_count};
+}
+
+class NeighboursBuild : public DeviceTest {
+ protected:
+  void run_case(const std::string& layout, const World& w) {
+    const motes_ref::Grid g = motes_ref::grid_build(w.particles, w.params);
+    const motes_ref::Neighbours want = motes_ref::neighbours_build(w.particles, g, w.params);
+    const std::size_t n = w.particles.size();
+    std::size_t listed = 0;
+    for (uint c : want.count) listed += c;
+    if (n >= 31) {
+      ASSERT_GE(listed, n / 2) << "too few neighbours for the case to prove much";
+    }
+
+    ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
+    ASSERT_NO_FATAL_FAILURE(poison_all_but(
+        {Buffer::ParticlePos, Buffer::ParticleVel, Buffer::ParticleBody, Buffer::GridOrder,
+         Buffer::GridCellStart, Buffer::SortedPos, Buffer::SortedBody, Buffer::NeighbourState}));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleVel, w.particles.vel));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleBody, w.particles.body));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::GridOrder, g.order));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::GridCellStart, g.cell_start));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::SortedPos, g.sorted_pos));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::SortedBody, g.sorted_body));
+    ASSERT_NO_FATAL_FAILURE(
+        write(Buffer::NeighbourState, std::vector<uint>{1u, kBuildsBefore, 77u, 88u}));
+    device().neighbours_build(w.params);
+    ASSERT_NO_FATAL_FAILURE(finish_kernel());
+
+    std::vector<uint> list, count, state;
+    std::vector<vec4> ref;
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourList, list));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourCount, count));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourRefPos, ref));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourState, state));
+
+    const uint capacity = w.params.neighbour_capacity;
+    begin_case("neighbours_build/" + layout, n);
+    check_identical("NeighbourCount", count, want.count);
+    if (count.size() == want.count.size()) {
+      check_identical("NeighbourList (kept entries)", kept_entries(list, count, capacity),
+                      kept_entries(want, capacity));
+    }
+    check_identical("NeighbourRefPos", ref, want.ref);
+    check_identical("NeighbourState", state, state_after(want));
+    end_case();
+  }
+};
+
+World with_capacity(World w, uint capacity) {
+  w.sizes.neighbour_capacity = capacity;
+  w.params.neighbour_capacity = capacity;
+  return w;
+}
+
+TEST_P(NeighboursBuild, Empty) { run_case("random", random_world(201, 0, 0, kTestSkin)); }
+TEST_P(NeighboursBuild, One) { run_case("random", random_world(202, 1, 0, kTestSkin)); }
+TEST_P(NeighboursBuild, Random31) { run_case("random", random_world(203, 31, 0, kTestSkin)); }
+TEST_P(NeighboursBuild, Random1234) { run_case("random", random_world(204, 1234, 0, kTestSkin)); }
+TEST_P(NeighboursBuild, Random20000) { run_case("random", random_world(205, 20000, 0, kTestSkin)); }
+TEST_P(NeighboursBuild, NoSkin) { run_case("skin_0", random_world(206, 1234, 0, 0.0f)); }
+TEST_P(NeighboursBuild, CapacityOne) {
+  // Most particles have more neighbours than they keep: their counts go on, their lists stop.
+  run_case("capacity_1", with_capacity(random_world(207, 1234, 0, kTestSkin), 1));
+}
+
+TEST_P(NeighboursBuild, OnCellFacesExactCell) {
+  // cell = 0.5 + 0.125 m: every face coordinate is exact, and many pairs sit exactly at the
+  // cutoff 2 rmax + skin (not listed: the test is strict) or coincide.
+  Rng rng(208);
+  run_case("on_cell_faces_exact",
+           make_world(rng, on_cell_faces(rng, 1234, 0.25f, 0.125f), 0, true, 0.125f));
+}
+
+TEST_P(NeighboursBuild, AllInOneCell) {
+  // 300 particles in one cell: most counts far beyond K = 16, so most lists stop early.
+  Rng rng(209);
+  run_case("one_cell",
+           make_world(rng, one_cell(rng, 300, 0.005f, vec3(0.07f, -0.03f, 0.11f), 0.001f), 0, true,
+                      0.001f));
+}
+
+TEST_P(NeighboursBuild, FarFromOrigin) {
+  Rng rng(210);
+  const float rmax = 0.05f;
+  auto pos = random_cloud(rng, 1234, rmax, dense_side(1234, rmax), vec3(1e5f, -1e5f, 1e5f));
+  run_case("far_1e5", make_world(rng, std::move(pos), 0, false, 0.1f));
+}
+
+TEST_P(NeighboursBuild, SmallTable) {
+  // T = 64 for 1234 particles: rows share buckets all the time, so a bucket visited twice (or
+  // skipped) by the walk changes the list.
+  World w = random_world(211, 1234, 0, kTestSkin);
+  w.sizes.table = 64;
+  w.params.table_mask = 63;
+  run_case("table_64", w);
+}
+
+INSTANTIATE_TEST_SUITE_P(Conformance, NeighboursBuild, testing::ValuesIn(device_params()),
+                         param_name);
+
+class NeighboursUpdate : public DeviceTest {
+ protected:
+  void run_case(const std::string& layout, const World& w, bool rebuild) {
+    const motes_ref::Grid g = motes_ref::grid_build(w.particles, w.params);
+    const motes_ref::Neighbours want = motes_ref::neighbours_build(w.particles, g, w.params);
+    const std::vector<uint> state_in = {rebuild ? 1u : 0u, kBuildsBefore, 77u, 88u};
+    ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
+    ASSERT_NO_FATAL_FAILURE(
+        poison_all_but({Buffer::ParticlePos, Buffer::ParticleVel, Buffer::ParticleBody,
+                        Buffer::ParticleMaterial, Buffer::NeighbourState}));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleVel, w.particles.vel));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleBody, w.particles.body));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleMaterial, w.particles.material));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourState, state_in));
+    // Twice: the first call rebuilds (when asked), the second must then do nothing more.
+    device().neighbours_update(w.params);
+    device().neighbours_update(w.params);
+    ASSERT_NO_FATAL_FAILURE(finish_kernel());
+
+    motes_ref::Grid got;
+    std::vector<uint> list, count, state;
+    std::vector<vec4> ref;
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::GridOrder, got.order));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::GridCellStart, got.cell_start));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::SortedPos, got.sorted_pos));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourList, list));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourCount, count));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourRefPos, ref));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourState, state));
+
+    const std::size_t n = w.particles.size();
+    begin_case(std::string("neighbours_update/") + layout + (rebuild ? " rebuild" : " no rebuild"),
+               n);
+    if (rebuild) {
+      const uint capacity = w.params.neighbour_capacity;
+      check_identical("GridOrder", got.order, g.order);
+      check_identical("GridCellStart", got.cell_start, g.cell_start);
+      check_identical("SortedPos", got.sorted_pos, g.sorted_pos);
+      check_identical("NeighbourCount", count, want.count);
+      if (count.size() == want.count.size()) {
+        check_identical("NeighbourList (kept entries)", kept_entries(list, count, capacity),
+                        kept_entries(want, capacity));
+      }
+      check_identical("NeighbourRefPos", ref, want.ref);
+      check_identical("NeighbourState", state, state_after(want));
+    } else {
+      // Untouched: still the poison (0xFF bytes) of every output.
+      check_identical("GridOrder untouched", got.order, std::vector<uint>(n, 0xFFFFFFFFu));
+      check_identical("NeighbourCount untouched", count, std::vector<uint>(n, 0xFFFFFFFFu));
+      check_identical("NeighbourList untouched", list, std::vector<uint>(list.size(), 0xFFFFFFFFu));
+      check_identical("NeighbourState untouched", state, state_in);
+    }
+    end_case();
+  }
+};
+
+TEST_P(NeighboursUpdate, NoRebuild) {
+  run_case("random", random_world(221, 1234, 0, kTestSkin), false);
+}
+TEST_P(NeighboursUpdate, Rebuild) {
+  run_case("random", random_world(221, 1234, 0, kTestSkin), true);
+}
+TEST_P(NeighboursUpdate, Rebuild65536) {
+  run_case("random", random_world(222, 65536, 0, kTestSkin), true);
+}
+
+INSTANTIATE_TEST_SUITE_P(Conformance, NeighboursUpdate, testing::ValuesIn(device_params()),
+                         param_name);
+
+}  // namespace
+}  // namespace motes_conf

@@ -1,0 +1,110 @@
+// particles_integrate against the oracle, the kernel alone: ParticlePos, ParticleVel,
+// ParticleForce, NeighbourRefPos and NeighbourState are written, every other buffer is poisoned;
+// ParticlePos, ParticleVel and NeighbourState are read back. Only the free particles [Nr, N)
+// move: the rigid ones must come back bitwise as written. xyz compared by NMSE, w (radius,
+// inverse mass) bitwise; the rebuild word of NeighbourState must be set exactly when a free
+// particle ends 0.45 skin or more from its NeighbourRefPos, nothing else of it may change.
+//
+// Tolerance: NMSE 1e-10, as particles_update: the shared particle_integrate on the same floats
+// (openmp: bitwise), a GPU's fused multiply-adds moving a component by an ulp or two.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "conformance.h"
+#include "reference/reference.h"
+#include "shared/neighbours.h"
+#include "test_data.h"
+
+namespace motes_conf {
+namespace {
+
+using motes::Buffer;
+
+constexpr double kTolerance = 1.0e-10;
+
+std::vector<vec4> random_forces(std::uint32_t seed, std::size_t n) {
+  Rng rng(seed);
+  std::vector<vec4> out;
+  for (std::size_t i = 0; i < n; ++i) {
+    out.emplace_back(rng.uniform(-2.0f, 2.0f), rng.uniform(-2.0f, 2.0f), rng.uniform(-2.0f, 2.0f),
+                     0.0f);
+  }
+  return out;
+}
+
+class ParticlesIntegrate : public DeviceTest {
+ protected:
+  /// `far`: one free particle's ref sits 0.6 skin from where it ends (a rebuild is due), the
+  /// others 0.3 skin.
+  void run_case(const std::string& layout, World w, bool far) {
+    w.params.neighbour_skin = kTestSkin;
+    const std::vector<vec4> force = random_forces(w.sizes.particles + 5u, w.particles.size());
+    motes_ref::Particles want = w.particles;
+    motes_ref::particles_integrate(want, force, w.params);
+    Rng rng(static_cast<std::uint32_t>(w.sizes.particles) + 77u);
+    std::vector<vec4> ref = moved_by(rng, want.pos, kTestSkin, 0.3f);
+    const std::size_t rigid = w.particles.rigid;
+    const bool any_free = w.particles.size() > rigid;
+    if (far && any_free) {
+      const std::size_t k = rigid + (w.particles.size() - rigid) / 2;
+      ref[k] = moved_by(rng, {want.pos[k]}, kTestSkin, 0.6f)[0];
+    }
+    motes_ref::Particles again = w.particles;
+    const bool rebuild = motes_ref::particles_integrate(again, force, w.params, ref);
+    ASSERT_EQ(rebuild, far && any_free) << "the case's own premise";
+    const std::vector<uint> state_in = {0u, 2u, 0u, 9u};
+
+    ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
+    ASSERT_NO_FATAL_FAILURE(
+        poison_all_but({Buffer::ParticlePos, Buffer::ParticleVel, Buffer::ParticleForce,
+                        Buffer::NeighbourRefPos, Buffer::NeighbourState}));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleVel, w.particles.vel));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleForce, force));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourRefPos, ref));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourState, state_in));
+    device().particles_integrate(w.params);
+    ASSERT_NO_FATAL_FAILURE(finish_kernel());
+    std::vector<vec4> pos;
+    std::vector<vec4> vel;
+    std::vector<uint> state;
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticlePos, pos));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticleVel, vel));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourState, state));
+
+    const auto head = [&](const std::vector<vec4>& v) {
+      return std::vector<vec4>(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(rigid));
+    };
+    const auto tail = [&](const std::vector<vec4>& v) {
+      return std::vector<vec4>(v.begin() + static_cast<std::ptrdiff_t>(rigid), v.end());
+    };
+    std::vector<uint> state_want = state_in;
+    if (rebuild) state_want[MOTES_NEIGHBOUR_REBUILD] = 1u;
+
+    begin_case("particles_integrate/" + layout, w.sizes.particles - rigid);
+    check_close("ParticlePos", tail(pos), tail(want.pos), kTolerance, Part::Xyz);
+    check_close("ParticleVel", tail(vel), tail(want.vel), kTolerance, Part::Xyz);
+    check_w_identical("ParticlePos.w (radius) kept", pos, w.particles.pos);
+    check_w_identical("ParticleVel.w (inverse mass) kept", vel, w.particles.vel);
+    check_identical("rigid particles' ParticlePos untouched", head(pos), head(w.particles.pos));
+    check_identical("rigid particles' ParticleVel untouched", head(vel), head(w.particles.vel));
+    check_identical("NeighbourState", state, state_want);
+    end_case();
+  }
+};
+
+TEST_P(ParticlesIntegrate, Empty) { run_case("random", random_world(161, 0), false); }
+TEST_P(ParticlesIntegrate, Random31) { run_case("random", random_world(163, 31), true); }
+TEST_P(ParticlesIntegrate, Random1234) { run_case("random", random_world(164, 1234), false); }
+TEST_P(ParticlesIntegrate, Random1234Moved) {
+  run_case("moved_far", random_world(164, 1234), true);
+}
+TEST_P(ParticlesIntegrate, Random65536) { run_case("random", random_world(165, 65536), true); }
+
+INSTANTIATE_TEST_SUITE_P(Conformance, ParticlesIntegrate, testing::ValuesIn(device_params()),
+                         param_name);
+
+}  // namespace
+}  // namespace motes_conf
