@@ -26,20 +26,10 @@ using motes::Buffer;
 constexpr double kTolerance = 1.0e-10;
 
 /// Random forces (up to 1 N per component), w = 0.
-std::vector<vec4> random_forces(std::uint32_t seed, std::size_t n) {
-  Rng rng(seed);
-  std::vector<vec4> out;
-  for (std::size_t i = 0; i < n; ++i) {
-    out.emplace_back(rng.uniform(-1.0f, 1.0f), rng.uniform(-1.0f, 1.0f), rng.uniform(-1.0f, 1.0f),
-                     0.0f);
-  }
-  return out;
-}
-
 class BodiesReduce : public DeviceTest {
  protected:
   void run_case(const std::string& layout, World w) {
-    const std::vector<vec4> force = random_forces(w.sizes.particles + 7, w.particles.size());
+    const std::vector<vec4> force = random_forces(w.sizes.particles + 7, w.particles.size(), 1.0f);
     motes_ref::bodies_reduce(w.particles.pos, force, w.bodies);
     ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
     ASSERT_NO_FATAL_FAILURE(poison_all_but(

@@ -257,6 +257,13 @@ World random_bodies(std::uint32_t seed, std::size_t bodies) {
   return w;
 }
 
+std::vector<vec4> random_forces(std::uint32_t seed, std::size_t n, float scale) {
+  Rng rng(seed);
+  std::vector<vec4> out;
+  for (std::size_t i = 0; i < n; ++i) out.push_back(random_vec(rng, scale));
+  return out;
+}
+
 std::vector<vec4> moved_by(Rng& rng, const std::vector<vec4>& pos, float skin, float fraction) {
   std::vector<vec4> out = pos;
   for (vec4& x : out) {

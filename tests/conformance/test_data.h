@@ -82,6 +82,16 @@ World random_bodies(std::uint32_t seed, std::size_t bodies);
 /// Particles in a cloud of about `n` particles with random bodies (make_world).
 World random_world(std::uint32_t seed, std::size_t n, std::uint32_t flags = 0, float skin = 0.0f);
 
+/// n forces with components uniform in [-scale, scale), w = 0.
+std::vector<vec4> random_forces(std::uint32_t seed, std::size_t n, float scale);
+
+/// Elements [from, to) of v.
+template <typename T>
+std::vector<T> slice(const std::vector<T>& v, std::size_t from, std::size_t to) {
+  return std::vector<T>(v.begin() + static_cast<std::ptrdiff_t>(from),
+                        v.begin() + static_cast<std::ptrdiff_t>(to));
+}
+
 /// Each position moved by `fraction` * skin in a random direction (w kept): the positions of the
 /// last neighbour-list build, as seen from `pos`, or later positions as seen from a build.
 std::vector<vec4> moved_by(Rng& rng, const std::vector<vec4>& pos, float skin, float fraction);

@@ -55,7 +55,24 @@ std::vector<uint> state_after(const motes_ref::Neighbours& want) {
   return {0u, kBuildsBefore + 1u, want.over_capacity, want.max_count};
 }
 
-class NeighboursBuild : public DeviceTest {
+/// The list checks shared by both fixtures.
+class ListTest : public DeviceTest {
+ protected:
+  /// EXPECTs the lists read back from the device equal to the oracle's.
+  void check_lists(const std::vector<uint>& list, const std::vector<uint>& count,
+                   const std::vector<vec4>& ref, const std::vector<uint>& state,
+                   const motes_ref::Neighbours& want, uint capacity) {
+    check_identical("NeighbourCount", count, want.count);
+    if (count.size() == want.count.size()) {
+      check_identical("NeighbourList (kept entries)", kept_entries(list, count, capacity),
+                      kept_entries(want, capacity));
+    }
+    check_identical("NeighbourRefPos", ref, want.ref);
+    check_identical("NeighbourState", state, state_after(want));
+  }
+};
+
+class NeighboursBuild : public ListTest {
  protected:
   void run_case(const std::string& layout, const World& w) {
     const motes_ref::Grid g = motes_ref::grid_build(w.particles, w.params);
@@ -90,15 +107,8 @@ class NeighboursBuild : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourRefPos, ref));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourState, state));
 
-    const uint capacity = w.params.neighbour_capacity;
     begin_case("neighbours_build/" + layout, n);
-    check_identical("NeighbourCount", count, want.count);
-    if (count.size() == want.count.size()) {
-      check_identical("NeighbourList (kept entries)", kept_entries(list, count, capacity),
-                      kept_entries(want, capacity));
-    }
-    check_identical("NeighbourRefPos", ref, want.ref);
-    check_identical("NeighbourState", state, state_after(want));
+    check_lists(list, count, ref, state, want, w.params.neighbour_capacity);
     end_case();
   }
 };
@@ -155,7 +165,7 @@ TEST_P(NeighboursBuild, SmallTable) {
 INSTANTIATE_TEST_SUITE_P(Conformance, NeighboursBuild, testing::ValuesIn(device_params()),
                          param_name);
 
-class NeighboursUpdate : public DeviceTest {
+class NeighboursUpdate : public ListTest {
  protected:
   void run_case(const std::string& layout, const World& w, bool rebuild) {
     const motes_ref::Grid g = motes_ref::grid_build(w.particles, w.params);
@@ -190,17 +200,10 @@ class NeighboursUpdate : public DeviceTest {
     begin_case(std::string("neighbours_update/") + layout + (rebuild ? " rebuild" : " no rebuild"),
                n);
     if (rebuild) {
-      const uint capacity = w.params.neighbour_capacity;
       check_identical("GridOrder", got.order, g.order);
       check_identical("GridCellStart", got.cell_start, g.cell_start);
       check_identical("SortedPos", got.sorted_pos, g.sorted_pos);
-      check_identical("NeighbourCount", count, want.count);
-      if (count.size() == want.count.size()) {
-        check_identical("NeighbourList (kept entries)", kept_entries(list, count, capacity),
-                        kept_entries(want, capacity));
-      }
-      check_identical("NeighbourRefPos", ref, want.ref);
-      check_identical("NeighbourState", state, state_after(want));
+      check_lists(list, count, ref, state, want, w.params.neighbour_capacity);
     } else {
       // Untouched: still the poison (0xFF bytes) of every output.
       check_identical("GridOrder untouched", got.order, std::vector<uint>(n, 0xFFFFFFFFu));

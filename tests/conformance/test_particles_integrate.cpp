@@ -24,23 +24,13 @@ using motes::Buffer;
 
 constexpr double kTolerance = 1.0e-10;
 
-std::vector<vec4> random_forces(std::uint32_t seed, std::size_t n) {
-  Rng rng(seed);
-  std::vector<vec4> out;
-  for (std::size_t i = 0; i < n; ++i) {
-    out.emplace_back(rng.uniform(-2.0f, 2.0f), rng.uniform(-2.0f, 2.0f), rng.uniform(-2.0f, 2.0f),
-                     0.0f);
-  }
-  return out;
-}
-
 class ParticlesIntegrate : public DeviceTest {
  protected:
   /// `far`: one free particle's ref sits 0.6 skin from where it ends (a rebuild is due), the
   /// others 0.3 skin.
   void run_case(const std::string& layout, World w, bool far) {
     w.params.neighbour_skin = kTestSkin;
-    const std::vector<vec4> force = random_forces(w.sizes.particles + 5u, w.particles.size());
+    const std::vector<vec4> force = random_forces(w.sizes.particles + 5u, w.particles.size(), 2.0f);
     motes_ref::Particles want = w.particles;
     motes_ref::particles_integrate(want, force, w.params);
     Rng rng(static_cast<std::uint32_t>(w.sizes.particles) + 77u);
@@ -74,22 +64,20 @@ class ParticlesIntegrate : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticleVel, vel));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourState, state));
 
-    const auto head = [&](const std::vector<vec4>& v) {
-      return std::vector<vec4>(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(rigid));
-    };
-    const auto tail = [&](const std::vector<vec4>& v) {
-      return std::vector<vec4>(v.begin() + static_cast<std::ptrdiff_t>(rigid), v.end());
-    };
     std::vector<uint> state_want = state_in;
     if (rebuild) state_want[MOTES_NEIGHBOUR_REBUILD] = 1u;
 
     begin_case("particles_integrate/" + layout, w.sizes.particles - rigid);
-    check_close("ParticlePos", tail(pos), tail(want.pos), kTolerance, Part::Xyz);
-    check_close("ParticleVel", tail(vel), tail(want.vel), kTolerance, Part::Xyz);
+    check_close("ParticlePos", slice(pos, rigid, pos.size()), slice(want.pos, rigid, pos.size()),
+                kTolerance, Part::Xyz);
+    check_close("ParticleVel", slice(vel, rigid, vel.size()), slice(want.vel, rigid, vel.size()),
+                kTolerance, Part::Xyz);
     check_w_identical("ParticlePos.w (radius) kept", pos, w.particles.pos);
     check_w_identical("ParticleVel.w (inverse mass) kept", vel, w.particles.vel);
-    check_identical("rigid particles' ParticlePos untouched", head(pos), head(w.particles.pos));
-    check_identical("rigid particles' ParticleVel untouched", head(vel), head(w.particles.vel));
+    check_identical("rigid particles' ParticlePos untouched", slice(pos, 0, rigid),
+                    slice(w.particles.pos, 0, rigid));
+    check_identical("rigid particles' ParticleVel untouched", slice(vel, 0, rigid),
+                    slice(w.particles.vel, 0, rigid));
     check_identical("NeighbourState", state, state_want);
     end_case();
   }

@@ -72,22 +72,20 @@ class ParticlesUpdate : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourState, state));
 
     const std::size_t rigid = w.particles.rigid;
-    const auto head = [&](const std::vector<vec4>& v) {
-      return std::vector<vec4>(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(rigid));
-    };
-    const auto tail = [&](const std::vector<vec4>& v) {
-      return std::vector<vec4>(v.begin() + static_cast<std::ptrdiff_t>(rigid), v.end());
-    };
     std::vector<uint> state_want = state_in;
     if (rebuild) state_want[MOTES_NEIGHBOUR_REBUILD] = 1u;
 
     begin_case("particles_update/" + layout, w.sizes.particles);
-    check_close("ParticlePos", head(pos), head(want.pos), kTolerance, Part::Xyz);
-    check_close("ParticleVel", head(vel), head(want.vel), kTolerance, Part::Xyz);
+    check_close("ParticlePos", slice(pos, 0, rigid), slice(want.pos, 0, rigid), kTolerance,
+                Part::Xyz);
+    check_close("ParticleVel", slice(vel, 0, rigid), slice(want.vel, 0, rigid), kTolerance,
+                Part::Xyz);
     check_w_identical("ParticlePos.w (radius) kept", pos, w.particles.pos);
     check_w_identical("ParticleVel.w (inverse mass) kept", vel, w.particles.vel);
-    check_identical("free particles' ParticlePos untouched", tail(pos), tail(w.particles.pos));
-    check_identical("free particles' ParticleVel untouched", tail(vel), tail(w.particles.vel));
+    check_identical("free particles' ParticlePos untouched", slice(pos, rigid, pos.size()),
+                    slice(w.particles.pos, rigid, pos.size()));
+    check_identical("free particles' ParticleVel untouched", slice(vel, rigid, vel.size()),
+                    slice(w.particles.vel, rigid, vel.size()));
     check_identical("NeighbourState", state, state_want);
     end_case();
   }
