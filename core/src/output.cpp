@@ -24,13 +24,13 @@ const char* output_format_name(OutputFormat format) {
   return "?";
 }
 
-Result<std::unique_ptr<FrameWriter>> open_frame_writer(OutputFormat format,
-                                                       const std::string& dir) {
+Result<std::unique_ptr<FrameWriter>> open_frame_writer(OutputFormat format, const std::string& dir,
+                                                       std::vector<std::string> body_names) {
   switch (format) {
     case OutputFormat::Vtu:
       return open_vtu_writer(dir);
     case OutputFormat::Csv:
-      return open_csv_writer(dir);
+      return open_csv_writer(dir, std::move(body_names));
     case OutputFormat::None:
       break;
   }

@@ -16,9 +16,33 @@ using output::OutputFile;
 // Rows are formatted into a buffer and written in pieces of about this size.
 constexpr std::size_t kChunkBytes = std::size_t{1} << 20;
 
+/// A CSV field: as is, or in double quotes (inner quotes doubled) when it holds a comma, a quote
+/// or a line break (RFC 4180).
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+/// Writes `buf` to `file` once it holds a chunk (or always, with `force`).
+Status drain(OutputFile& file, fmt::memory_buffer& buf, bool force) {
+  if (!force && buf.size() < kChunkBytes) return Status::ok();
+  if (Status st = file.write(buf.data(), buf.size()); !st) return st;
+  buf.clear();
+  return Status::ok();
+}
+
 class CsvWriter final : public FrameWriter {
  public:
-  explicit CsvWriter(OutputFile file) : file_(std::move(file)), path_(file_.path()) {}
+  CsvWriter(OutputFile file, OutputFile bodies, std::vector<std::string> body_names)
+      : file_(std::move(file)),
+        bodies_(std::move(bodies)),
+        path_(file_.path()),
+        body_names_(std::move(body_names)) {}
 
   Status write_frame(const Snapshot& s) override {
     if (Status st = output::check_snapshot(s); !st) return st;
@@ -38,30 +62,61 @@ class CsvWriter final : public FrameWriter {
     }
     if (Status st = file_.write(buf.data(), buf.size()); !st) return st;
     if (Status st = file_.flush(); !st) return st;
+    buf.clear();
+    for (std::size_t b = 0; b < s.body_pos.size(); ++b) {
+      const shared::vec4& x = s.body_pos[b];
+      const shared::vec4& q = s.body_quat[b];
+      const shared::vec4& v = s.body_vel[b];
+      const shared::vec4& w = s.body_angvel[b];
+      fmt::format_to(std::back_inserter(buf),
+                     "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", frame, s.time, b,
+                     b < body_names_.size() ? csv_field(body_names_[b]) : "", x.x, x.y, x.z, q.x,
+                     q.y, q.z, q.w, v.x, v.y, v.z, w.x, w.y, w.z);
+      if (Status st = drain(bodies_, buf, false); !st) return st;
+    }
+    if (Status st = drain(bodies_, buf, true); !st) return st;
+    if (Status st = bodies_.flush(); !st) return st;
     ++frames_;
     return Status::ok();
   }
 
-  Status finish() override { return file_.close(); }
+  Status finish() override {
+    Status a = file_.close();
+    Status b = bodies_.close();
+    return a ? b : a;
+  }
   [[nodiscard]] std::size_t frames() const override { return frames_; }
   [[nodiscard]] const std::string& main_path() const override { return path_; }
 
  private:
   OutputFile file_;
+  OutputFile bodies_;
   std::string path_;
+  std::vector<std::string> body_names_;
   std::size_t frames_ = 0;
 };
 
 }  // namespace
 
-Result<std::unique_ptr<FrameWriter>> open_csv_writer(const std::string& dir) {
+Result<std::unique_ptr<FrameWriter>> open_csv_writer(const std::string& dir,
+                                                     std::vector<std::string> body_names) {
   if (Status s = create_output_directory(dir); !s) return s;
   auto opened = OutputFile::create((std::filesystem::path(dir) / "particles.csv").string());
   if (!opened) return opened.status();
   OutputFile file = std::move(opened).value();
   if (Status s = file.write(std::string("frame,time,particle,body,x,y,z,vx,vy,vz\n")); !s) return s;
   if (Status s = file.flush(); !s) return s;
-  return std::unique_ptr<FrameWriter>(std::make_unique<CsvWriter>(std::move(file)));
+  auto bodies_opened = OutputFile::create((std::filesystem::path(dir) / "bodies.csv").string());
+  if (!bodies_opened) return bodies_opened.status();
+  OutputFile bodies = std::move(bodies_opened).value();
+  if (Status s =
+          bodies.write(std::string("frame,time,body,name,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz\n"));
+      !s) {
+    return s;
+  }
+  if (Status s = bodies.flush(); !s) return s;
+  return std::unique_ptr<FrameWriter>(
+      std::make_unique<CsvWriter>(std::move(file), std::move(bodies), std::move(body_names)));
 }
 
 Status write_points_csv(const std::string& path, const std::vector<Eigen::Vector3f>& points) {

@@ -117,6 +117,13 @@ Status check_snapshot(const Snapshot& s) {
         "inconsistent snapshot at step {}: {} particle positions, {} velocities, {} body ids",
         s.step, n, s.particle_vel.size(), s.particle_body.size()));
   }
+  const std::size_t b = s.body_pos.size();
+  if (s.body_quat.size() != b || s.body_vel.size() != b || s.body_angvel.size() != b) {
+    return Status::error(fmt::format(
+        "inconsistent snapshot at step {}: {} body positions, {} orientations, {} velocities, {} "
+        "angular velocities",
+        s.step, b, s.body_quat.size(), s.body_vel.size(), s.body_angvel.size()));
+  }
   return Status::ok();
 }
 

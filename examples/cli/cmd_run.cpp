@@ -120,7 +120,11 @@ class Runner {
     sim_ = std::move(sim).value();
 
     if (format.value() != OutputFormat::None) {
-      Result<std::unique_ptr<FrameWriter>> writer = open_frame_writer(format.value(), args_.out);
+      std::vector<std::string> names;
+      names.reserve(sim_->bodies().size());
+      for (const BodyInfo& b : sim_->bodies()) names.push_back(b.name);
+      Result<std::unique_ptr<FrameWriter>> writer =
+          open_frame_writer(format.value(), args_.out, std::move(names));
       if (!writer) fail(writer.message());
       writer_ = std::move(writer).value();
     }

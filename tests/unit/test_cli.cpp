@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "motes/devices.h"
+#include "motes/scene.h"
+#include "motes/simulation.h"
 #include "unit/cli_support.h"
 #include "unit/test_support.h"
 
@@ -105,10 +107,14 @@ TEST(Cli, RunWritesVtuFramesAndSeries) {
   ASSERT_EQ(o.exit_code, 0) << describe(o);
   std::vector<std::string> vtus = files_with_extension(out, ".vtu");
   std::sort(vtus.begin(), vtus.end());
-  EXPECT_EQ(vtus, (std::vector<std::string>{"particles_000000.vtu", "particles_000001.vtu",
-                                            "particles_000002.vtu"}));
+  EXPECT_EQ(vtus, (std::vector<std::string>{"bodies_000000.vtu", "bodies_000001.vtu",
+                                            "bodies_000002.vtu", "particles_000000.vtu",
+                                            "particles_000001.vtu", "particles_000002.vtu"}));
   const std::string pvd = read_text(fs::path(out) / "particles.pvd");
-  for (const std::string& name : vtus) EXPECT_TRUE(contains(pvd, name)) << pvd;
+  const std::string bodies_pvd = read_text(fs::path(out) / "bodies.pvd");
+  for (const std::string& name : vtus) {
+    EXPECT_TRUE(contains(name.starts_with("bodies") ? bodies_pvd : pvd, name)) << name;
+  }
   // The summary says what ran and where the frames are.
   for (const char* word : {"openmp", "particles", "steps/s", "particle-steps/s", "particles.pvd"}) {
     EXPECT_TRUE(contains(o.out, word)) << word << "\n" << describe(o);
@@ -141,6 +147,48 @@ TEST(Cli, RunWritesCsvWithThreeFrames) {
   EXPECT_EQ(rows_per_frame[2], rows_per_frame[0]);
   EXPECT_EQ(times.size(), 3u);
   EXPECT_TRUE(times.count("0")) << "frame 0 is the initial state";
+}
+
+TEST(Cli, RunWritesBodyTableThatMatchesTheSimulation) {
+  // The last frame of bodies.csv is the bodies' state after the run, exactly: the same scene
+  // stepped in this process on the same backend gives the same floats.
+  TempDir tmp;
+  const std::string out = tmp / "bodies";
+  const Outcome o = run_motes(tmp, {"run", kSmallScene, "--steps", "30", "--every", "10", "--out",
+                                    out, "--format", "csv", "--backend", "openmp"});
+  ASSERT_EQ(o.exit_code, 0) << describe(o);
+  const std::vector<std::string> lines = lines_of(fs::path(out) / "bodies.csv");
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines[0], "frame,time,body,name,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz");
+
+  auto scene = motes::load_scene_file(kSmallScene);
+  ASSERT_TRUE(scene) << scene.message();
+  auto device = motes::open_device("openmp");
+  ASSERT_TRUE(device) << device.message();
+  auto sim = motes::Simulation::create(scene.value(), std::move(device).value());
+  ASSERT_TRUE(sim) << sim.message();
+  ASSERT_TRUE(sim.value()->step(30));
+  auto snap = sim.value()->snapshot();
+  ASSERT_TRUE(snap) << snap.message();
+  const std::size_t bodies = snap->body_pos.size();
+  ASSERT_GT(bodies, 0u);
+  ASSERT_EQ(lines.size(), 1 + 4 * bodies) << "a row per body for frames 0, 10, 20 and 30 steps";
+  for (std::size_t b = 0; b < bodies; ++b) {
+    std::vector<std::string> f;
+    std::stringstream ss(lines[1 + 3 * bodies + b]);
+    for (std::string field; std::getline(ss, field, ',');) f.push_back(field);
+    ASSERT_EQ(f.size(), 17u) << lines[1 + 3 * bodies + b];
+    EXPECT_EQ(f[0], "3");
+    EXPECT_EQ(std::stoul(f[2]), b);
+    EXPECT_EQ(f[3], sim.value()->bodies()[b].name);
+    const motes::shared::vec4 x = snap->body_pos[b], q = snap->body_quat[b];
+    const motes::shared::vec4 v = snap->body_vel[b], w = snap->body_angvel[b];
+    const float want[13] = {x.x, x.y, x.z, q.x, q.y, q.z, q.w, v.x, v.y, v.z, w.x, w.y, w.z};
+    for (int k = 0; k < 13; ++k) {
+      EXPECT_EQ(std::strtof(f[4 + static_cast<std::size_t>(k)].c_str(), nullptr), want[k])
+          << "body " << b << " column " << 4 + k;
+    }
+  }
 }
 
 TEST(Cli, RunWithoutSceneUsesTheBuiltInScene) {

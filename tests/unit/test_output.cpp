@@ -1,4 +1,5 @@
 // Output writers: VTU frames read back by meshio, the .pvd series, CSV parsed back, and errors.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -311,3 +312,140 @@ TEST(OutputErrors, InconsistentSnapshotAndUnknownFormat) {
 }
 
 }  // namespace
+
+namespace {
+
+/// Three bodies with values that need all nine digits, added to a particle snapshot.
+motes::Snapshot with_bodies(motes::Snapshot s, float shift) {
+  for (int b = 0; b < 3; ++b) {
+    const float f = static_cast<float>(b) + shift;
+    s.body_pos.emplace_back(0.1f * f, -1.0f / 3.0f + f, 123456.789f - f, 0.5f);
+    const float c = std::cos(0.3f * f);
+    const float sn = std::sin(0.3f * f);
+    s.body_quat.emplace_back(sn, 0.0f, 0.0f, c);
+    s.body_vel.emplace_back(7.0f / 9.0f * f, -2.5f, 1.0e-30f, 0.0f);
+    s.body_angvel.emplace_back(0.0f, 3.0e-7f * f, -11.0f, 0.0f);
+    s.body_angmom.emplace_back(0.0f);
+  }
+  return s;
+}
+
+/// Splits one CSV line with RFC 4180 quoting ("a,b" and "" inside quotes).
+std::vector<std::string> split_quoted(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+      out.back() += '"';
+      ++i;
+    } else if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      out.emplace_back();
+    } else {
+      out.back() += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(OutputCsv, BodyTableReadsBackExactly) {
+  TempDir tmp;
+  const std::vector<std::string> names = {"plain", "with, comma", "say \"hi\""};
+  auto writer = motes::open_csv_writer(tmp.path().string(), names);
+  ASSERT_TRUE(writer) << writer.message();
+  const std::vector<motes::Snapshot> frames = {with_bodies(sample_snapshot(0, 0.0, 0.0f), 0.0f),
+                                               with_bodies(sample_snapshot(5, 0.1, 2.0f), 1.5f)};
+  for (const auto& f : frames) ASSERT_TRUE(writer.value()->write_frame(f));
+  ASSERT_TRUE(writer.value()->finish());
+
+  std::ifstream in(tmp.path() / "bodies.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line, "frame,time,body,name,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz");
+  std::size_t rows = 0;
+  while (std::getline(in, line)) {
+    const auto f = split_quoted(line);
+    ASSERT_EQ(f.size(), 17u) << line;
+    const std::size_t frame = std::stoul(f[0]);
+    const std::size_t b = std::stoul(f[2]);
+    ASSERT_LT(frame, frames.size());
+    ASSERT_LT(b, names.size());
+    EXPECT_EQ(rows, frame * names.size() + b) << "rows out of order";
+    const motes::Snapshot& s = frames[frame];
+    EXPECT_EQ(std::strtod(f[1].c_str(), nullptr), s.time);
+    EXPECT_EQ(f[3], names[b]);
+    const motes::shared::vec4 want[4] = {s.body_pos[b], s.body_quat[b], s.body_vel[b],
+                                         s.body_angvel[b]};
+    EXPECT_EQ(parse_float(f[4]), want[0].x) << line;
+    EXPECT_EQ(parse_float(f[5]), want[0].y) << line;
+    EXPECT_EQ(parse_float(f[6]), want[0].z) << line;
+    EXPECT_EQ(parse_float(f[7]), want[1].x) << line;
+    EXPECT_EQ(parse_float(f[8]), want[1].y) << line;
+    EXPECT_EQ(parse_float(f[9]), want[1].z) << line;
+    EXPECT_EQ(parse_float(f[10]), want[1].w) << line;
+    EXPECT_EQ(parse_float(f[11]), want[2].x) << line;
+    EXPECT_EQ(parse_float(f[12]), want[2].y) << line;
+    EXPECT_EQ(parse_float(f[13]), want[2].z) << line;
+    EXPECT_EQ(parse_float(f[14]), want[3].x) << line;
+    EXPECT_EQ(parse_float(f[15]), want[3].y) << line;
+    EXPECT_EQ(parse_float(f[16]), want[3].z) << line;
+    ++rows;
+  }
+  EXPECT_EQ(rows, frames.size() * names.size());
+}
+
+TEST(OutputVtu, BodySeriesReadsBackExactly) {
+  const std::string python = meshio_python();
+  if (python.empty()) GTEST_SKIP() << "no Python with meshio (apt-get install python3-meshio)";
+  TempDir tmp;
+  const fs::path dir = tmp.path() / "run";
+  auto writer = motes::open_vtu_writer(dir.string());
+  ASSERT_TRUE(writer) << writer.message();
+  const std::vector<motes::Snapshot> frames = {with_bodies(sample_snapshot(0, 0.0, 0.0f), 0.0f),
+                                               with_bodies(sample_snapshot(5, 0.25, 2.0f), 1.5f)};
+  for (const auto& f : frames) ASSERT_TRUE(writer.value()->write_frame(f));
+  ASSERT_TRUE(writer.value()->finish());
+
+  const auto entries = pvd_entries(dir / "bodies.pvd");
+  ASSERT_EQ(entries.size(), frames.size());
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    EXPECT_EQ(entries[k].first, fmt::format("bodies_{:06}.vtu", k));
+    EXPECT_EQ(entries[k].second, frames[k].time);
+    const motes::Snapshot& s = frames[k];
+    const nlohmann::json m = read_with_meshio(python, dir / entries[k].first, tmp.path());
+    ASSERT_FALSE(m.is_null()) << "meshio could not read " << entries[k].first;
+    EXPECT_EQ(m["field_data"]["TimeValue"][0].get<double>(), s.time);
+    ASSERT_EQ(m["points"].size(), s.body_pos.size());
+    EXPECT_EQ(m["dtypes"]["orientation"], "float32");
+    EXPECT_EQ(m["dtypes"]["angular_velocity"], "float32");
+    EXPECT_EQ(m["dtypes"]["body"], "uint32");
+    const auto& pd = m["point_data"];
+    for (std::size_t b = 0; b < s.body_pos.size(); ++b) {
+      EXPECT_EQ(m["points"][b][0].get<double>(), double{s.body_pos[b].x});
+      EXPECT_EQ(m["points"][b][1].get<double>(), double{s.body_pos[b].y});
+      EXPECT_EQ(m["points"][b][2].get<double>(), double{s.body_pos[b].z});
+      EXPECT_EQ(pd["orientation"][b][0].get<double>(), double{s.body_quat[b].x});
+      EXPECT_EQ(pd["orientation"][b][3].get<double>(), double{s.body_quat[b].w});
+      EXPECT_EQ(pd["velocity"][b][0].get<double>(), double{s.body_vel[b].x});
+      EXPECT_EQ(pd["angular_velocity"][b][1].get<double>(), double{s.body_angvel[b].y});
+      EXPECT_EQ(pd["angular_velocity"][b][2].get<double>(), double{s.body_angvel[b].z});
+      EXPECT_EQ(pd["body"][b].get<std::uint32_t>(), b);
+    }
+  }
+}
+
+TEST(OutputCsv, InconsistentBodyArraysAreRefused) {
+  TempDir tmp;
+  auto writer = motes::open_csv_writer(tmp.path().string());
+  ASSERT_TRUE(writer) << writer.message();
+  motes::Snapshot s = with_bodies(sample_snapshot(3, 0.0, 0.0f), 0.0f);
+  s.body_angvel.pop_back();
+  const motes::Status st = writer.value()->write_frame(s);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message().find("inconsistent snapshot at step 3"), std::string::npos)
+      << st.message();
+}

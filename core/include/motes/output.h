@@ -39,24 +39,34 @@ class FrameWriter {
   [[nodiscard]] virtual const std::string& main_path() const = 0;
 };
 
-/// VTU series in `dir` (created if missing): particles_000000.vtu, particles_000001.vtu, ... and
-/// particles.pvd listing every frame with its simulated time. The .pvd is rewritten (atomically,
-/// by rename) after each frame, so an interrupted run still opens in ParaView.
+/// Two VTU series in `dir` (created if missing): particles_000000.vtu, particles_000001.vtu, ...
+/// with particles.pvd, and bodies_000000.vtu, ... with bodies.pvd, each .pvd listing every frame
+/// with its simulated time. The .pvd files are rewritten (atomically, by rename) after each
+/// frame, so an interrupted run still opens in ParaView.
 ///
-/// Each .vtu is an UnstructuredGrid of VTK_VERTEX cells, one per particle, in binary appended raw
-/// encoding (header_type UInt64, the machine's byte order). Points are Float32 particle centres;
-/// point data: "velocity" (Float32 x 3), "radius" (Float32), "body" (UInt32 body index) and
-/// "speed" (Float32: the length of the velocity, computed in double and rounded to float). Field
-/// data "TimeValue" (Float64) holds the simulated time.
+/// Each .vtu is an UnstructuredGrid of VTK_VERTEX cells in binary appended raw encoding
+/// (header_type UInt64, the machine's byte order); field data "TimeValue" (Float64) holds the
+/// simulated time. Particles: one point per particle at its centre (Float32); point data
+/// "velocity" (Float32 x 3), "radius" (Float32), "body" (UInt32 body index) and "speed" (Float32:
+/// the length of the velocity, computed in double and rounded to float). Bodies: one point per
+/// body at its centre of mass; point data "orientation" (Float32 x 4: the quaternion x, y, z, w,
+/// body frame to world), "velocity", "angular_velocity" (Float32 x 3, world), "body" (UInt32) and
+/// "speed".
 Result<std::unique_ptr<FrameWriter>> open_vtu_writer(const std::string& dir);
 
-/// CSV file `dir`/particles.csv (dir created if missing), one row per particle per frame, with
-/// the header line `frame,time,particle,body,x,y,z,vx,vy,vz`. Floats are printed with the fewest
-/// digits that read back to the same float32 (time: the same double). Flushed after each frame.
-Result<std::unique_ptr<FrameWriter>> open_csv_writer(const std::string& dir);
+/// CSV files in `dir` (created if missing): particles.csv, one row per particle per frame, with
+/// the header line `frame,time,particle,body,x,y,z,vx,vy,vz`, and bodies.csv, one row per body
+/// per frame, with `frame,time,body,name,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz` (centre of mass,
+/// orientation quaternion body frame to world, velocity, angular velocity in world axes; `name`
+/// from body_names, quoted when it holds a comma or a quote, empty without one). Floats are
+/// printed with the fewest digits that read back to the same float32 (time: the same double).
+/// Flushed after each frame.
+Result<std::unique_ptr<FrameWriter>> open_csv_writer(const std::string& dir,
+                                                     std::vector<std::string> body_names = {});
 
 /// open_vtu_writer or open_csv_writer; OutputFormat::None is an error (write nothing instead).
-Result<std::unique_ptr<FrameWriter>> open_frame_writer(OutputFormat format, const std::string& dir);
+Result<std::unique_ptr<FrameWriter>> open_frame_writer(OutputFormat format, const std::string& dir,
+                                                       std::vector<std::string> body_names = {});
 
 /// Writes one snapshot as a single .vtu file (same layout as the series), not listed in any .pvd.
 Status write_vtu_file(const std::string& path, const Snapshot& snapshot);
