@@ -27,3 +27,14 @@ function(motes_target_warnings target)
     target_compile_options(${target} PRIVATE $<$<COMPILE_LANGUAGE:CXX>:-ffp-contract=off>)
   endif()
 endfunction()
+
+# A part of libmotes (an object library whose objects go into it) or libmotes_render:
+# position-independent code, symbols hidden unless a public header declares them
+# (core/include/motes/api.h), the warnings.
+function(motes_library_part target)
+  set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON
+                                             CXX_VISIBILITY_PRESET hidden
+                                             CUDA_VISIBILITY_PRESET hidden
+                                             VISIBILITY_INLINES_HIDDEN ON)
+  motes_target_warnings(${target})
+endfunction()

@@ -16,6 +16,10 @@ export MOTES_VULKAN_VALIDATION=${MOTES_VULKAN_VALIDATION:-1}
 ctest --output-on-failure -j "${JOBS:-$(nproc)}" --timeout 900 --no-tests=error \
   --output-junit "$build/ctest-results.xml"
 
+# The installed package as another project uses it (examples/embed, find_package and
+# pkg-config): static from this build, shared from a lean second build (no CUDA, no tests).
+MOTES_SKIP_INSTALL=1 "$root/scripts/check-package.sh" "$build"
+
 # The sanitizer stage: every test again, built with AddressSanitizer and UndefinedBehaviorSanitizer
 # (MOTES_SANITIZER_STAGE=0 skips it). The Vulkan tests run without the validation layer here (it
 # ran above); the Vulkan loader's and lavapipe's process-lifetime allocations are suppressed by

@@ -1,6 +1,8 @@
 // Files and directories for the output writers, with errors that name the path.
 #include "output_file.h"
 
+#include "motes/output.h"
+
 #include <fmt/format.h>
 
 #include <cerrno>

@@ -252,6 +252,7 @@ Status Simulation::upload(const Scene& scene) {
   if (s) s = write_vector(d, Buffer::BodyAngMom, bangmom);
   if (s) s = write_vector(d, Buffer::BodyAngVel, bangvel);
   if (s) s = write_vector(d, Buffer::BodyInvInertia, binertia);
+  rigid_inv_inertia_ = binertia;
   if (s) s = write_vector(d, Buffer::BodyFirst, rigid_first_);
   if (s) s = write_vector(d, Buffer::NeighbourRefPos, ppos);
   if (s) s = d.write(Buffer::NeighbourState, neighbour_state, sizeof neighbour_state);
@@ -369,6 +370,63 @@ Status Simulation::restore(const Snapshot& state) {
   if (s) s = d.write(Buffer::NeighbourState, neighbour_state, sizeof neighbour_state);
   if (!s) return s;
   return d.synchronize();
+}
+
+Status Simulation::set_body_velocities(const std::vector<Eigen::Vector3d>& velocity,
+                                       const std::vector<Eigen::Vector3d>& angular) {
+  const std::size_t count = bodies_.size();
+  if (velocity.size() != count || (!angular.empty() && angular.size() != count)) {
+    return Status::error(
+        fmt::format("set_body_velocities: {} velocities and {} angular velocities for {} bodies",
+                    velocity.size(), angular.size(), count));
+  }
+  for (std::size_t b = 0; b < count; ++b) {
+    const bool moving = !velocity[b].isZero(0.0) || (!angular.empty() && !angular[b].isZero(0.0));
+    if (!velocity[b].allFinite() || (!angular.empty() && !angular[b].allFinite())) {
+      return Status::error(fmt::format("set_body_velocities: body {} '{}': not a finite velocity",
+                                       b, bodies_[b].name));
+    }
+    if (bodies_[b].kind == BodyKind::Static && moving) {
+      return Status::error(
+          fmt::format("set_body_velocities: body {} '{}' is static: its velocity stays zero", b,
+                      bodies_[b].name));
+    }
+    if (bodies_[b].free_sphere && !angular.empty() && !angular[b].isZero(0.0)) {
+      return Status::error(fmt::format(
+          "set_body_velocities: body {} '{}' is a free sphere, which does not turn: its angular "
+          "velocity stays zero",
+          b, bodies_[b].name));
+    }
+  }
+  Result<Snapshot> snap = snapshot();
+  if (!snap) return snap.status();
+  Snapshot& state = snap.value();
+  for (std::size_t b = 0; b < count; ++b) {
+    const BodyInfo& info = bodies_[b];
+    const vec4 v = to_vec4(velocity[b], 0.0);
+    if (info.free_sphere) {
+      const vec4 old = state.particle_vel[info.first_particle];
+      state.particle_vel[info.first_particle] = vec4(v.x, v.y, v.z, old.w);
+      continue;
+    }
+    state.body_vel[b] = v;
+    if (angular.empty()) continue;
+    // L = R diag(I) R^T w, in double, with the moments the body was uploaded with.
+    const vec4 q = state.body_quat[b];
+    const Eigen::Matrix3d rot =
+        Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
+    const vec4 inv = rigid_inv_inertia_[device_index_[b]];
+    const auto moment = [](float inverse) {
+      return inverse > 0.0f ? 1.0 / static_cast<double>(inverse) : 0.0;
+    };
+    const Eigen::Vector3d moments(moment(inv.x), moment(inv.y), moment(inv.z));
+    state.body_angvel[b] = to_vec4(angular[b], 0.0);
+    state.body_angmom[b] = to_vec4(rot * moments.asDiagonal() * rot.transpose() * angular[b], 0.0);
+  }
+  if (Status s = restore(state); !s) return s;
+  // The rigid particles' velocities from their bodies' new motion.
+  if (sizes_.rigid_particles > 0) device_->particles_update(params_);
+  return device_->synchronize();
 }
 
 Result<NeighbourStats> Simulation::neighbour_stats() {

@@ -228,6 +228,8 @@ class Runner {
 
   void summary() const {
     const DeviceInfo& info = sim_->device().info();
+    // The state's fingerprint: equal on every run of the same scene, steps and backend.
+    const Result<std::uint64_t> hash = sim_->state_hash();
     const std::uint64_t steps = sim_->steps();
     const double rate = step_seconds_ > 0.0 ? static_cast<double>(steps) / step_seconds_ : 0.0;
     const double particle_rate = rate * sim_->particle_count();
@@ -238,6 +240,7 @@ class Runner {
     fmt::print("  {:<16}{}\n", "bodies", sim_->body_count());
     fmt::print("  {:<16}{} of {}\n", "steps", steps, total_);
     fmt::print("  {:<16}{:.6g} s\n", "simulated time", sim_->time());
+    if (hash) fmt::print("  {:<16}{:016x}\n", "state hash", hash.value());
     fmt::print("  {:<16}{} (scene, device and upload)\n", "setup", format_seconds(setup_seconds_));
     fmt::print("  {:<16}{} (stepping {}, checks and output {})\n", "wall time",
                format_seconds(wall_seconds_), format_seconds(step_seconds_),

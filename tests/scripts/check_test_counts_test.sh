@@ -21,7 +21,7 @@ case_xml() {  # case_xml FILE "name status" ...
   } >"$work/$file"
 }
 case_xml first.xml "Grid.Sort run" "Param/Case.Run/vulkan_0__#_GetParam()_=_0x55d0 run" \
-  "Conformance/Grid.Sort/cuda_0 run" "Cli.RunOnCuda notrun" "Render.Png notrun"
+  "Conformance/Grid.Sort/cuda_0 run" "Cli.RunOnCuda notrun" "Render.Png notrun" "Python.Module run"
 case_xml same.xml "Grid.Sort run" "Param/Case.Run/vulkan_0__#_GetParam()_=_0x7f10 run" \
   "Sanitizers.LeakCanary run"
 case_xml missing.xml "Param/Case.Run/vulkan_0 run"

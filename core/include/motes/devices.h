@@ -5,9 +5,11 @@
 #include <string>
 #include <vector>
 
+#include "motes/api.h"
 #include "motes/backend/device.h"
 #include "motes/status.h"
 
+MOTES_API_BEGIN
 namespace motes {
 
 /// What `motes devices` prints for one backend.
@@ -34,3 +36,4 @@ Result<std::unique_ptr<Device>> open_device(const std::string& backend, int inde
                                             const DeviceOptions& options = {});
 
 }  // namespace motes
+MOTES_API_END

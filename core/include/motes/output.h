@@ -7,9 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "motes/api.h"
 #include "motes/simulation.h"
 #include "motes/status.h"
 
+MOTES_API_BEGIN
 namespace motes {
 
 /// What `motes run --format` writes.
@@ -83,3 +85,4 @@ Snapshot particle_set_snapshot(const std::vector<Eigen::Vector3f>& points, doubl
 Status create_output_directory(const std::string& dir, const std::string& purpose = "output");
 
 }  // namespace motes
+MOTES_API_END

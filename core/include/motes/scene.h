@@ -9,9 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "motes/api.h"
 #include "motes/shapes.h"
 #include "motes/status.h"
 
+MOTES_API_BEGIN
 namespace motes {
 
 /// A named material: density and the contact law of its particles.
@@ -93,3 +95,4 @@ Result<Scene> load_scene_text(const std::string& text, const std::string& source
 Result<Scene> builtin_default_scene();
 
 }  // namespace motes
+MOTES_API_END

@@ -7,8 +7,10 @@
 #include <string>
 #include <vector>
 
+#include "motes/api.h"
 #include "motes/status.h"
 
+MOTES_API_BEGIN
 namespace motes {
 
 /// Equal spheres filling a shape, in the shape's own frame (metres).
@@ -73,3 +75,4 @@ struct MassProperties {
 MassProperties mass_properties(const ParticleSet& particles, double density);
 
 }  // namespace motes
+MOTES_API_END

@@ -7,11 +7,13 @@
 #include <utility>
 #include <vector>
 
+#include "motes/api.h"
 #include "motes/backend/device.h"
 #include "motes/scene.h"
 #include "motes/status.h"
 #include "shared/common.h"
 
+MOTES_API_BEGIN
 namespace motes {
 
 /// State read back from the device (vec4 layouts as in motes::Buffer), in the scene's order: body
@@ -67,6 +69,13 @@ class Simulation {
   /// Reads the neighbour-list figures from the device.
   Result<NeighbourStats> neighbour_stats();
 
+  /// Sets every body's velocity (m/s) and, unless `angular` is empty, angular velocity (rad/s,
+  /// world axes), in the scene's body order; the particles' velocities follow. A static body
+  /// must get zero, a free sphere (which never turns) a zero angular velocity: anything else is
+  /// an error naming the body, and nothing is changed.
+  Status set_body_velocities(const std::vector<Eigen::Vector3d>& velocity,
+                             const std::vector<Eigen::Vector3d>& angular = {});
+
   /// Writes the dynamic state (bodies, particles, step, time) to a checkpoint file.
   Status save_state(const std::string& path);
   /// Restores a checkpoint written by save_state for the same scene (same particle and body
@@ -107,6 +116,8 @@ class Simulation {
   std::vector<std::uint32_t> device_index_;
   /// BodyFirst as uploaded (B + 1 entries): the first device particle of each rigid body.
   std::vector<std::uint32_t> rigid_first_;
+  /// BodyInvInertia as uploaded (B entries): inverse principal moments of each rigid body.
+  std::vector<shared::vec4> rigid_inv_inertia_;
   /// (scene body, orientation) of the free spheres that are not at the identity orientation; a
   /// free sphere never turns.
   std::vector<std::pair<std::uint32_t, shared::vec4>> sphere_turns_;
@@ -115,3 +126,4 @@ class Simulation {
 };
 
 }  // namespace motes
+MOTES_API_END

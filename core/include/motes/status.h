@@ -6,6 +6,9 @@
 #include <string>
 #include <utility>
 
+#include "motes/api.h"
+
+MOTES_API_BEGIN
 namespace motes {
 
 /// Outcome of an operation: ok, or a message written for the user.
@@ -70,3 +73,4 @@ class Error : public std::runtime_error {
 };
 
 }  // namespace motes
+MOTES_API_END

@@ -4,8 +4,10 @@
 #include <cstdint>
 #include <string>
 
+#include "motes/api.h"
 #include "motes/scene.h"
 
+MOTES_API_BEGIN
 namespace motes {
 
 /// W1 "settle": NX x NY x NZ free spheres (d = 0.01 m, density 2500 kg/m^3) on a simple-cubic
@@ -28,3 +30,4 @@ bool settle_dimensions(std::uint64_t particles, int& nx, int& ny, int& nz);
 Scene dominoes_workload(int count, int rows);
 
 }  // namespace motes
+MOTES_API_END

@@ -10,10 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "motes/api.h"
 #include "motes/scene.h"
 #include "motes/simulation.h"
 #include "motes/status.h"
 
+MOTES_API_BEGIN
 namespace motes::render {
 
 /// An 8-bit sRGB picture, rows top to bottom, 3 bytes (R, G, B) per pixel.
@@ -132,3 +134,4 @@ class FrameRenderer {
 Status write_png(const std::string& path, const Image& image);
 
 }  // namespace motes::render
+MOTES_API_END

@@ -8,10 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "motes/api.h"
 #include "motes/render.h"
 #include "motes/simulation.h"
 #include "motes/status.h"
 
+MOTES_API_BEGIN
 namespace motes::render {
 
 /// The video frame rate for frames `interval` simulated seconds apart: 1 / interval, clamped to
@@ -125,3 +127,4 @@ class FrameReader {
 };
 
 }  // namespace motes::render
+MOTES_API_END

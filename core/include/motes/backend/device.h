@@ -8,9 +8,11 @@
 #include <cstdint>
 #include <string>
 
+#include "motes/api.h"
 #include "motes/status.h"
 #include "shared/params.h"
 
+MOTES_API_BEGIN
 namespace motes {
 
 /// Every buffer a device holds, grouped by feature. Element types and counts: see
@@ -175,3 +177,4 @@ class Device {
 };
 
 }  // namespace motes
+MOTES_API_END

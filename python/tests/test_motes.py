@@ -1,0 +1,126 @@
+"""The Python module against the command line and its own promises (pytest, Debian's
+/usr/bin/python3 with python3-pytest and python3-numpy). ctest runs it with PYTHONPATH at the
+build's python/ folder, MOTES_CLI_PATH at the motes command and MOTES_SOURCE_DIR at the source."""
+import csv
+import os
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import motes
+
+SOURCE = os.environ.get("MOTES_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+CLI = os.environ.get("MOTES_CLI_PATH", "motes")
+DOMINOES = os.path.join(SOURCE, "examples", "scenes", "dominoes.json")
+
+
+def cli_hash(scene, steps, backend):
+    out = subprocess.run([CLI, "run", scene, "--steps", str(steps), "--every", str(steps),
+                          "--format", "none", "--backend", backend],
+                         check=True, capture_output=True, text=True).stdout
+    return int(re.search(r"state hash\s+([0-9a-f]{16})", out).group(1), 16)
+
+
+def test_dominoes_fall_the_same_as_from_the_command_line():
+    sim = motes.Simulation(motes.load_scene(DOMINOES), backend="openmp")
+    sim.step(400)
+    assert sim.steps == 400
+    assert sim.state_hash() == cli_hash(DOMINOES, 400, "openmp")
+
+
+def test_a_scene_from_a_dict_is_the_scene_from_its_file():
+    import json
+    with open(DOMINOES) as f:
+        as_dict = json.load(f)
+    a = motes.Simulation(motes.load_scene(as_dict), backend="openmp")
+    b = motes.Simulation(motes.load_scene(DOMINOES), backend="openmp")
+    a.step(50)
+    b.step(50)
+    assert a.state_hash() == b.state_hash()
+
+
+def test_state_arrays_have_the_documented_shapes():
+    sim = motes.Simulation(motes.default_scene(), backend="openmp")
+    sim.step(10)
+    n, b = sim.particle_count, sim.body_count
+    assert (n, b) == (600, 40)
+    for array, shape, dtype in [(sim.positions(), (n, 3), np.float32),
+                                (sim.velocities(), (n, 3), np.float32),
+                                (sim.radii(), (n,), np.float32),
+                                (sim.particle_bodies(), (n,), np.uint32),
+                                (sim.body_positions(), (b, 3), np.float32),
+                                (sim.body_orientations(), (b, 4), np.float32),
+                                (sim.body_velocities(), (b, 3), np.float32),
+                                (sim.body_angular_velocities(), (b, 3), np.float32)]:
+        assert array.shape == shape and array.dtype == dtype
+    q = sim.body_orientations()
+    assert np.allclose(np.linalg.norm(q, axis=1), 1.0, atol=1e-6)
+    # Copies: changing one changes nothing in the simulation.
+    p = sim.positions()
+    p[:] = 0.0
+    assert not np.array_equal(sim.positions(), p)
+    assert len(sim.body_names) == b and sim.body_names[0] == "first"
+
+
+def test_set_body_velocities_moves_the_particles_with_their_body():
+    sim = motes.Simulation(motes.default_scene(), backend="openmp")
+    v = np.zeros((sim.body_count, 3))
+    w = np.zeros((sim.body_count, 3))
+    v[5] = [0.1, 0.2, -0.3]
+    w[5] = [0.0, 0.0, 2.0]
+    sim.set_body_velocities(v, w)
+    assert np.allclose(sim.body_velocities()[5], v[5], atol=1e-7)
+    assert np.allclose(sim.body_angular_velocities()[5], w[5], atol=1e-6)
+    # A particle's velocity is v + w x r, r from the body's centre.
+    mine = sim.particle_bodies() == 5
+    r = sim.positions()[mine] - sim.body_positions()[5]
+    expected = v[5] + np.cross(w[5], r)
+    assert np.allclose(sim.velocities()[mine], expected, atol=1e-6)
+    with pytest.raises(motes.Error, match="expected an array of shape"):
+        sim.set_body_velocities(np.zeros((3, 3)))
+
+
+def test_bad_scenes_raise_with_the_file_and_the_path():
+    with pytest.raises(motes.Error, match=r"<dict>: /settings/dtt: unknown key"):
+        motes.load_scene({"settings": {"dtt": 1e-4}, "bodies": []})
+    bad = os.path.join(SOURCE, "tests", "data", "scenes", "bad", "negative_dt.json")
+    with pytest.raises(motes.Error, match=re.escape(bad)):
+        motes.load_scene(bad)
+    with pytest.raises(motes.Error, match="cannot open|No such file"):
+        motes.load_scene("/no/such/scene.json")
+
+
+def test_a_missing_backend_raises_with_the_reason():
+    with pytest.raises(motes.Error, match="nosuch"):
+        motes.Simulation(motes.default_scene(), backend="nosuch")
+    for report in motes.devices():
+        if report["compiled"] and not report["devices"]:
+            with pytest.raises(motes.Error) as raised:
+                motes.Simulation(motes.default_scene(), backend=report["backend"])
+            assert report["unavailable_reason"] in str(raised.value)
+
+
+def test_frame_writer_writes_particles_and_the_body_table(tmp_path):
+    sim = motes.Simulation(motes.default_scene(), backend="openmp")
+    writer = motes.FrameWriter(str(tmp_path), "csv", sim.body_names)
+    for _ in range(3):
+        writer.write(sim)
+        sim.step(20)
+    writer.close()
+    assert writer.frames == 3
+    with open(tmp_path / "bodies.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 3 * sim.body_count
+    assert rows[-1]["name"] == sim.body_names[-1]
+    with pytest.raises(motes.Error, match="unknown output format"):
+        motes.FrameWriter(str(tmp_path), "xml")
+
+
+def test_the_readme_example_runs():
+    env = dict(os.environ, PYTHONPATH=os.path.dirname(os.path.abspath(motes.__file__)))
+    out = subprocess.run([sys.executable, os.path.join(SOURCE, "python", "example.py")],
+                         cwd=SOURCE, env=env, check=True, capture_output=True, text=True).stdout
+    assert re.match(r"\w+: t = 0\.030 s, lowest particle at y = [0-9.]+ m, 40 bodies", out), out
