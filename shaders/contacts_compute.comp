@@ -39,7 +39,7 @@ void main() {
     int ranges = grid_walk(neighbour_ref_pos[i], lo, hi);
     for (int r = 0; r < ranges; ++r) {
       for (uint t = lo[r]; t < hi[r]; ++t) {
-        if (sorted_body[t] == body_i) continue;
+        if (contact_excluded(sorted_body[t], body_i)) continue;
         uint j = grid_order[t];
         vec4 pj = particle_pos[j];
         vec4 vj = particle_vel[j];

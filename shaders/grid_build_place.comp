@@ -18,7 +18,5 @@ void main() {
   }
   grid_order[s] = i;
   sorted_pos[s] = particle_pos[i];
-  sorted_vel[s] = particle_vel[i];
   sorted_body[s] = particle_body[i];
-  sorted_material[s] = particle_material[i];
 }

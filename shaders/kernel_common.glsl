@@ -4,6 +4,7 @@
 #define MOTES_KERNEL_COMMON_GLSL
 
 #include "shared/common.h"
+#include "shared/links.h"
 #include "shared/params.h"
 #include "vulkan_bindings.h"
 
@@ -34,15 +35,14 @@ layout(std430, binding = B_GRID_BUCKET) buffer GridBucketBuf { uint grid_bucket_
 layout(std430, binding = B_GRID_ORDER) buffer GridOrderBuf { uint grid_order[]; };
 layout(std430, binding = B_GRID_CELL_START) buffer GridCellStartBuf { uint grid_cell_start[]; };
 layout(std430, binding = B_SORTED_POS) buffer SortedPosBuf { vec4 sorted_pos[]; };
-layout(std430, binding = B_SORTED_VEL) buffer SortedVelBuf { vec4 sorted_vel[]; };
 layout(std430, binding = B_SORTED_BODY) buffer SortedBodyBuf { uint sorted_body[]; };
-layout(std430, binding = B_SORTED_MATERIAL) buffer SortedMaterialBuf { uint sorted_material[]; };
 layout(std430, binding = B_NEIGHBOUR_LIST) buffer NeighbourListBuf { uint neighbour_list[]; };
 layout(std430, binding = B_NEIGHBOUR_COUNT) buffer NeighbourCountBuf { uint neighbour_count[]; };
 layout(std430, binding = B_NEIGHBOUR_REF_POS) buffer NeighbourRefPosBuf { vec4 neighbour_ref_pos[]; };
 layout(std430, binding = B_NEIGHBOUR_STATE) buffer NeighbourStateBuf { uint neighbour_state[]; };
 layout(std430, binding = B_CONTACT_LAWS) readonly buffer ContactLawsBuf { ContactLaw contact_laws[]; };
 layout(std430, binding = B_PLANES) readonly buffer PlanesBuf { PlaneData planes[]; };
+layout(std430, binding = B_CONSTRAINTS) readonly buffer ConstraintsBuf { Constraint constraints[]; };
 layout(std430, binding = B_GRID_ARRIVAL) buffer GridArrivalBuf { uint grid_arrival[]; };
 layout(std430, binding = B_GRID_UNSORTED) buffer GridUnsortedBuf { uint grid_unsorted[]; };
 layout(std430, binding = B_SCAN_SCRATCH) buffer ScanScratchBuf { uint scan_scratch[]; };

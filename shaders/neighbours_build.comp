@@ -31,7 +31,8 @@ void main() {
       int ranges = grid_walk(pi, lo, hi);
       for (int r = 0; r < ranges; ++r) {
         for (uint t = lo[r]; t < hi[r]; ++t) {
-          if (sorted_body[t] == body_i || !neighbour_within(pi, sorted_pos[t], p.neighbour_skin)) {
+          if (contact_excluded(sorted_body[t], body_i) ||
+              !neighbour_within(pi, sorted_pos[t], p.neighbour_skin)) {
             continue;
           }
           if (c < p.neighbour_capacity) neighbour_list[c * p.particle_count + i] = grid_order[t];

@@ -15,7 +15,7 @@ void main() {
   barrier();
   if (i < p.particle_count) {
     vec4 pos = particle_pos[i];
-    vec4 vel = particle_vel[i];
+    vec4 vel = linked_damped(particle_vel[i], i, p.linked_first, p.linked_damping);
     particle_integrate(pos, vel, particle_force[i], p.gravity_dt);
     particle_pos[i] = pos;
     particle_vel[i] = vel;

@@ -23,23 +23,22 @@
 #define B_GRID_ORDER 16
 #define B_GRID_CELL_START 17
 #define B_SORTED_POS 18
-#define B_SORTED_VEL 19
-#define B_SORTED_BODY 20
-#define B_SORTED_MATERIAL 21
-#define B_NEIGHBOUR_LIST 22
-#define B_NEIGHBOUR_COUNT 23
-#define B_NEIGHBOUR_REF_POS 24
-#define B_NEIGHBOUR_STATE 25
-#define B_CONTACT_LAWS 26
-#define B_PLANES 27
+#define B_SORTED_BODY 19
+#define B_NEIGHBOUR_LIST 20
+#define B_NEIGHBOUR_COUNT 21
+#define B_NEIGHBOUR_REF_POS 22
+#define B_NEIGHBOUR_STATE 23
+#define B_CONTACT_LAWS 24
+#define B_PLANES 25
+#define B_CONSTRAINTS 26
 // Scratch buffers of the backend (not part of motes::Buffer).
-#define B_GRID_ARRIVAL 28  // uint (N): arrival rank of a particle in its bucket (atomic, any order)
-#define B_GRID_UNSORTED 29  // uint (N): particle ids grouped by bucket, in arrival order
-#define B_SCAN_SCRATCH 30   // uint: block sums of every level of the bucket-count scan
+#define B_GRID_ARRIVAL 27  // uint (N): arrival rank of a particle in its bucket (atomic, any order)
+#define B_GRID_UNSORTED 28  // uint (N): particle ids grouped by bucket, in arrival order
+#define B_SCAN_SCRATCH 29   // uint: block sums of every level of the bucket-count scan
 // uint: VkDispatchIndirectCommand (4 words each) of every pass of a conditional rebuild, then the
 // same for when it runs (written once at allocate); neighbours_decide copies or zeroes the first.
-#define B_INDIRECT_ARGS 31
-#define B_COUNT 32
+#define B_INDIRECT_ARGS 30
+#define B_COUNT 31
 
 // Threads per workgroup of every kernel; the scan handles 4 elements per thread.
 #define WORKGROUP_SIZE 256

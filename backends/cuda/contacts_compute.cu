@@ -7,6 +7,7 @@
 #include "cuda_device.h"
 #include "grid_walk.cuh"
 #include "shared/contact_force.h"
+#include "shared/links.h"
 
 namespace motes::cuda {
 
@@ -60,7 +61,7 @@ __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
     const uint body_i = in.body[i];
     grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
       for (uint t = lo; t < hi; ++t) {
-        if (in.sbody[t] != body_i) add_contact(in.order[t]);
+        if (!shared::contact_excluded(in.sbody[t], body_i)) add_contact(in.order[t]);
       }
     });
   }

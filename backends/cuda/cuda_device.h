@@ -57,6 +57,9 @@ class CudaDevice final : public Device {
   void particles_integrate(const shared::StepParams& p) override {
     enqueue(Kernel::ParticlesIntegrate, p);
   }
+  void constraints_solve(const shared::StepParams& p) override {
+    enqueue(Kernel::ConstraintsSolve, p);
+  }
 
   Status synchronize() override;
   Status check_guards() override;
@@ -106,6 +109,7 @@ class CudaDevice final : public Device {
   void launch_bodies_reduce(const shared::StepParams& p);
   void launch_bodies_integrate(const shared::StepParams& p);
   void launch_particles_update(const shared::StepParams& p);
+  void launch_constraints_solve(const shared::StepParams& p);
   /// bodies_reduce, bodies_integrate and particles_update in one pass (bodies_step.cu), for scenes
   /// whose bodies are small; the same arithmetic as the three kernels.
   void launch_bodies_step(const shared::StepParams& p);

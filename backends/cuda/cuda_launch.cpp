@@ -83,6 +83,9 @@ std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t
     case Kernel::ParticlesIntegrate:
       launch_particles_integrate(p);
       return 1;
+    case Kernel::ConstraintsSolve:
+      launch_constraints_solve(p);
+      return 1;
     case Kernel::Count:
       break;
   }

@@ -34,11 +34,8 @@ __global__ void grid_hash_kernel(shared::StepParams p, const vec4* __restrict__ 
 /// starts is written exactly once, and with coalesced stores however sparse the table.
 __global__ void grid_reorder_kernel(shared::StepParams p, const uint* __restrict__ keys,
                                     const uint* __restrict__ order, const vec4* __restrict__ pos,
-                                    const vec4* __restrict__ vel, const uint* __restrict__ body,
-                                    const uint* __restrict__ material,
-                                    uint* __restrict__ cell_start, vec4* __restrict__ spos,
-                                    vec4* __restrict__ svel, uint* __restrict__ sbody,
-                                    uint* __restrict__ smat) {
+                                    const uint* __restrict__ body, uint* __restrict__ cell_start,
+                                    vec4* __restrict__ spos, uint* __restrict__ sbody) {
   __shared__ uint block_keys[CudaDevice::kBlock];
   const uint n = p.particle_count;
   const std::uint64_t s0 = std::uint64_t{blockIdx.x} * blockDim.x;
@@ -46,9 +43,7 @@ __global__ void grid_reorder_kernel(shared::StepParams p, const uint* __restrict
   if (s < n) {
     const uint i = order[s];
     spos[s] = pos[i];
-    svel[s] = vel[i];
     sbody[s] = body[i];
-    smat[s] = material[i];
     block_keys[threadIdx.x] = keys[s];
   }
   __syncthreads();
@@ -112,10 +107,8 @@ void CudaDevice::launch_grid_build(const shared::StepParams& p) {
     return;
   }
   grid_reorder_kernel<<<blocks_for(n), kBlock, 0, stream_>>>(
-      p, sorted_keys_, order, buf<vec4>(Buffer::ParticlePos), buf<vec4>(Buffer::ParticleVel),
-      buf<uint>(Buffer::ParticleBody), buf<uint>(Buffer::ParticleMaterial), cell_start,
-      buf<vec4>(Buffer::SortedPos), buf<vec4>(Buffer::SortedVel), buf<uint>(Buffer::SortedBody),
-      buf<uint>(Buffer::SortedMaterial));
+      p, sorted_keys_, order, buf<vec4>(Buffer::ParticlePos), buf<uint>(Buffer::ParticleBody),
+      cell_start, buf<vec4>(Buffer::SortedPos), buf<uint>(Buffer::SortedBody));
 }
 
 }  // namespace motes::cuda

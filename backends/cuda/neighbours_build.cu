@@ -7,6 +7,7 @@
 // conditional rebuild (cuda_launch.cpp).
 #include "cuda_device.h"
 #include "grid_walk.cuh"
+#include "shared/links.h"
 #include "shared/neighbours.h"
 
 namespace motes::cuda {
@@ -58,7 +59,7 @@ __global__ void neighbours_build_kernel(shared::StepParams p, BuildInputs in, Bu
       const std::size_t stride = p.particle_count;
       grid_walk(p, pi, in.cell_start, [&](uint lo, uint hi) {
         for (uint t = lo; t < hi; ++t) {
-          if (in.sbody[t] == body_i ||
+          if (shared::contact_excluded(in.sbody[t], body_i) ||
               !shared::neighbour_within(pi, in.spos[t], p.neighbour_skin)) {
             continue;
           }

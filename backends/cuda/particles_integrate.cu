@@ -3,6 +3,7 @@
 // the last build (one store per block at most).
 #include "cuda_device.h"
 #include "shared/body_math.h"
+#include "shared/links.h"
 #include "shared/neighbours.h"
 
 namespace motes::cuda {
@@ -20,7 +21,7 @@ __global__ void particles_integrate_kernel(shared::StepParams p, vec4* __restric
   bool moved = false;
   if (i < p.particle_count) {
     vec4 x = pos[i];
-    vec4 v = vel[i];
+    vec4 v = shared::linked_damped(vel[i], static_cast<uint>(i), p.linked_first, p.linked_damping);
     shared::particle_integrate(x, v, force[i], p.gravity_dt);
     pos[i] = x;
     vel[i] = v;

@@ -8,6 +8,7 @@
 #include "grid_walk.h"
 #include "openmp_device.h"
 #include "shared/contact_force.h"
+#include "shared/links.h"
 
 namespace motes::openmp {
 
@@ -62,7 +63,7 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
       const GridRanges ranges = grid_walk(p, ref[i], cell_start);
       for (int r = 0; r < ranges.count; ++r) {
         for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
-          if (sbody[t] != body_i) add_contact(order[t]);
+          if (!shared::contact_excluded(sbody[t], body_i)) add_contact(order[t]);
         }
       }
     }

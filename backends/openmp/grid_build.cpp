@@ -131,20 +131,14 @@ void OpenMPDevice::grid_build(const shared::StepParams& p) {
   }
 
   const uint* order = buf<uint>(Buffer::GridOrder);
-  const vec4* vel = buf<vec4>(Buffer::ParticleVel);
   const uint* body = buf<uint>(Buffer::ParticleBody);
-  const uint* material = buf<uint>(Buffer::ParticleMaterial);
   vec4* spos = buf<vec4>(Buffer::SortedPos);
-  vec4* svel = buf<vec4>(Buffer::SortedVel);
   uint* sbody = buf<uint>(Buffer::SortedBody);
-  uint* smat = buf<uint>(Buffer::SortedMaterial);
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
   for (std::int64_t s = 0; s < n; ++s) {
     const uint i = order[s];
     spos[s] = pos[i];
-    svel[s] = vel[i];
     sbody[s] = body[i];
-    smat[s] = material[i];
   }
   record(Kernel::GridBuild, start);
 }

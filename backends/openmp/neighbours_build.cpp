@@ -7,6 +7,7 @@
 
 #include "grid_walk.h"
 #include "openmp_device.h"
+#include "shared/links.h"
 #include "shared/neighbours.h"
 
 namespace motes::openmp {
@@ -55,7 +56,8 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
     uint c = 0;
     for (int r = 0; r < ranges.count; ++r) {
       for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
-        if (sbody[t] == body_i || !shared::neighbour_within(pi, spos[t], p.neighbour_skin)) {
+        if (shared::contact_excluded(sbody[t], body_i) ||
+            !shared::neighbour_within(pi, spos[t], p.neighbour_skin)) {
           continue;
         }
         if (c < capacity) list[std::size_t{c} * stride + static_cast<std::size_t>(i)] = order[t];

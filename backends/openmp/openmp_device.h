@@ -58,6 +58,7 @@ class OpenMPDevice final : public Device {
   void bodies_integrate(const shared::StepParams& p) override;
   void particles_update(const shared::StepParams& p) override;
   void particles_integrate(const shared::StepParams& p) override;
+  void constraints_solve(const shared::StepParams& p) override;
 
   Status synchronize() override { return Status::ok(); }
   Status check_guards() override;

@@ -1,10 +1,12 @@
-// particles_integrate: semi-implicit Euler on the free spheres [Nr, N) (particle_integrate), and
-// a neighbour-list rebuild asked for when one has moved too far since the last build.
+// particles_integrate: semi-implicit Euler on the free particles [Nr, N) (particle_integrate; cloth
+// and rope particles damped first), and a neighbour-list rebuild asked for when one has moved too
+// far since the last build.
 #include <chrono>
 #include <cstdint>
 
 #include "openmp_device.h"
 #include "shared/body_math.h"
+#include "shared/links.h"
 #include "shared/neighbours.h"
 
 namespace motes::openmp {
@@ -26,6 +28,7 @@ void OpenMPDevice::particles_integrate(const shared::StepParams& p) {
     reduction(|                                                                          \
               : moved)
   for (std::int64_t i = first; i < n; ++i) {
+    vel[i] = shared::linked_damped(vel[i], static_cast<uint>(i), p.linked_first, p.linked_damping);
     shared::particle_integrate(pos[i], vel[i], force[i], p.gravity_dt);
     moved |= shared::neighbour_moved_too_far(pos[i], ref[i], p.neighbour_skin) ? 1u : 0u;
   }

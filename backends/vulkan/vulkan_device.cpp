@@ -21,20 +21,21 @@ static_assert(B_BODY_POS == static_cast<int>(Buffer::BodyPos));
 static_assert(B_BODY_FIRST == static_cast<int>(Buffer::BodyFirst));
 static_assert(B_GRID_BUCKET == static_cast<int>(Buffer::GridBucket));
 static_assert(B_GRID_CELL_START == static_cast<int>(Buffer::GridCellStart));
-static_assert(B_SORTED_MATERIAL == static_cast<int>(Buffer::SortedMaterial));
+static_assert(B_SORTED_BODY == static_cast<int>(Buffer::SortedBody));
 static_assert(B_NEIGHBOUR_LIST == static_cast<int>(Buffer::NeighbourList));
 static_assert(B_NEIGHBOUR_STATE == static_cast<int>(Buffer::NeighbourState));
 static_assert(B_CONTACT_LAWS == static_cast<int>(Buffer::ContactLaws));
 static_assert(B_PLANES == static_cast<int>(Buffer::Planes));
+static_assert(B_CONSTRAINTS == static_cast<int>(Buffer::Constraints));
 static_assert(B_GRID_ARRIVAL == static_cast<int>(Buffer::Count));
 
 namespace {
 
 constexpr const char* kPipelineShaders[kPipelineCount] = {
-    "neighbours_decide",   "grid_build_clear",   "grid_build_count", "grid_build_scan_block",
-    "grid_build_scan_add", "grid_build_scatter", "grid_build_place", "neighbours_begin",
-    "neighbours_build",    "contacts_compute",   "bodies_reduce",    "bodies_integrate",
-    "particles_update",    "particles_integrate"};
+    "neighbours_decide",   "grid_build_clear",    "grid_build_count", "grid_build_scan_block",
+    "grid_build_scan_add", "grid_build_scatter",  "grid_build_place", "neighbours_begin",
+    "neighbours_build",    "contacts_compute",    "bodies_reduce",    "bodies_integrate",
+    "particles_update",    "particles_integrate", "constraints_solve"};
 
 const char* binding_name(std::uint32_t binding) {
   if (binding < kBufferCount) return buffer_name(static_cast<Buffer>(binding));
@@ -542,6 +543,9 @@ void VulkanDevice::particles_update(const shared::StepParams& p) {
 }
 void VulkanDevice::particles_integrate(const shared::StepParams& p) {
   enqueue(Kernel::ParticlesIntegrate, p);
+}
+void VulkanDevice::constraints_solve(const shared::StepParams& p) {
+  enqueue(Kernel::ConstraintsSolve, p);
 }
 
 Listing list_devices() {

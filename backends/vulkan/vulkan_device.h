@@ -37,6 +37,7 @@ enum class Pipeline : std::uint32_t {
   BodiesIntegrate,
   ParticlesUpdate,
   ParticlesIntegrate,
+  ConstraintsSolve,
   Count
 };
 constexpr std::size_t kPipelineCount = static_cast<std::size_t>(Pipeline::Count);
@@ -47,7 +48,7 @@ struct PushConstants {
   shared::StepParams params;
   std::uint32_t args[4];
 };
-static_assert(sizeof(PushConstants) == 80, "PushConstants layout");
+static_assert(sizeof(PushConstants) == 96, "PushConstants layout");
 
 class VulkanDevice final : public Device {
  public:
@@ -74,6 +75,7 @@ class VulkanDevice final : public Device {
   void bodies_integrate(const shared::StepParams& p) override;
   void particles_update(const shared::StepParams& p) override;
   void particles_integrate(const shared::StepParams& p) override;
+  void constraints_solve(const shared::StepParams& p) override;
 
   Status synchronize() override;
   Status check_guards() override;
@@ -161,6 +163,7 @@ class VulkanDevice final : public Device {
   void record_grid_build(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_neighbours_build(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_particles_integrate(VkCommandBuffer cb, const shared::StepParams& p) const;
+  void record_constraints_solve(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_contacts_compute(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_bodies_reduce(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_bodies_integrate(VkCommandBuffer cb, const shared::StepParams& p) const;

@@ -171,6 +171,9 @@ Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool ti
       case Kernel::ParticlesIntegrate:
         record_particles_integrate(cb, p);
         break;
+      case Kernel::ConstraintsSolve:
+        record_constraints_solve(cb, p);
+        break;
       case Kernel::NeighboursUpdate:
       case Kernel::Count:
         break;

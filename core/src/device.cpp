@@ -3,6 +3,8 @@
 
 #include <bit>
 
+#include "shared/links.h"
+
 namespace motes {
 
 const char* buffer_name(Buffer b) {
@@ -45,12 +47,8 @@ const char* buffer_name(Buffer b) {
       return "GridCellStart";
     case Buffer::SortedPos:
       return "SortedPos";
-    case Buffer::SortedVel:
-      return "SortedVel";
     case Buffer::SortedBody:
       return "SortedBody";
-    case Buffer::SortedMaterial:
-      return "SortedMaterial";
     case Buffer::NeighbourList:
       return "NeighbourList";
     case Buffer::NeighbourCount:
@@ -63,6 +61,8 @@ const char* buffer_name(Buffer b) {
       return "ContactLaws";
     case Buffer::Planes:
       return "Planes";
+    case Buffer::Constraints:
+      return "Constraints";
     case Buffer::Count:
       break;
   }
@@ -87,6 +87,8 @@ const char* kernel_name(Kernel k) {
       return "particles_update";
     case Kernel::ParticlesIntegrate:
       return "particles_integrate";
+    case Kernel::ConstraintsSolve:
+      return "constraints_solve";
     case Kernel::Count:
       break;
   }
@@ -101,7 +103,6 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
     case Buffer::ParticleVel:
     case Buffer::ParticleForce:
     case Buffer::SortedPos:
-    case Buffer::SortedVel:
     case Buffer::NeighbourRefPos:
       return {kVec4, s.particles};
     case Buffer::ParticleLocal:
@@ -111,7 +112,6 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
     case Buffer::GridBucket:
     case Buffer::GridOrder:
     case Buffer::SortedBody:
-    case Buffer::SortedMaterial:
     case Buffer::NeighbourCount:
       return {kUint, s.particles};
     case Buffer::NeighbourList:
@@ -135,6 +135,8 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
       return {sizeof(shared::ContactLaw), std::size_t{s.materials} * s.materials};
     case Buffer::Planes:
       return {sizeof(shared::PlaneData), s.planes};
+    case Buffer::Constraints:
+      return {sizeof(shared::Constraint), s.constraints};
     case Buffer::Count:
       break;
   }

@@ -1,4 +1,5 @@
-// Scene bodies: the "bodies" array, with repeats expanded into named copies sharing one shape.
+// Scene bodies: the "bodies" array, with repeats expanded into named copies sharing one shape
+// (cloth and ropes are read in scene_linked.cpp).
 #include <fmt/format.h>
 
 #include <limits>
@@ -58,7 +59,8 @@ Eigen::Vector3d read_vector_or_zero(const Node& body, std::string_view key) {
   return Eigen::Vector3d::Zero();
 }
 
-/// A body's colour for pictures: [r, g, b] with each from 0 to 1 (sRGB), or "#rrggbb".
+}  // namespace
+
 Eigen::Vector3d read_color(const Node& node) {
   const std::string expected = "must be a colour: [r, g, b] with each from 0 to 1, or \"#rrggbb\"";
   if (node.json().is_string()) {
@@ -95,8 +97,6 @@ Eigen::Vector3d read_color(const Node& node) {
   return rgb;
 }
 
-}  // namespace
-
 int find_material(const Node& where, const std::vector<Material>& materials) {
   const std::string name = where.string();
   std::vector<std::string> names;
@@ -113,8 +113,31 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
   if (bodies.size() == 0) bodies.fail("a scene needs at least one body");
   std::map<std::string, std::string> names;  // body name -> JSON path that made it
   std::uint64_t particles = 0;
+  // Counts before expanding, so an oversized scene is refused before it is built.
+  const auto count = [&](const Node& body, std::uint64_t more) {
+    particles += more;
+    if (particles > static_cast<std::uint64_t>(cache.max_particles)) {
+      body.fail(
+          fmt::format("the scene would have {} particles, more than settings.max_particles "
+                      "({})",
+                      particles, cache.max_particles));
+    }
+  };
+  const auto add_name = [&](const Node& body, const std::string& name, const std::string& where) {
+    if (auto [it, added] = names.emplace(name, where); !added) {
+      const Node name_node = body.has("name") ? body.at("name") : body;
+      name_node.fail(fmt::format("duplicate body name \"{}\" (also made by {})", name, it->second));
+    }
+  };
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const Node body = bodies.at(i);
+    if (is_linked(body)) {
+      LinkedSpec spec = read_linked(body, i, cache, scene);
+      count(body, spec.points.size());
+      add_name(body, spec.name, body.path());
+      scene.linked.push_back(std::move(spec));
+      continue;
+    }
     body.expect_object({"name", "kind", "shape", "material", "position", "rotation", "velocity",
                         "angular_velocity", "repeat", "color"});
     BodySpec spec;
@@ -124,7 +147,8 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
       if (k == "static") {
         spec.kind = BodyKind::Static;
       } else if (k != "dynamic") {
-        kind->fail(fmt::format("must be \"dynamic\" or \"static\", got \"{}\"", k));
+        kind->fail(
+            fmt::format("must be \"dynamic\", \"static\", \"cloth\" or \"rope\", got \"{}\"", k));
       }
     }
     if (auto color = body.find("color")) spec.color = read_color(*color);
@@ -145,15 +169,8 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
         body.has("repeat") ? read_repeat(body.at("repeat"), max_copies) : Repeat{};
     spec.shape = read_shape(body.at("shape"), cache);
 
-    // Count before expanding, so an oversized scene is refused before it is built.
     const std::uint64_t copies = static_cast<std::uint64_t>(repeat.copies());
-    particles += copies * spec.shape->points.size();
-    if (particles > static_cast<std::uint64_t>(cache.max_particles)) {
-      body.fail(
-          fmt::format("the scene would have {} particles, more than settings.max_particles "
-                      "({})",
-                      particles, cache.max_particles));
-    }
+    count(body, copies * spec.shape->points.size());
 
     entries.push_back(BodyEntry{scene.bodies.size(), copies, body.path()});
     Eigen::Quaterniond step_rotation = Eigen::Quaterniond::Identity();
@@ -172,12 +189,7 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
           }
           copy.rotation = (step_rotation * spec.rotation).normalized();
           step_rotation = (repeat.step * step_rotation).normalized();
-          const std::string where = repeat.repeated ? body.path() + "/repeat" : body.path();
-          if (auto [it, added] = names.emplace(copy.name, where); !added) {
-            const Node name_node = body.has("name") ? body.at("name") : body;
-            name_node.fail(
-                fmt::format("duplicate body name \"{}\" (also made by {})", copy.name, it->second));
-          }
+          add_name(body, copy.name, repeat.repeated ? body.path() + "/repeat" : body.path());
           scene.bodies.push_back(std::move(copy));
         }
       }

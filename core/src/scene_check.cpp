@@ -1,9 +1,12 @@
-// Scene checks on the whole scene: the explicit stability limit of the contact law.
+// Scene checks on the whole scene: the explicit stability limit of the contact law, for rigid
+// bodies, cloth and ropes.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <utility>
 
 #include "contact_laws.h"
@@ -13,12 +16,14 @@ namespace motes::scene_detail {
 
 namespace {
 
-/// Dynamic bodies that behave alike in a contact: same material and particle mass.
+/// Dynamic bodies, cloth and ropes whose particles behave alike in a contact: same material and
+/// particle mass.
 struct BodyClass {
   int material = 0;
   double particle_mass = 0.0;
   std::size_t copies = 0;
-  std::string name;  ///< first body of the class, for messages
+  std::string name;   ///< first body of the class, for messages: body "NAME", cloth "NAME"...
+  bool self = false;  ///< a cloth or rope of the class can touch itself
 };
 
 /// The worst contact found so far.
@@ -44,7 +49,8 @@ double stable_step(const shared::ContactLaw& law, double m_eff) {
 
 void check_stability(const Scene& scene, const std::vector<BodyEntry>& entries) {
   std::map<std::pair<int, double>, BodyClass> dynamic;
-  std::map<int, std::string> partners;  // material of static bodies and planes -> first user
+  // Material of static bodies, planes and pinned cloth or rope particles -> first user.
+  std::map<int, std::string> partners;
   for (const BodyEntry& e : entries) {
     const BodySpec& b = scene.bodies[e.first];
     const Material& mat = scene.materials[static_cast<std::size_t>(b.material)];
@@ -55,8 +61,24 @@ void check_stability(const Scene& scene, const std::vector<BodyEntry>& entries) 
     const double d = b.shape->diameter;
     const double m = mat.density * d * d * d;
     BodyClass& c = dynamic[{b.material, m}];
-    if (c.copies == 0) c = BodyClass{b.material, m, 0, b.name};
+    if (c.copies == 0) c = BodyClass{b.material, m, 0, fmt::format("body \"{}\"", b.name)};
     c.copies += e.copies;
+  }
+  // Cloth and rope particles are lone spheres; they touch their own object beyond two lattice
+  // steps (so once a side has more than 3 particles), and a pinned one is static.
+  for (const LinkedSpec& l : scene.linked) {
+    const Material& mat = scene.materials[static_cast<std::size_t>(l.material)];
+    const char* kind = l.kind == LinkedKind::Cloth ? "cloth" : "rope";
+    const std::string name = fmt::format("{} \"{}\"", kind, l.name);
+    if (!l.pinned.empty()) partners.emplace(l.material, "a pinned particle of " + name);
+    const double d = l.diameter;
+    const double m = mat.density * std::numbers::pi / 6.0 * d * d * d;
+    BodyClass& c = dynamic[{l.material, m}];
+    if (c.copies == 0) c = BodyClass{l.material, m, 0, name};
+    c.copies += 1;
+    std::uint32_t side = 0;
+    for (const auto& uv : l.lattice) side = std::max({side, uv[0] + 1, uv[1] + 1});
+    c.self = c.self || side > 3;
   }
   for (const PlaneSpec& p : scene.planes) {
     partners.emplace(p.material, fmt::format("plane \"{}\"", p.name));
@@ -75,7 +97,7 @@ void check_stability(const Scene& scene, const std::vector<BodyEntry>& entries) 
     if (h < worst.h) {
       worst.h = h;
       worst.what = fmt::format(
-          "body \"{}\" (material \"{}\", particle mass {:.4g} kg) against {} (material \"{}\"): "
+          "{} (material \"{}\", particle mass {:.4g} kg) against {} (material \"{}\"): "
           "k = {:.4g} N/m, damping = {:.4g} 1/s, tangential = {:.4g} 1/s, m* = {:.4g} kg, "
           "w0 = {:.4g} rad/s",
           a.name, scene.materials[static_cast<std::size_t>(a.material)].name, a.particle_mass,
@@ -88,10 +110,11 @@ void check_stability(const Scene& scene, const std::vector<BodyEntry>& entries) 
   for (const auto& [key_a, a] : dynamic) {
     for (const auto& [material, name] : partners) consider(a, material, a.particle_mass, name);
     for (const auto& [key_b, b] : dynamic) {
-      // A body does not touch itself: a class meets itself only through a second copy.
-      if (key_a == key_b && a.copies < 2) continue;
+      // A body does not touch itself: a class meets itself only through a second copy, or a
+      // cloth or rope through itself.
+      if (key_a == key_b && a.copies < 2 && !a.self) continue;
       const double m_eff = a.particle_mass * b.particle_mass / (a.particle_mass + b.particle_mass);
-      consider(a, b.material, m_eff, fmt::format("body \"{}\"", b.name));
+      consider(a, b.material, m_eff, b.name);
     }
   }
 

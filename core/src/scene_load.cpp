@@ -1,5 +1,6 @@
-// Scene loading (docs/scene-format.md): the document, settings, materials and planes; bodies and
-// shapes are read in scene_body.cpp and scene_shape.cpp, the stability check in scene_check.cpp.
+// Scene loading (docs/scene-format.md): the document, settings, materials and planes; bodies,
+// shapes, cloth and ropes are read in scene_body.cpp, scene_shape.cpp and scene_linked.cpp, the
+// stability check in scene_check.cpp.
 #include <fmt/format.h>
 
 #include <cerrno>
@@ -39,7 +40,7 @@ Material read_material_fields(const Node& node, Material base) {
 void read_settings(const Node& node, Settings& s, std::int64_t& max_particles) {
   node.expect_object({"dt", "substeps", "gravity", "particle_diameter", "clamp_attraction",
                       "duration", "output_interval", "max_particles", "neighbour_skin",
-                      "neighbour_capacity", "contact"});
+                      "neighbour_capacity", "constraint_iterations", "link_damping", "contact"});
   if (auto v = node.find("dt")) s.dt = v->number(Sign::Positive);
   if (auto v = node.find("substeps")) s.substeps = static_cast<int>(v->integer(1, 1'000'000));
   if (auto v = node.find("gravity")) s.gravity = v->vec3();
@@ -51,6 +52,10 @@ void read_settings(const Node& node, Settings& s, std::int64_t& max_particles) {
   if (auto v = node.find("neighbour_capacity")) {
     s.neighbour_capacity = static_cast<int>(v->integer(1, 1024));
   }
+  if (auto v = node.find("constraint_iterations")) {
+    s.constraint_iterations = static_cast<int>(v->integer(1, 1000));
+  }
+  if (auto v = node.find("link_damping")) s.link_damping = v->number(Sign::NonNegative);
   if (auto v = node.find("max_particles")) {
     max_particles = v->integer(1, scene_detail::kParticleLimit);
   }
@@ -166,10 +171,12 @@ CameraSpec read_camera(const Node& node) {
   return c;
 }
 
-/// Every material a body or plane uses needs a stiffness (from itself or settings.contact).
+/// Every material a body, cloth, rope or plane uses needs a stiffness (from itself or
+/// settings.contact).
 void check_stiffness(const Scene& scene, const std::vector<std::string>& paths) {
   std::vector<bool> used(scene.materials.size(), false);
   for (const BodySpec& b : scene.bodies) used[static_cast<std::size_t>(b.material)] = true;
+  for (const LinkedSpec& l : scene.linked) used[static_cast<std::size_t>(l.material)] = true;
   for (const PlaneSpec& p : scene.planes) used[static_cast<std::size_t>(p.material)] = true;
   static const Json none;
   for (std::size_t i = 0; i < scene.materials.size(); ++i) {
@@ -222,6 +229,7 @@ Scene read_scene(const Json& doc, const std::string& source, const std::string& 
 std::size_t Scene::particle_count() const {
   std::size_t n = 0;
   for (const BodySpec& b : bodies) n += b.shape ? b.shape->points.size() : 0;
+  for (const LinkedSpec& l : linked) n += l.points.size();
   return n;
 }
 

@@ -1,5 +1,5 @@
-// The pieces of the scene loader (scene_load.cpp): shapes, bodies and the checks on the whole
-// scene. Private to motes_core.
+// The pieces of the scene loader (scene_load.cpp): shapes, bodies, cloth and ropes, and the checks
+// on the whole scene. Private to motes_core.
 #pragma once
 
 #include <cstdint>
@@ -42,13 +42,24 @@ struct BodyEntry {
   std::size_t copies = 0;
   std::string path;  ///< JSON pointer of the entry
 };
-/// Reads the "bodies" array into scene.bodies (materials must already be in scene.materials),
-/// one BodyEntry per array element into `entries`.
+/// Reads the "bodies" array into scene.bodies and scene.linked (materials must already be in
+/// scene.materials), one BodyEntry per rigid body element into `entries`.
 void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
                  std::vector<BodyEntry>& entries);
 
 /// Index of a material by name; fails at `where` naming the known materials.
 int find_material(const Node& where, const std::vector<Material>& materials);
+
+/// A colour for pictures: [r, g, b] with each from 0 to 1 (sRGB), or "#rrggbb".
+Eigen::Vector3d read_color(const Node& node);
+
+/// Whether an entry of the "bodies" array is a cloth or a rope ("kind": "cloth" or "rope").
+bool is_linked(const Node& entry);
+/// Reads such an entry, the index-th of "bodies", into a LinkedSpec (materials must already be in
+/// scene.materials; scene.linked holds the ones before it). Errors carry the JSON path; those of
+/// make_cloth and make_rope that of the entry's "cloth" or "rope" object (scene_linked.cpp).
+LinkedSpec read_linked(const Node& entry, std::size_t index, const ShapeCache& cache,
+                       const Scene& scene);
 
 /// Fails at /settings/dt when dt / substeps is above the explicit stability limit of the stiffest,
 /// lightest contact the scene can make (docs/scene-format.md, "Stability").

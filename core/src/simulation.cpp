@@ -7,9 +7,12 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numbers>
 
 #include "contact_laws.h"
+#include "motes/cloth.h"
 #include "shared/body_math.h"
+#include "shared/links.h"
 #include "shared/neighbours.h"
 
 namespace motes {
@@ -83,6 +86,21 @@ Status Simulation::upload(const Scene& scene) {
     }
     max_diameter = std::max(max_diameter, b.shape->diameter);
   }
+  const std::uint64_t body_particles = n;
+  if (scene.linked.size() > kLinkedMaxObjects) {
+    return Status::error(fmt::format("{}: {} cloths and ropes; motes supports at most {}",
+                                     scene.source, scene.linked.size(), kLinkedMaxObjects));
+  }
+  std::uint64_t constraint_count = 0;
+  for (const LinkedSpec& l : scene.linked) {
+    if (l.points.empty() || l.lattice.size() != l.points.size()) {
+      return Status::error(fmt::format("{}: '{}' has no particles, or not one lattice place each",
+                                       scene.source, l.name));
+    }
+    n += l.points.size();
+    constraint_count += l.links.size();
+    max_diameter = std::max(max_diameter, l.diameter);
+  }
   if (n > std::numeric_limits<std::uint32_t>::max() / 2) {
     return Status::error(
         fmt::format("{}: {} particles is more than motes supports (2^31)", scene.source, n));
@@ -96,6 +114,17 @@ Status Simulation::upload(const Scene& scene) {
   sizes_.materials = static_cast<std::uint32_t>(scene.materials.size());
   sizes_.planes = static_cast<std::uint32_t>(scene.planes.size());
   sizes_.neighbour_capacity = static_cast<std::uint32_t>(settings_.neighbour_capacity);
+  sizes_.constraints = static_cast<std::uint32_t>(
+      std::min<std::uint64_t>(constraint_count, std::numeric_limits<std::uint32_t>::max()));
+  if (constraint_count > std::numeric_limits<std::uint32_t>::max() / 2) {
+    return Status::error(fmt::format("{}: {} constraints is more than motes supports (2^31)",
+                                     scene.source, constraint_count));
+  }
+  if (settings_.constraint_iterations < 1 || !(settings_.link_damping >= 0.0)) {
+    return Status::error(fmt::format(
+        "{}: constraint_iterations must be at least 1 and link_damping >= 0 (got {} and {})",
+        scene.source, settings_.constraint_iterations, settings_.link_damping));
+  }
 
   Device& d = *device_;
   // Device memory: refuse before allocating anything, with both numbers.
@@ -214,6 +243,70 @@ Status Simulation::upload(const Scene& scene) {
   }
   rigid_first_.push_back(next_rigid);
 
+  // Cloth and ropes after the free spheres: particles [Nl, N), each object's in its own order.
+  const auto linked_first = static_cast<std::uint32_t>(body_particles);
+  std::vector<shared::Constraint> constraints;
+  constraints.reserve(sizes_.constraints);
+  std::uint32_t next_linked = linked_first;
+  for (std::size_t li = 0; li < scene.linked.size(); ++li) {
+    const LinkedSpec& spec = scene.linked[li];
+    if (spec.material < 0 || static_cast<std::size_t>(spec.material) >= scene.materials.size()) {
+      return Status::error(fmt::format("{}: '{}' has no valid material", scene.source, spec.name));
+    }
+    const Material& mat = scene.materials[static_cast<std::size_t>(spec.material)];
+    const double particle_mass = mat.density * std::numbers::pi / 6.0 * std::pow(spec.diameter, 3);
+    if (!(particle_mass > 0.0) || !std::isfinite(particle_mass)) {
+      return Status::error(fmt::format("{}: '{}' has no mass (density {}, diameter {})",
+                                       scene.source, spec.name, mat.density, spec.diameter));
+    }
+    const auto count = static_cast<std::uint32_t>(spec.points.size());
+    std::vector<bool> pinned(count, false);
+    for (const std::uint32_t k : spec.pinned) {
+      if (k >= count) {
+        return Status::error(
+            fmt::format("{}: '{}' pins particle {} of {}", scene.source, spec.name, k, count));
+      }
+      pinned[k] = true;
+    }
+    BodyInfo info;
+    info.name = spec.name;
+    info.kind = BodyKind::Dynamic;
+    info.mass = particle_mass * static_cast<double>(count);
+    info.first_particle = scene_particle;
+    info.particle_count = count;
+    info.linked = true;
+    bodies_.push_back(info);
+    device_index_.push_back(next_linked);
+    scene_particle += count;
+    for (std::uint32_t k = 0; k < count; ++k) {
+      const std::array<std::uint32_t, 2> uv = spec.lattice[k];
+      if (uv[0] >= kLinkedMaxSide || uv[1] >= kLinkedMaxSide) {
+        return Status::error(fmt::format("{}: '{}': lattice place ({}, {}) beyond {}", scene.source,
+                                         spec.name, uv[0], uv[1], kLinkedMaxSide));
+      }
+      const std::uint32_t i = next_linked + k;
+      ppos[i] = to_vec4(spec.points[k], 0.5 * spec.diameter);
+      pvel[i] = pinned[k] ? vec4(0.0f) : to_vec4(spec.velocity, 1.0 / particle_mass);
+      pbody[i] = shared::linked_body(static_cast<std::uint32_t>(li), uv[0], uv[1]);
+      pmat[i] = static_cast<std::uint32_t>(spec.material);
+    }
+    for (const LinkSpec& link : spec.links) {
+      if (link.a >= count || link.b >= count || link.a == link.b) {
+        return Status::error(fmt::format("{}: '{}': a link joins particles {} and {} of {}",
+                                         scene.source, spec.name, link.a, link.b, count));
+      }
+      shared::Constraint c{};
+      c.a = next_linked + link.a;
+      c.b = next_linked + link.b;
+      c.rest = static_cast<float>((spec.points[link.a] - spec.points[link.b]).norm());
+      c.stiffness = static_cast<float>(link.stiffness);
+      constraints.push_back(c);
+    }
+    next_linked += count;
+  }
+  ConstraintColouring colouring = colour_constraints(constraints, sizes_.particles);
+  colour_first_ = colouring.first;
+
   std::vector<shared::PlaneData> planes;
   for (const PlaneSpec& pl : scene.planes) {
     const Eigen::Vector3d nrm = pl.normal.normalized();
@@ -238,6 +331,9 @@ Status Simulation::upload(const Scene& scene) {
   params_.rigid_particle_count = sizes_.rigid_particles;
   params_.neighbour_capacity = sizes_.neighbour_capacity;
   params_.neighbour_skin = static_cast<float>(skin);
+  params_.linked_first = linked_first;
+  params_.linked_damping =
+      static_cast<float>(-std::expm1(-settings_.link_damping * settings_.dt / settings_.substeps));
 
   const std::uint32_t neighbour_state[4] = {1u, 0u, 0u, 0u};  // build at the first step
   Status s = d.allocate(sizes_);
@@ -258,6 +354,7 @@ Status Simulation::upload(const Scene& scene) {
   if (s) s = d.write(Buffer::NeighbourState, neighbour_state, sizeof neighbour_state);
   if (s) s = write_vector(d, Buffer::ContactLaws, laws);
   if (s) s = write_vector(d, Buffer::Planes, planes);
+  if (s) s = write_vector(d, Buffer::Constraints, colouring.constraints);
   if (!s) return s;
   // Rigid particles take their pose from the bodies with the device's own arithmetic.
   if (sizes_.rigid_particles > 0) d.particles_update(params_);
@@ -278,6 +375,14 @@ Status Simulation::step(std::uint64_t count) {
         d.particles_update(params_);
       }
       if (free) d.particles_integrate(params_);
+      for (int it = 0; it < settings_.constraint_iterations && colour_first_.size() > 1; ++it) {
+        for (std::size_t c = 0; c + 1 < colour_first_.size(); ++c) {
+          shared::StepParams colour = params_;
+          colour.constraint_first = colour_first_[c];
+          colour.constraint_count = colour_first_[c + 1] - colour_first_[c];
+          d.constraints_solve(colour);
+        }
+      }
     }
     ++steps_;
     time_ = static_cast<double>(steps_) * settings_.dt;
@@ -314,11 +419,27 @@ Result<Snapshot> Simulation::snapshot() {
   for (std::size_t b = 0; b < scene_bodies; ++b) {
     const BodyInfo& info = bodies_[b];
     const std::uint32_t at = device_index_[b];
-    const std::uint32_t first = info.free_sphere ? at : rigid_first_[at];
+    const std::uint32_t first = info.free_sphere || info.linked ? at : rigid_first_[at];
     for (std::uint32_t k = 0; k < info.particle_count; ++k) {
       s.particle_pos[info.first_particle + k] = ppos[first + k];
       s.particle_vel[info.first_particle + k] = pvel[first + k];
       s.particle_body[info.first_particle + k] = static_cast<std::uint32_t>(b);
+    }
+    if (info.linked) {  // the mean of its particles, in double
+      Eigen::Vector3d x = Eigen::Vector3d::Zero();
+      Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      for (std::uint32_t k = 0; k < info.particle_count; ++k) {
+        const vec4 p = ppos[first + k];
+        const vec4 u = pvel[first + k];
+        x += Eigen::Vector3d(p.x, p.y, p.z);
+        v += Eigen::Vector3d(u.x, u.y, u.z);
+      }
+      const double count = static_cast<double>(info.particle_count);
+      s.body_pos[b] = to_vec4(x / count, 1.0 / info.mass);
+      s.body_vel[b] = to_vec4(v / count, 0.0);
+      s.body_angmom[b] = vec4(0.0f);
+      s.body_angvel[b] = vec4(0.0f);
+      continue;
     }
     if (info.free_sphere) {
       const vec4 p = ppos[at];
@@ -347,12 +468,12 @@ Status Simulation::restore(const Snapshot& state) {
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     const BodyInfo& info = bodies_[b];
     const std::uint32_t at = device_index_[b];
-    const std::uint32_t first = info.free_sphere ? at : rigid_first_[at];
+    const std::uint32_t first = info.free_sphere || info.linked ? at : rigid_first_[at];
     for (std::uint32_t k = 0; k < info.particle_count; ++k) {
       ppos[first + k] = state.particle_pos[info.first_particle + k];
       pvel[first + k] = state.particle_vel[info.first_particle + k];
     }
-    if (info.free_sphere) continue;
+    if (info.free_sphere || info.linked) continue;
     bpos[at] = state.body_pos[b];
     bquat[at] = state.body_quat[b];
     bvel[at] = state.body_vel[b];
@@ -391,11 +512,12 @@ Status Simulation::set_body_velocities(const std::vector<Eigen::Vector3d>& veloc
           fmt::format("set_body_velocities: body {} '{}' is static: its velocity stays zero", b,
                       bodies_[b].name));
     }
-    if (bodies_[b].free_sphere && !angular.empty() && !angular[b].isZero(0.0)) {
+    if ((bodies_[b].free_sphere || bodies_[b].linked) && !angular.empty() &&
+        !angular[b].isZero(0.0)) {
       return Status::error(fmt::format(
-          "set_body_velocities: body {} '{}' is a free sphere, which does not turn: its angular "
-          "velocity stays zero",
-          b, bodies_[b].name));
+          "set_body_velocities: body {} '{}' is a {}, which has no angular velocity of its own: "
+          "give its particles velocities instead",
+          b, bodies_[b].name, bodies_[b].linked ? "cloth or rope" : "free sphere"));
     }
   }
   Result<Snapshot> snap = snapshot();
@@ -404,9 +526,12 @@ Status Simulation::set_body_velocities(const std::vector<Eigen::Vector3d>& veloc
   for (std::size_t b = 0; b < count; ++b) {
     const BodyInfo& info = bodies_[b];
     const vec4 v = to_vec4(velocity[b], 0.0);
-    if (info.free_sphere) {
-      const vec4 old = state.particle_vel[info.first_particle];
-      state.particle_vel[info.first_particle] = vec4(v.x, v.y, v.z, old.w);
+    if (info.free_sphere || info.linked) {  // every particle that is not pinned
+      for (std::uint32_t k = info.first_particle; k < info.first_particle + info.particle_count;
+           ++k) {
+        const vec4 old = state.particle_vel[k];
+        if (old.w != 0.0f) state.particle_vel[k] = vec4(v.x, v.y, v.z, old.w);
+      }
       continue;
     }
     state.body_vel[b] = v;

@@ -1,4 +1,4 @@
-// Benchmark workloads W1 "settle" and W2 "dominoes" (docs/benchmarks.md).
+// Benchmark workloads W1 "settle", W2 "dominoes" and W3 "cloth" (docs/benchmarks.md).
 #include "motes/workloads.h"
 
 #include <array>
@@ -10,6 +10,8 @@
 #include <sstream>
 
 #include <fmt/format.h>
+
+#include "motes/cloth.h"
 
 namespace motes {
 
@@ -225,6 +227,41 @@ Scene dominoes_workload(int count, int rows) {
     if (col == 0) b.angular_velocity = {0.0, 0.0, -8.0};  // tips towards +x
     scene.bodies.push_back(std::move(b));
   }
+  scene.planes.push_back(plane("floor", {0, 1, 0}, {0, 0, 0}));
+  return scene;
+}
+
+Scene cloth_workload(int side) {
+  constexpr double d = 0.01;
+  Scene scene;
+  scene.source = fmt::format("<cloth workload {} x {}>", side, side);
+  scene.settings.dt = 1e-4;
+  scene.settings.particle_diameter = d;
+  scene.settings.duration = 1.0;
+  scene.settings.constraint_iterations = 8;
+  scene.settings.link_damping = 1.0;
+  Material m;
+  m.name = "cloth";
+  m.density = 1000.0;
+  m.stiffness = 2000.0;
+  m.damping = 500.0;
+  m.tangential = 200.0;
+  m.friction = 0.5;
+  scene.materials.push_back(m);
+  scene.settings.contact = m;
+  ClothOptions o;
+  o.corner = {0.0, 0.1 + d * side, 0.0};
+  o.edge_u = {d * (side - 1), 0.0, 0.0};
+  o.edge_v = {0.0, 0.0, d * (side - 1)};
+  o.nu = side;
+  o.nv = side;
+  o.diameter = d;
+  Result<LinkedSpec> cloth = make_cloth(o);
+  if (!cloth) return scene;  // the caller's side is checked: 2 <= side <= 1024
+  LinkedSpec c = std::move(cloth).value();
+  c.name = "cloth";
+  c.pinned = {0u, static_cast<std::uint32_t>(side - 1)};
+  scene.linked.push_back(std::move(c));
   scene.planes.push_back(plane("floor", {0, 1, 0}, {0, 0, 0}));
   return scene;
 }

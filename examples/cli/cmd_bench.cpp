@@ -35,6 +35,8 @@ struct BenchOptions {
   int dominoes = 1000;
   int domino_rows = 10;
   std::uint64_t domino_steps = 2000;
+  std::vector<int> cloth_sides = {256};
+  std::uint64_t cloth_steps = 1000;
   std::string cache = "bench-cache";
   std::string dense_from;  // LAMMPS data file: the dense phase starts from LAMMPS's settled state
   std::string json_path;
@@ -45,10 +47,11 @@ struct Measurement {
   std::uint32_t particles = 0, bodies = 0;
   std::uint32_t rigid_particles = 0, rigid_bodies = 0;
   std::uint32_t table = 0;
-  std::uint64_t steps = 0;         // per timed repeat
-  std::vector<double> seconds;     // per repeat, kernel timing off
-  std::uint64_t kernel_steps = 0;  // of the run with kernel timing on
-  motes::KernelTimes kernels;      // of that run
+  std::uint64_t constraint_sweeps = 0;  // constraints projected per step (C x iterations)
+  std::uint64_t steps = 0;              // per timed repeat
+  std::vector<double> seconds;          // per repeat, kernel timing off
+  std::uint64_t kernel_steps = 0;       // of the run with kernel timing on
+  motes::KernelTimes kernels;           // of that run
   std::string backend, device, detail;
   std::uint64_t device_bytes = 0;    // what the simulation holds on the device
   motes::NeighbourStats neighbours;  // after the first timed repeat
@@ -104,6 +107,9 @@ Measurement measure(const motes::Scene& scene, const BenchOptions& o, std::uint6
       m.rigid_particles = sim->sizes().rigid_particles;
       m.rigid_bodies = sim->sizes().bodies;
       m.table = sim->sizes().table;
+      m.constraint_sweeps = std::uint64_t{sim->sizes().constraints} *
+                            static_cast<std::uint64_t>(sim->settings().constraint_iterations) *
+                            static_cast<std::uint64_t>(sim->settings().substeps);
       m.backend = sim->device().info().backend;
       m.device = sim->device().info().name;
       m.detail = sim->device().info().detail;
@@ -133,8 +139,8 @@ double compulsory_bytes(motes::Kernel k, const Measurement& m) {
   switch (k) {
     case motes::Kernel::NeighboursUpdate:  // read one word
       return 4;
-    case motes::Kernel::GridBuild:  // read pos, vel, body, material; write bucket, order, 4 sorted
-      return 40 * n + 8 * n + 40 * n + 4 * (t + 1);
+    case motes::Kernel::GridBuild:  // read pos, body; write bucket, order, 2 sorted copies
+      return 20 * n + 8 * n + 20 * n + 4 * (t + 1);
     case motes::Kernel::NeighboursBuild:  // read pos, vel, body, starts, sorted pos + body, order;
                                           // write count and ref (the entries are not counted)
       return 36 * n + 4 * (t + 1) + 24 * n + 20 * n;
@@ -150,6 +156,9 @@ double compulsory_bytes(motes::Kernel k, const Measurement& m) {
       return (4 + 16 + 48) * nr + 64 * b + 32 * nr;
     case motes::Kernel::ParticlesIntegrate:  // read pos, vel, force, ref; write pos, vel
       return 96 * nf;
+    case motes::Kernel::ConstraintsSolve:  // per projection: read the constraint, both
+                                           // particles' pos, vel, ref; write their pos, vel
+      return (16.0 + 96.0 + 64.0) * static_cast<double>(m.constraint_sweeps);
     case motes::Kernel::Count:
       break;
   }
@@ -253,8 +262,14 @@ void print_row(const Measurement& m) {
 }
 
 void run_bench(const BenchOptions& o) {
-  if (o.workload != "all" && o.workload != "settle" && o.workload != "dominoes") {
-    fail(fmt::format("--workload must be settle, dominoes or all, got '{}'", o.workload));
+  if (o.workload != "all" && o.workload != "settle" && o.workload != "dominoes" &&
+      o.workload != "cloth") {
+    fail(fmt::format("--workload must be settle, dominoes, cloth or all, got '{}'", o.workload));
+  }
+  for (const int side : o.cloth_sides) {
+    if (side < 2 || side > 1024) {
+      fail(fmt::format("--cloth-sides: {} is not from 2 to 1024 particles", side));
+    }
   }
   if (o.phase != "both" && o.phase != "falling" && o.phase != "dense") {
     fail(fmt::format("--phase must be falling, dense or both, got '{}'", o.phase));
@@ -277,8 +292,9 @@ void run_bench(const BenchOptions& o) {
         o.repeats);
   }
   // Column labels of the kernel families, in motes::Kernel order (JSON has the full names).
-  constexpr const char* kLabels[motes::kKernelCount] = {
-      "nb_upd", "grid", "nb_build", "contacts", "b_reduce", "b_integr", "p_update", "p_integr"};
+  constexpr const char* kLabels[motes::kKernelCount] = {"nb_upd",   "grid",     "nb_build",
+                                                        "contacts", "b_reduce", "b_integr",
+                                                        "p_update", "p_integr", "constr"};
   std::string ks;
   for (const char* label : kLabels) ks += fmt::format(" {:>8}", label);
   fmt::print(
@@ -303,7 +319,8 @@ void run_bench(const BenchOptions& o) {
       any_failed = true;
     }
   };
-  if (o.workload != "dominoes") {
+  const bool rigid = o.workload == "all" || o.workload == "settle" || o.workload == "dominoes";
+  if (rigid && o.workload != "dominoes") {
     for (std::uint64_t n : o.sizes) {
       int nx = 0, ny = 0, nz = 0;
       motes::settle_dimensions(n, nx, ny, nz);
@@ -336,7 +353,7 @@ void run_bench(const BenchOptions& o) {
       }
     }
   }
-  if (o.workload != "settle") {
+  if (rigid && o.workload != "settle") {
     attempt([&] {
       const motes::Scene scene = motes::dominoes_workload(o.dominoes, o.domino_rows);
       Measurement m = measure(scene, o, o.domino_steps, [](motes::Simulation&) {});
@@ -345,6 +362,18 @@ void run_bench(const BenchOptions& o) {
       print_row(m);
       results.push_back(to_json(m));
     });
+  }
+  if (o.workload == "cloth") {
+    for (const int side : o.cloth_sides) {
+      attempt([&] {
+        const motes::Scene scene = motes::cloth_workload(side);
+        Measurement m = measure(scene, o, o.cloth_steps, [](motes::Simulation&) {});
+        m.workload = "cloth";
+        m.phase = "falling";
+        print_row(m);
+        results.push_back(to_json(m));
+      });
+    }
   }
   if (!o.json_path.empty()) {
     std::ofstream out(o.json_path);
@@ -360,8 +389,18 @@ void run_bench(const BenchOptions& o) {
 void add_bench_command(CLI::App& app) {
   auto opts = std::make_shared<BenchOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "bench", "Run the fixed benchmark workloads (docs/benchmarks.md): W1 settle, W2 dominoes");
-  cmd->add_option("--workload", opts->workload, "settle, dominoes or all")->capture_default_str();
+      "bench",
+      "Run the fixed benchmark workloads (docs/benchmarks.md): W1 settle, W2 dominoes, W3 cloth");
+  cmd->add_option("--workload", opts->workload,
+                  "settle, dominoes, all (settle and dominoes) or cloth")
+      ->capture_default_str();
+  cmd->add_option("--cloth-sides", opts->cloth_sides,
+                  "W3: cloth sides in particles (a side x side cloth each)")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--cloth-steps", opts->cloth_steps, "W3: steps timed")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->add_option("--sizes", opts->sizes, "W1 particle counts")
       ->delimiter(',')
       ->capture_default_str();

@@ -142,12 +142,18 @@ SceneLook look_from_scene(const Scene& scene) {
       look.ground_height = look.ground_height ? std::max(*look.ground_height, height) : height;
     }
   }
-  look.body_static.reserve(scene.bodies.size());
-  look.body_colors.reserve(scene.bodies.size());
+  // Body indices as in a Snapshot: the scene's bodies, then its cloths and ropes.
+  look.body_static.reserve(scene.bodies.size() + scene.linked.size());
+  look.body_colors.reserve(scene.bodies.size() + scene.linked.size());
   for (const BodySpec& body : scene.bodies) {
     look.body_static.push_back(body.kind == BodyKind::Static ? 1 : 0);
     look.body_colors.push_back(
         body.color ? std::optional<Eigen::Vector3f>(body.color->cast<float>()) : std::nullopt);
+  }
+  for (const LinkedSpec& linked : scene.linked) {
+    look.body_static.push_back(0);
+    look.body_colors.push_back(
+        linked.color ? std::optional<Eigen::Vector3f>(linked.color->cast<float>()) : std::nullopt);
   }
   return look;
 }

@@ -10,14 +10,15 @@ import json
 import sys
 
 KERNELS = ["neighbours_update", "grid_build", "neighbours_build", "contacts_compute",
-           "bodies_reduce", "bodies_integrate", "particles_update", "particles_integrate"]
+           "bodies_reduce", "bodies_integrate", "particles_update", "particles_integrate",
+           "constraints_solve"]
 # Bytes per particle of a fused grid-DEM step (../shared/gpu/README.md): the step's floor at the
 # copy bandwidth measured in the same run.
 FUSED_FLOOR_BYTES = 200
 GOALS_MS = {("settle", "falling", 16384): 0.030, ("settle", "falling", 1048576): 0.20,
             ("settle", "falling", 16777216): 2.5, ("settle", "dense", 16384): 0.030,
             ("settle", "dense", 1048576): 0.20, ("settle", "dense", 16777216): 2.5,
-            ("dominoes", "falling", 15000000): 1.6}
+            ("dominoes", "falling", 15000000): 1.6, ("cloth", "falling", 1048576): 2.0}
 
 
 def load_rows(paths):

@@ -24,6 +24,10 @@ struct StepParams {
   uint rigid_particle_count;  // Nr: particles [Nr, N) are free spheres, integrated as particles
   uint neighbour_capacity;    // K: list entries kept per particle
   float neighbour_skin;       // s (m): lists hold pairs closer than r_i + r_j + s
+  uint linked_first;          // Nl: particles [Nl, N) are cloth and rope particles (shared/links.h)
+  float linked_damping;       // fraction of their velocity the linked particles lose per substep
+  uint constraint_first;      // constraints_solve: the colour's first constraint
+  uint constraint_count;      // constraints_solve: its number of constraints
   uint reserved;              // 0
 };
 
@@ -48,10 +52,11 @@ struct PlaneData {
 MOTES_SHARED_END
 
 #ifdef __cplusplus
-static_assert(sizeof(motes::shared::StepParams) == 64, "StepParams layout");
+static_assert(sizeof(motes::shared::StepParams) == 80, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, particle_count) == 16, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, flags) == 44, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, neighbour_skin) == 56, "StepParams layout");
+static_assert(offsetof(motes::shared::StepParams, constraint_count) == 72, "StepParams layout");
 static_assert(sizeof(motes::shared::ContactLaw) == 16, "ContactLaw layout");
 static_assert(sizeof(motes::shared::PlaneData) == 32, "PlaneData layout");
 #endif

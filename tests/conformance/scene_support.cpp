@@ -43,6 +43,11 @@ motes::Scene fast_forward(motes::Scene scene, double seconds) {
     b.position += b.velocity * seconds + 0.5 * g * seconds * seconds;
     b.velocity += g * seconds;
   }
+  for (motes::LinkedSpec& l : scene.linked) {
+    if (!l.pinned.empty()) continue;
+    for (Eigen::Vector3d& x : l.points) x += l.velocity * seconds + 0.5 * g * seconds * seconds;
+    l.velocity += g * seconds;
+  }
   return scene;
 }
 
@@ -79,6 +84,14 @@ void OracleRun::step(std::uint64_t steps) {
   for (std::uint64_t k = 0; k < steps; ++k) {
     for (int sub = 0; sub < substeps; ++sub) {
       motes_ref::step(particles, bodies, laws, planes, params);
+      for (int it = 0; it < iterations; ++it) {
+        for (std::size_t c = 0; c + 1 < colour_first.size(); ++c) {
+          StepParams colour = params;
+          colour.constraint_first = colour_first[c];
+          colour.constraint_count = colour_first[c + 1] - colour_first[c];
+          motes_ref::constraints_solve(particles, constraints, colour);
+        }
+      }
     }
   }
 }
@@ -98,6 +111,9 @@ motes::Status capture(motes::Simulation& sim, OracleRun& out) {
   if (s) s = read_all(sim, motes::Buffer::BodyFirst, out.bodies.first);
   if (s) s = read_all(sim, motes::Buffer::ContactLaws, out.laws);
   if (s) s = read_all(sim, motes::Buffer::Planes, out.planes);
+  if (s) s = read_all(sim, motes::Buffer::Constraints, out.constraints);
+  out.colour_first = sim.constraint_colours();
+  out.iterations = sim.settings().constraint_iterations;
   out.particles.rigid = sim.sizes().rigid_particles;
   out.params = sim.step_params();
   out.substeps = sim.settings().substeps;

@@ -18,9 +18,9 @@ namespace motes_conf {
 /// examples/scenes/<name>, loaded once per process (the bunny is voxelized on load).
 const motes::Result<motes::Scene>& example_scene(const std::string& name);
 
-/// The scene `seconds` later, for bodies in free fall that do not turn (dice, bunny): positions
-/// advanced by v t + g t^2 / 2, velocities by g t. Skips the uneventful fall before the first
-/// contact, which would cost thousands of steps.
+/// The scene `seconds` later, for bodies in free fall that do not turn (dice, bunny) and cloths
+/// and ropes without pins: positions advanced by v t + g t^2 / 2, velocities by g t. Skips the
+/// uneventful fall before the first contact, which would cost thousands of steps.
 motes::Scene fast_forward(motes::Scene scene, double seconds);
 
 /// A simulation of `scene` on device `index` of `backend`.
@@ -43,7 +43,12 @@ struct OracleRun {
   std::vector<PlaneData> planes;
   StepParams params{};
   int substeps = 1;
-  /// Advances `steps` steps with motes_ref::step (each settings.substeps substeps).
+  /// Cloth and ropes: the coloured constraints, relaxed `iterations` times per substep.
+  std::vector<motes_ref::Constraint> constraints;
+  std::vector<uint> colour_first;
+  int iterations = 0;
+  /// Advances `steps` steps with motes_ref::step (each settings.substeps substeps), then the
+  /// constraints colour by colour (motes_ref::constraints_solve), as Simulation::step does.
   void step(std::uint64_t steps);
 };
 motes::Status capture(motes::Simulation& sim, OracleRun& out);

@@ -143,6 +143,10 @@ TEST_P(ContactsCompute, Random1234) { run_case("random", random_world(24, 1234, 
 TEST_P(ContactsCompute, Random1234Clamped) {
   run_case("random_clamped", random_world(24, 1234, MOTES_FLAG_CLAMP_ATTRACTION, kTestSkin));
 }
+TEST_P(ContactsCompute, Linked1234) {
+  // Cloth and rope particles: no force between particles of one object within two lattice steps.
+  run_case("linked", with_linked(random_world(25, 1234, 0, kTestSkin), 25));
+}
 TEST_P(ContactsCompute, Random20000) {
   run_case("random_clamped", random_world(25, 20000, MOTES_FLAG_CLAMP_ATTRACTION, kTestSkin));
 }

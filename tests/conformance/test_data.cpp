@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "shared/links.h"
+
 namespace motes_conf {
 
 namespace {
@@ -274,6 +276,17 @@ std::vector<vec4> moved_by(Rng& rng, const std::vector<vec4>& pos, float skin, f
     x = vec4(x.x + d.x * s, x.y + d.y * s, x.z + d.z * s, x.w);
   }
   return out;
+}
+
+World with_linked(World w, std::uint32_t seed) {
+  Rng rng(seed);
+  motes_ref::Particles& p = w.particles;
+  for (std::size_t i = p.rigid; i < p.size(); ++i) {
+    p.body[i] = motes::shared::linked_body(rng.below(3), rng.below(6), rng.below(6));
+  }
+  w.params.linked_first = static_cast<uint>(p.rigid);
+  w.params.linked_damping = 0.25f;
+  return w;
 }
 
 World random_world(std::uint32_t seed, std::size_t n, std::uint32_t flags, float skin) {

@@ -82,6 +82,12 @@ World random_bodies(std::uint32_t seed, std::size_t bodies);
 /// Particles in a cloud of about `n` particles with random bodies (make_world).
 World random_world(std::uint32_t seed, std::size_t n, std::uint32_t flags = 0, float skin = 0.0f);
 
+/// The free particles of w [Nr, N) made cloth and rope particles: ParticleBody =
+/// shared::linked_body of one of three objects at a random lattice place in [0, 6)^2 (so many
+/// pairs are within two lattice steps: excluded from contact), linked_first = Nr, linked damping
+/// 0.25 per substep.
+World with_linked(World w, std::uint32_t seed);
+
 /// n forces with components uniform in [-scale, scale), w = 0.
 std::vector<vec4> random_forces(std::uint32_t seed, std::size_t n, float scale);
 

@@ -162,6 +162,11 @@ TEST_P(NeighboursBuild, SmallTable) {
   run_case("table_64", w);
 }
 
+TEST_P(NeighboursBuild, Linked1234) {
+  // Cloth and rope particles: pairs of one object within two lattice steps are not listed.
+  run_case("linked", with_linked(random_world(212, 1234, 0, kTestSkin), 212));
+}
+
 INSTANTIATE_TEST_SUITE_P(Conformance, NeighboursBuild, testing::ValuesIn(device_params()),
                          param_name);
 

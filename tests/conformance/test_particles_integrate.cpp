@@ -89,6 +89,10 @@ TEST_P(ParticlesIntegrate, Random1234) { run_case("random", random_world(164, 12
 TEST_P(ParticlesIntegrate, Random1234Moved) {
   run_case("moved_far", random_world(164, 1234), true);
 }
+TEST_P(ParticlesIntegrate, Linked1234) {
+  // The free particles are cloth and rope particles: damped before they are integrated.
+  run_case("linked", with_linked(random_world(166, 1234), 166), true);
+}
 TEST_P(ParticlesIntegrate, Random65536) { run_case("random", random_world(165, 65536), true); }
 
 INSTANTIATE_TEST_SUITE_P(Conformance, ParticlesIntegrate, testing::ValuesIn(device_params()),

@@ -10,6 +10,8 @@
 #include "shared/quaternion.h"
 #include "shared/contact_force.h"
 #include "shared/body_math.h"
+#include "shared/links.h"
+#include "shared/neighbours.h"
 
 layout(local_size_x = 64) in;
 layout(push_constant) uniform Push { StepParams p; };

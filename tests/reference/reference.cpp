@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <numeric>
+#include <stdexcept>
 
 #include "shared/body_math.h"
 #include "shared/contact_force.h"
@@ -43,15 +44,11 @@ Grid grid_build(const Particles& particles, const StepParams& p) {
   }
 
   g.sorted_pos.assign(n, vec4(0.0f));
-  g.sorted_vel.assign(n, vec4(0.0f));
   g.sorted_body.assign(n, 0u);
-  g.sorted_material.assign(n, 0u);
   for (std::size_t k = 0; k < n; ++k) {
     const uint i = g.order[k];
     g.sorted_pos[k] = particles.pos[i];
-    g.sorted_vel[k] = particles.vel[i];
     g.sorted_body[k] = particles.body[i];
-    g.sorted_material[k] = particles.material[i];
   }
   return g;
 }
@@ -86,7 +83,8 @@ Neighbours neighbours_build(const Particles& particles, const Grid& grid, const 
     const std::vector<uint> walk = walk_buckets(particles.pos[i], p);
     std::vector<std::pair<std::size_t, uint>> found;  // (place on the walk, slot) of each j
     for (std::size_t j = 0; j < n; ++j) {
-      if (particles.body[j] == particles.body[i]) continue;  // includes j == i
+      if (motes::shared::contact_excluded(particles.body[j], particles.body[i]))
+        continue;  // j == i
       const auto on_walk = std::find(walk.begin(), walk.end(), grid.bucket[j]);
       if (on_walk == walk.end()) continue;
       if (!motes::shared::neighbour_within(particles.pos[i], particles.pos[j], p.neighbour_skin)) {
@@ -120,7 +118,8 @@ std::vector<vec4> contacts_compute(const Particles& particles, const std::vector
       sum[2] += static_cast<double>(f.z);
     };
     for (std::size_t j = 0; j < n; ++j) {
-      if (particles.body[j] == particles.body[i]) continue;  // includes j == i
+      if (motes::shared::contact_excluded(particles.body[j], particles.body[i]))
+        continue;  // j == i
       const vec4 xj = particles.pos[j];
       const vec4 vj = particles.vel[j];
       const ContactLaw law = laws[particles.material[i] * m + particles.material[j]];
@@ -189,10 +188,44 @@ bool particles_integrate(Particles& particles, const std::vector<vec4>& force, c
                          const std::vector<vec4>& ref) {
   bool moved = false;
   for (std::size_t i = particles.rigid; i < particles.size(); ++i) {
+    if (i >= p.linked_first) {  // cloth and rope particles: Jakobsen's damping first
+      const vec4 v = particles.vel[i];
+      const float keep = 1.0f - p.linked_damping;
+      particles.vel[i] = vec4(v.x * keep, v.y * keep, v.z * keep, v.w);
+    }
     motes::shared::particle_integrate(particles.pos[i], particles.vel[i], force[i], p.gravity_dt);
     if (!ref.empty()) {
       moved = motes::shared::neighbour_moved_too_far(particles.pos[i], ref[i], p.neighbour_skin) ||
               moved;
+    }
+  }
+  return moved;
+}
+
+bool constraints_solve(Particles& particles, const std::vector<Constraint>& constraints,
+                       const StepParams& p, const std::vector<vec4>& ref) {
+  const float inv_dt = 1.0f / p.gravity_dt.w;
+  std::vector<bool> used(particles.size(), false);
+  bool moved = false;
+  for (std::size_t k = p.constraint_first; k < p.constraint_first + p.constraint_count; ++k) {
+    const Constraint c = constraints[k];
+    if (used[c.a] || used[c.b] || c.a == c.b) {
+      throw std::invalid_argument(
+          "constraints_solve: two constraints of one colour share a particle");
+    }
+    used[c.a] = used[c.b] = true;
+    const float wa = particles.vel[c.a].w;
+    const float wb = particles.vel[c.b].w;
+    const vec3 d = motes::shared::constraint_correction(particles.pos[c.a], particles.pos[c.b], wa,
+                                                        wb, c.rest, c.stiffness);
+    motes::shared::constraint_apply(particles.pos[c.a], particles.vel[c.a], d * wa, inv_dt);
+    motes::shared::constraint_apply(particles.pos[c.b], particles.vel[c.b], d * -wb, inv_dt);
+    for (const uint i : {c.a, c.b}) {
+      if (!ref.empty()) {
+        moved =
+            motes::shared::neighbour_moved_too_far(particles.pos[i], ref[i], p.neighbour_skin) ||
+            moved;
+      }
     }
   }
   return moved;

@@ -11,10 +11,12 @@
 #include <vector>
 
 #include "shared/common.h"
+#include "shared/links.h"
 #include "shared/params.h"
 
 namespace motes_ref {
 
+using motes::shared::Constraint;
 using motes::shared::ContactLaw;
 using motes::shared::PlaneData;
 using motes::shared::StepParams;
@@ -27,7 +29,8 @@ struct Particles {
   std::vector<vec4> pos;       ///< xyz, w = radius
   std::vector<vec4> vel;       ///< xyz, w = inverse mass (0 = static)
   std::vector<vec4> local;     ///< (rigid) body-frame offset from the body's centre of mass
-  std::vector<uint> body;      ///< body index (B + k for the k-th free sphere)
+  std::vector<uint> body;      ///< body index (B + k for the k-th free sphere; cloth and rope:
+                               ///< shared::linked_body)
   std::vector<uint> material;  ///< material index
   std::size_t rigid = 0;       ///< Nr: particles of rigid bodies
   [[nodiscard]] std::size_t size() const { return pos.size(); }
@@ -53,9 +56,7 @@ struct Grid {
   std::vector<uint> order;       ///< N: particle ids stably sorted by bucket
   std::vector<uint> cell_start;  ///< T + 1: first sorted position with bucket >= b; [T] = N
   std::vector<vec4> sorted_pos;
-  std::vector<vec4> sorted_vel;
   std::vector<uint> sorted_body;
-  std::vector<uint> sorted_material;
 };
 
 /// grid_build: bucket = shared::grid_bucket of the particle's cell (shared::grid_cell_coord with
@@ -108,9 +109,17 @@ bool particles_update(const Bodies& bodies, Particles& particles, const StepPara
                       const std::vector<vec4>& ref = {});
 
 /// particles_integrate: shared::particle_integrate on the free particles [particles.rigid, N)
-/// with `force`; returns whether one has moved too far from `ref` (empty ref: false).
+/// with `force`, the velocities of the linked ones [p.linked_first, N) first times 1 -
+/// p.linked_damping; returns whether one has moved too far from `ref` (empty ref: false).
 bool particles_integrate(Particles& particles, const std::vector<vec4>& force, const StepParams& p,
                          const std::vector<vec4>& ref = {});
+
+/// constraints_solve: constraints [p.constraint_first, + p.constraint_count) projected one after
+/// the other (shared::constraint_correction, constraint_apply); throws std::invalid_argument when
+/// two of them share a particle (the colour would not be parallel). Returns whether a particle it
+/// moved ends too far from `ref` (empty ref: false).
+bool constraints_solve(Particles& particles, const std::vector<Constraint>& constraints,
+                       const StepParams& p, const std::vector<vec4>& ref = {});
 
 /// One whole step in the core's order (the grid and the lists are skipped: the brute-force
 /// contacts do not need them).

@@ -248,9 +248,7 @@ void check_on_device(const Particles& p, std::uint32_t flags, const motes::Devic
   const auto order = read_all<std::uint32_t>(dev, motes::Buffer::GridOrder, sizes);
   const auto start = read_all<std::uint32_t>(dev, motes::Buffer::GridCellStart, sizes);
   const auto sorted_pos = read_all<vec4>(dev, motes::Buffer::SortedPos, sizes);
-  const auto sorted_vel = read_all<vec4>(dev, motes::Buffer::SortedVel, sizes);
   const auto sorted_body = read_all<std::uint32_t>(dev, motes::Buffer::SortedBody, sizes);
-  const auto sorted_mat = read_all<std::uint32_t>(dev, motes::Buffer::SortedMaterial, sizes);
   const auto force = read_all<vec4>(dev, motes::Buffer::ParticleForce, sizes);
 
   // Integer outputs: exact.
@@ -285,9 +283,7 @@ void check_on_device(const Particles& p, std::uint32_t flags, const motes::Devic
   for (std::uint32_t k = 0; k < n; ++k) {
     const std::uint32_t i = want_order[k];
     ASSERT_TRUE(same_bytes(sorted_pos[k], p.pos[i])) << "SortedPos[" << k << "]";
-    ASSERT_TRUE(same_bytes(sorted_vel[k], p.vel[i])) << "SortedVel[" << k << "]";
     ASSERT_EQ(sorted_body[k], p.body[i]) << "SortedBody[" << k << "]";
-    ASSERT_EQ(sorted_mat[k], p.material[i]) << "SortedMaterial[" << k << "]";
   }
 
   // Neighbour pairs: 27 cells through the device's buckets vs O(N^2), exact sets.

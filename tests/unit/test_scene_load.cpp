@@ -434,7 +434,9 @@ const BadCase kBadCases[] = {
      {": /bodies/0/position: must be an array of 3 numbers [x, y, z], got an array of 2 values"}},
     {"shape_too_small.json", {": /bodies/0/shape: ", "no particle fits"}},
     {"zero_axis.json", {": /bodies/0/rotation/axis: must be a non-zero vector"}},
-    {"bad_kind.json", {": /bodies/0/kind: must be \"dynamic\" or \"static\", got \"kinematic\""}},
+    {"bad_kind.json",
+     {": /bodies/0/kind: must be \"dynamic\", \"static\", \"cloth\" or \"rope\", got "
+      "\"kinematic\""}},
     {"camera_same_point.json", {": /camera/target: must differ from /camera/position"}},
     {"camera_bad_fov.json",
      {": /camera/fov: must be a vertical field of view in degrees between 0 and 180", "got 200"}},

@@ -3,7 +3,9 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -39,7 +41,11 @@ struct Settings {
   /// the largest particle diameter. 0 rebuilds every substep.
   double neighbour_skin = -1.0;
   int neighbour_capacity = 16;  ///< list entries per particle; beyond, a particle walks the grid
-  Material contact;             ///< defaults for materials' missing fields
+  /// Cloth and ropes: relaxation sweeps over every constraint colour per substep (Jakobsen).
+  int constraint_iterations = 8;
+  /// Cloth and ropes: their particles' velocities decay at this rate (1/s); 0 = none.
+  double link_damping = 0.0;
+  Material contact;  ///< defaults for materials' missing fields
 };
 
 enum class BodyKind { Dynamic, Static };
@@ -55,6 +61,34 @@ struct BodySpec {
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< rad/s, world frame
   std::optional<Eigen::Vector3d> color;  ///< sRGB, each 0..1, for pictures (docs/rendering.md)
+};
+
+enum class LinkedKind { Rope, Cloth };
+
+/// A distance constraint between two particles of one cloth or rope (indices into its points); its
+/// rest length is their distance as built.
+struct LinkSpec {
+  std::uint32_t a = 0;
+  std::uint32_t b = 0;
+  double stiffness = 1.0;  ///< fraction of the error one projection removes, in (0, 1]
+};
+
+/// A cloth or a rope (Jakobsen 2001): equal spheres on a lattice, joined by distance constraints,
+/// integrated by position Verlet and relaxed colour by colour; they collide with everything
+/// through the one grid, themselves included (not within two lattice steps). Built by make_rope
+/// and make_cloth (motes/cloth.h).
+struct LinkedSpec {
+  std::string name;
+  LinkedKind kind = LinkedKind::Rope;
+  int material = 0;                     ///< index into Scene::materials; each particle weighs
+                                        ///< density x pi/6 diameter^3, as a lone sphere
+  double diameter = 0.0;                ///< particle diameter (m)
+  std::vector<Eigen::Vector3d> points;  ///< world positions of the particles
+  std::vector<std::array<std::uint32_t, 2>> lattice;  ///< (u, v) of each point; a rope: (i, 0)
+  std::vector<LinkSpec> links;
+  std::vector<std::uint32_t> pinned;  ///< points held fixed in space (inverse mass 0)
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  std::optional<Eigen::Vector3d> color;  ///< sRGB, each 0..1, for pictures
 };
 
 /// A static analytic half-space: solid below the plane (opposite to the normal).
@@ -78,6 +112,7 @@ struct Scene {
   Settings settings;
   std::vector<Material> materials;
   std::vector<BodySpec> bodies;
+  std::vector<LinkedSpec> linked;  ///< cloth and ropes; in outputs they follow the bodies
   std::vector<PlaneSpec> planes;
   std::optional<CameraSpec> camera;  ///< none: pictures fit a camera to the particles
 

@@ -17,8 +17,9 @@ MOTES_API_BEGIN
 namespace motes {
 
 /// State read back from the device (vec4 layouts as in motes::Buffer), in the scene's order: body
-/// b is the scene's b-th body and its particles are [BodyInfo::first_particle, + particle_count).
-/// A free sphere's body state is its particle's (orientation fixed, no angular momentum).
+/// b is the scene's b-th body (then its cloths and ropes) and its particles are
+/// [BodyInfo::first_particle, + particle_count). A free sphere's body state is its particle's, a
+/// cloth's or rope's the mean of its particles' (orientation fixed, no angular momentum).
 struct Snapshot {
   double time = 0.0;
   std::uint64_t step = 0;
@@ -42,6 +43,9 @@ struct BodyInfo {
   /// A dynamic one-particle body without spin, integrated as a particle (no body state on the
   /// device); otherwise a rigid body.
   bool free_sphere = false;
+  /// A cloth or a rope (Scene::linked; they follow the scene's bodies): its body state in a
+  /// Snapshot is the mean position and velocity of its particles (orientation fixed).
+  bool linked = false;
 };
 
 /// Neighbour-list figures since the simulation was created (NeighbourState).
@@ -87,13 +91,18 @@ class Simulation {
   [[nodiscard]] std::uint64_t steps() const { return steps_; }
   [[nodiscard]] const Settings& settings() const { return settings_; }
   [[nodiscard]] std::uint32_t particle_count() const { return sizes_.particles; }
-  /// Bodies of the scene (rigid bodies and free spheres).
+  /// Bodies of the scene (rigid bodies and free spheres), then its cloths and ropes.
   [[nodiscard]] std::uint32_t body_count() const {
     return static_cast<std::uint32_t>(bodies_.size());
   }
   [[nodiscard]] const std::vector<BodyInfo>& bodies() const { return bodies_; }
-  /// The device's sizes: rigid bodies first (sizes().bodies of them), then the free spheres.
+  /// The device's sizes: rigid bodies first (sizes().bodies of them), then the free spheres, then
+  /// the cloth and rope particles.
   [[nodiscard]] const Sizes& sizes() const { return sizes_; }
+  /// First constraint of each colour (colours + 1 entries; Device::constraints_solve).
+  [[nodiscard]] const std::vector<std::uint32_t>& constraint_colours() const {
+    return colour_first_;
+  }
   [[nodiscard]] const shared::StepParams& step_params() const { return params_; }
   /// Device memory this simulation holds (Device::required_bytes).
   [[nodiscard]] std::uint64_t device_bytes() const { return device_->required_bytes(sizes_); }
@@ -112,12 +121,15 @@ class Simulation {
   shared::StepParams params_{};
   std::vector<BodyInfo> bodies_;
   /// Per scene body: its index among the device's rigid bodies, or for a free sphere the index of
-  /// its particle on the device (the rigid bodies' particles come first).
+  /// its particle on the device (the rigid bodies' particles come first); for a cloth or rope its
+  /// first particle on the device.
   std::vector<std::uint32_t> device_index_;
   /// BodyFirst as uploaded (B + 1 entries): the first device particle of each rigid body.
   std::vector<std::uint32_t> rigid_first_;
   /// BodyInvInertia as uploaded (B entries): inverse principal moments of each rigid body.
   std::vector<shared::vec4> rigid_inv_inertia_;
+  /// Constraints of colour c are Constraints [colour_first_[c], colour_first_[c + 1]).
+  std::vector<std::uint32_t> colour_first_;
   /// (scene body, orientation) of the free spheres that are not at the identity orientation; a
   /// free sphere never turns.
   std::vector<std::pair<std::uint32_t, shared::vec4>> sphere_turns_;

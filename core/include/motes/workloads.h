@@ -29,5 +29,12 @@ bool settle_dimensions(std::uint64_t particles, int& nx, int& ny, int& nz);
 /// on a floor, pitch 0.6 x domino height along a row; the first of each row is tipped.
 Scene dominoes_workload(int count, int rows);
 
+/// W3 "cloth": a side x side cloth (d = 0.01 m particles, spacing d; structural, shear and bend
+/// links; 8 relaxation sweeps; self-collision on) held at the two corners of one edge, starting
+/// flat at y = 0.1 m + side d so that it swings down and folds without reaching the floor at
+/// y = 0 in the first second; k = 2000 N/m, gamma_n = 500/s, dt = 1e-4 s, link damping 1/s.
+/// side: 2 to 1024.
+Scene cloth_workload(int side);
+
 }  // namespace motes
 MOTES_API_END

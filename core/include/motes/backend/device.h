@@ -38,13 +38,11 @@ enum class Buffer : std::uint32_t {
   BodyTorque,      ///< vec4: summed torque about the centre of mass
   BodyFirst,       ///< uint (B + 1): first particle of each body, then Nr
   // Hashed grid (outputs of grid_build).
-  GridBucket,      ///< uint (N): bucket of particle i
-  GridOrder,       ///< uint (N): particle ids sorted stably by bucket
-  GridCellStart,   ///< uint (T + 1): sorted position of each bucket's first particle, then N
-  SortedPos,       ///< vec4 (N): ParticlePos in grid order
-  SortedVel,       ///< vec4 (N): ParticleVel in grid order
-  SortedBody,      ///< uint (N): ParticleBody in grid order
-  SortedMaterial,  ///< uint (N): ParticleMaterial in grid order
+  GridBucket,     ///< uint (N): bucket of particle i
+  GridOrder,      ///< uint (N): particle ids sorted stably by bucket
+  GridCellStart,  ///< uint (T + 1): sorted position of each bucket's first particle, then N
+  SortedPos,      ///< vec4 (N): ParticlePos in grid order
+  SortedBody,     ///< uint (N): ParticleBody in grid order
   // Neighbour lists (outputs of neighbours_build).
   NeighbourList,    ///< uint (K * N): entry k of particle i at k * N + i, a particle id
   NeighbourCount,   ///< uint (N): neighbours found at the last build (may exceed K)
@@ -53,6 +51,8 @@ enum class Buffer : std::uint32_t {
   // Tables.
   ContactLaws,  ///< ContactLaw (M * M): law of material pair (a, b) at a * M + b
   Planes,       ///< PlaneData (P)
+  // Cloth and ropes: their particles are [Nl, N) (StepParams.linked_first).
+  Constraints,  ///< Constraint (C): distance constraints, grouped by colour (shared/links.h)
   Count
 };
 
@@ -67,6 +67,7 @@ enum class Kernel : std::uint32_t {
   BodiesIntegrate,
   ParticlesUpdate,
   ParticlesIntegrate,
+  ConstraintsSolve,
   Count
 };
 
@@ -85,6 +86,7 @@ struct Sizes {
   std::uint32_t materials = 0;           ///< M
   std::uint32_t planes = 0;              ///< P
   std::uint32_t neighbour_capacity = 0;  ///< K: list entries per particle
+  std::uint32_t constraints = 0;         ///< C: distance constraints of cloth and ropes
 };
 
 /// Bytes of one element and number of elements of a buffer.
@@ -159,9 +161,15 @@ class Device {
   /// ParticlePos and ParticleVel xyz of the rigid particles [0, Nr) from their body's pose; asks
   /// for a rebuild (NeighbourState) when one has moved too far from its NeighbourRefPos.
   virtual void particles_update(const shared::StepParams& p) = 0;
-  /// Semi-implicit Euler on the free particles [Nr, N) (shared/body_math.h: particle_integrate);
-  /// asks for a rebuild when one has moved too far from its NeighbourRefPos.
+  /// Semi-implicit Euler on the free particles [Nr, N) (shared/body_math.h: particle_integrate),
+  /// the velocities of the linked particles [Nl, N) first multiplied by 1 - p.linked_damping; asks
+  /// for a rebuild when one has moved too far from its NeighbourRefPos.
   virtual void particles_integrate(const shared::StepParams& p) = 0;
+  /// One colour of distance constraints: Constraints [p.constraint_first, + p.constraint_count),
+  /// no two of which share a particle, each projected once (shared/links.h:
+  /// constraint_correction) on ParticlePos and ParticleVel; asks for a rebuild when a particle it
+  /// moved is too far from its NeighbourRefPos.
+  virtual void constraints_solve(const shared::StepParams& p) = 0;
 
   /// Waits for queued work; reports any error it raised.
   virtual Status synchronize() = 0;

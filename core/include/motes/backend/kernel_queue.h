@@ -24,6 +24,6 @@ bool same_calls(const std::vector<KernelCall>& a, const std::vector<KernelCall>&
 
 /// The shortest period p <= max_period that divides calls.size() and with which the calls repeat
 /// (calls[i] == calls[i % p]); calls.size() when there is none.
-std::size_t repeating_period(const std::vector<KernelCall>& calls, std::size_t max_period = 64);
+std::size_t repeating_period(const std::vector<KernelCall>& calls, std::size_t max_period = 1024);
 
 }  // namespace motes

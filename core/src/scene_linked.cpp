@@ -1,0 +1,169 @@
+// Scene cloth and ropes: entries of "bodies" with "kind": "cloth" or "rope" (docs/scene-format.md,
+// "Cloth and ropes"), built by make_cloth and make_rope (motes/cloth.h).
+#include <fmt/format.h>
+
+#include <array>
+#include <limits>
+#include <map>
+#include <string_view>
+#include <utility>
+
+#include "motes/cloth.h"
+#include "scene_parts.h"
+
+namespace motes::scene_detail {
+
+namespace {
+
+/// Keys of a rigid body that a cloth or rope cannot have, and why.
+constexpr std::pair<std::string_view, std::string_view> kRigidOnly[] = {
+    {"shape", "its particles are laid out by its \"{0}\" object"},
+    {"repeat", "give each {0} an entry of its own"},
+    {"rotation", "lay it out turned through the points in \"{0}\" instead"},
+    {"angular_velocity", "a {0} is not a rigid body (give \"velocity\")"},
+};
+
+/// A constraint stiffness: the fraction of the error one projection removes, in (0, 1].
+double read_stiffness(const Node& node) {
+  const double s = node.number();
+  if (!(s > 0.0 && s <= 1.0)) {
+    node.fail(
+        fmt::format("must be a number in (0, 1] (the fraction of a link's error one "
+                    "projection removes), got {}",
+                    describe(node.json())));
+  }
+  return s;
+}
+
+/// An array of exactly two integers, each in [lo, hi[k]].
+std::array<int, 2> read_pair(const Node& node, std::int64_t lo, std::array<std::int64_t, 2> hi,
+                             std::string_view what) {
+  if (!node.json().is_array() || node.size() != 2) {
+    node.fail(
+        fmt::format("must be an array of 2 integers {}, got {}", what, describe(node.json())));
+  }
+  return {static_cast<int>(node.at(std::size_t{0}).integer(lo, hi[0])),
+          static_cast<int>(node.at(std::size_t{1}).integer(lo, hi[1]))};
+}
+
+/// Adds a pin to `pins` (point -> JSON path of the pin that made it); fails on a duplicate.
+void add_pin(const Node& pin, std::uint32_t point, std::map<std::uint32_t, std::string>& pins) {
+  if (auto [it, added] = pins.emplace(point, pin.path()); !added) {
+    pin.fail(fmt::format("duplicate pin: point {} is already pinned by {}", point, it->second));
+  }
+}
+
+/// Unwraps make_cloth or make_rope: its message (without its "cloth: " or "rope: " prefix) follows
+/// the path of the entry's "cloth" or "rope" object.
+LinkedSpec take(Result<LinkedSpec> result, const Node& where, std::string_view kind) {
+  if (!result) {
+    std::string message = result.message();
+    const std::string prefix = fmt::format("{}: ", kind);
+    if (message.starts_with(prefix)) message.erase(0, prefix.size());
+    where.fail(message);
+  }
+  return std::move(result).value();
+}
+
+LinkedSpec read_cloth(const Node& node, double diameter) {
+  node.expect_object(
+      {"corner", "edge_u", "edge_v", "particles", "bend", "stiffness", "bend_stiffness", "pin"});
+  ClothOptions o;
+  o.diameter = diameter;
+  o.corner = node.at("corner").vec3();
+  o.edge_u = node.at("edge_u").vec3();
+  o.edge_v = node.at("edge_v").vec3();
+  const std::int64_t side = kLinkedMaxSide;
+  const std::array<int, 2> n = read_pair(node.at("particles"), 2, {side, side}, "[nu, nv]");
+  o.nu = n[0];
+  o.nv = n[1];
+  if (auto v = node.find("bend")) o.bend = v->boolean();
+  if (auto v = node.find("stiffness")) o.stiffness = read_stiffness(*v);
+  if (auto v = node.find("bend_stiffness")) o.bend_stiffness = read_stiffness(*v);
+  LinkedSpec c = take(make_cloth(o), node, "cloth");
+  if (auto pins = node.find("pin")) {
+    pins->expect_array();
+    std::map<std::uint32_t, std::string> pinned;
+    for (std::size_t k = 0; k < pins->size(); ++k) {
+      const Node pin = pins->at(k);
+      const std::array<int, 2> ij = read_pair(pin, 0, {o.nu - 1, o.nv - 1}, "[i, j]");
+      add_pin(pin, cloth_index(o, ij[0], ij[1]), pinned);
+    }
+    for (const auto& entry : pinned) c.pinned.push_back(entry.first);
+  }
+  return c;
+}
+
+LinkedSpec read_rope(const Node& node, double diameter) {
+  node.expect_object(
+      {"from", "to", "path", "particles", "bend", "stiffness", "bend_stiffness", "pin"});
+  RopeOptions o;
+  o.diameter = diameter;
+  if (auto path = node.find("path")) {
+    for (const char* key : {"from", "to"}) {
+      if (node.has(key)) node.at(key).fail("give either \"path\" or \"from\" and \"to\", not both");
+    }
+    path->expect_array();
+    if (path->size() < 2) path->fail("must hold at least two points [x, y, z]");
+    for (std::size_t k = 0; k < path->size(); ++k) o.path.push_back(path->at(k).vec3());
+  } else {
+    o.from = node.at("from").vec3();
+    o.to = node.at("to").vec3();
+  }
+  o.count = static_cast<int>(node.at("particles").integer(2, kLinkedMaxSide));
+  if (auto v = node.find("bend")) o.bend = v->boolean();
+  if (auto v = node.find("stiffness")) o.stiffness = read_stiffness(*v);
+  if (auto v = node.find("bend_stiffness")) o.bend_stiffness = read_stiffness(*v);
+  LinkedSpec r = take(make_rope(o), node, "rope");
+  if (auto pins = node.find("pin")) {
+    pins->expect_array();
+    std::map<std::uint32_t, std::string> pinned;
+    for (std::size_t k = 0; k < pins->size(); ++k) {
+      const Node pin = pins->at(k);
+      const std::int64_t i = pin.integer(-o.count, o.count - 1);  // -1: the last
+      add_pin(pin, static_cast<std::uint32_t>(i < 0 ? i + o.count : i), pinned);
+    }
+    for (const auto& entry : pinned) r.pinned.push_back(entry.first);
+  }
+  return r;
+}
+
+}  // namespace
+
+bool is_linked(const Node& entry) {
+  const Json& json = entry.json();
+  if (!json.is_object()) return false;
+  const auto kind = json.find("kind");
+  return kind != json.end() && kind->is_string() && (*kind == "cloth" || *kind == "rope");
+}
+
+LinkedSpec read_linked(const Node& entry, std::size_t index, const ShapeCache& cache,
+                       const Scene& scene) {
+  const std::string kind = entry.at("kind").string();
+  if (scene.linked.size() >= kLinkedMaxObjects) {
+    entry.fail(fmt::format("more than {} cloth and rope objects in one scene", kLinkedMaxObjects));
+  }
+  for (const auto& [key, why] : kRigidOnly) {
+    if (entry.has(key)) {
+      entry.at(key).fail(
+          fmt::format("not allowed on a {}: {}", kind, fmt::format(fmt::runtime(why), kind)));
+    }
+  }
+  entry.expect_object({"name", "kind", "material", "diameter", kind, "velocity", "color"});
+  const double diameter =
+      entry.has("diameter") ? entry.at("diameter").number(Sign::Positive) : cache.default_diameter;
+  const Node shape = entry.at(kind);
+  LinkedSpec spec = kind == "cloth" ? read_cloth(shape, diameter) : read_rope(shape, diameter);
+  for (const Eigen::Vector3d& p : spec.points) {
+    if (!(p.cwiseAbs().maxCoeff() <= static_cast<double>(std::numeric_limits<float>::max()))) {
+      shape.fail("a particle lands outside the float range");
+    }
+  }
+  spec.name = entry.has("name") ? entry.at("name").string() : fmt::format("{}{}", kind, index);
+  spec.material = entry.has("material") ? find_material(entry.at("material"), scene.materials) : 0;
+  if (auto v = entry.find("velocity")) spec.velocity = v->vec3();
+  if (auto color = entry.find("color")) spec.color = read_color(*color);
+  return spec;
+}
+
+}  // namespace motes::scene_detail
