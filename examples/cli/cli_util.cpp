@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -58,5 +59,19 @@ CLI::Validator finite_number(bool allow_zero) {
 
 CLI::Validator finite_non_negative() { return finite_number(true); }
 CLI::Validator finite_positive() { return finite_number(false); }
+
+CLI::Validator whole_number(std::uint64_t least) {
+  return CLI::Validator(
+      [least](std::string& text) -> std::string {
+        const bool digits =
+            !text.empty() && text.size() <= 19 &&
+            std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+        if (!digits || std::stoull(text) < least) {
+          return fmt::format("'{}' is not a whole number >= {}", text, least);
+        }
+        return {};
+      },
+      fmt::format("INTEGER >= {}", least));
+}
 
 }  // namespace motes::cli

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <string>
 
 namespace motes::cli {
@@ -22,5 +23,9 @@ std::string format_si(double value);
 CLI::Validator finite_non_negative();
 /// Validator for a finite number > 0.
 CLI::Validator finite_positive();
+/// Validator for a count: a whole number >= least, in digits only ("-5", "2.5" and "1e3" are
+/// refused with a plain message; CLI11 would wrap a negative count around or print its range up
+/// to the largest double).
+CLI::Validator whole_number(std::uint64_t least);
 
 }  // namespace motes::cli

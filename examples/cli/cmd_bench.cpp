@@ -397,41 +397,44 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--cloth-sides", opts->cloth_sides,
                   "W3: cloth sides in particles (a side x side cloth each)")
       ->delimiter(',')
+      ->check(whole_number(2))
       ->capture_default_str();
   cmd->add_option("--cloth-steps", opts->cloth_steps, "W3: steps timed")
-      ->check(CLI::PositiveNumber)
+      ->check(whole_number(1))
       ->capture_default_str();
   cmd->add_option("--sizes", opts->sizes, "W1 particle counts")
       ->delimiter(',')
+      ->check(whole_number(1))
       ->capture_default_str();
   cmd->add_option("--phase", opts->phase, "W1 phase: falling, dense or both")
       ->capture_default_str();
   cmd->add_option("--backend", opts->backend, "auto, openmp, cuda or vulkan")
       ->capture_default_str();
-  cmd->add_option("--device", opts->device, "device index within the backend");
+  cmd->add_option("--device", opts->device, "device index within the backend")
+      ->check(whole_number(0));
   cmd->add_option("--threads", opts->threads, "OpenMP threads (0: OpenMP's default)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(whole_number(0));
   cmd->add_option("--repeats", opts->repeats, "timed repeats (the median is reported)")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   cmd->add_option("--falling-steps", opts->falling_steps, "steps of the W1 falling phase")
-      ->check(CLI::PositiveNumber)
+      ->check(whole_number(1))
       ->capture_default_str();
   cmd->add_option("--dense-steps", opts->dense_steps, "steps of the W1 dense phase")
-      ->check(CLI::PositiveNumber)
+      ->check(whole_number(1))
       ->capture_default_str();
   cmd->add_option("--settle-steps", opts->settle_steps,
                   "steps run once to make the W1 dense-phase start state")
-      ->check(CLI::PositiveNumber)
+      ->check(whole_number(1))
       ->capture_default_str();
   cmd->add_option("--dominoes", opts->dominoes, "W2: number of dominoes")
-      ->check(CLI::PositiveNumber)
+      ->check(whole_number(1))
       ->capture_default_str();
   cmd->add_option("--domino-rows", opts->domino_rows, "W2: parallel rows")
-      ->check(CLI::PositiveNumber)
+      ->check(whole_number(1))
       ->capture_default_str();
   cmd->add_option("--domino-steps", opts->domino_steps, "W2: steps timed")
-      ->check(CLI::PositiveNumber)
+      ->check(whole_number(1))
       ->capture_default_str();
   cmd->add_option("--cache", opts->cache, "folder for settled W1 states")->capture_default_str();
   cmd->add_option("--dense-from", opts->dense_from,

@@ -282,8 +282,9 @@ void add_run_command(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "openmp", "cuda", "vulkan"}))
       ->capture_default_str();
   sub->add_option("--device", args->device, "device index within the backend (motes devices)")
-      ->check(CLI::NonNegativeNumber);
-  args->steps_option = sub->add_option("--steps", args->steps, "number of steps to run");
+      ->check(whole_number(0));
+  args->steps_option =
+      sub->add_option("--steps", args->steps, "number of steps to run")->check(whole_number(0));
   args->duration_option =
       sub->add_option("--duration", args->duration,
                       "simulated seconds to run (default: the scene's settings.duration)")
@@ -293,13 +294,13 @@ void add_run_command(CLI::App& app) {
   args->every_option =
       sub->add_option("--every", args->every,
                       "write a frame every K steps (default: settings.output_interval / dt)")
-          ->check(CLI::PositiveNumber);
+          ->check(whole_number(1));
   sub->add_option("--format", args->format, "output files: vtu (+ .pvd), csv or none")
       ->check(CLI::IsMember({"vtu", "csv", "none"}))
       ->capture_default_str();
   sub->add_option("--threads", args->threads,
                   "OpenMP backend threads (default: OMP_NUM_THREADS or every core)")
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number(1));
   sub->add_option("--render", args->render_dir,
                   "also draw every frame as a PNG in this directory, and an MP4 when ffmpeg is "
                   "installed (docs/rendering.md)");

@@ -99,6 +99,27 @@ TEST(Cli, VersionAndUsage) {
   EXPECT_TRUE(contains(nan.err, "finite")) << describe(nan);
 }
 
+TEST(Cli, NegativeCountsAreUsageErrors) {
+  // CLI11 alone wraps "-5" around to 18446744073709551611 steps, or prints a range up to the
+  // largest double: every count option says plainly what it wants instead.
+  TempDir tmp;
+  const std::vector<std::vector<std::string>> cases = {
+      {"run", kSmallScene, "--steps", "-5"},   {"run", kSmallScene, "--every", "-5"},
+      {"run", kSmallScene, "--every", "2.5"},  {"run", kSmallScene, "--device", "-1"},
+      {"run", kSmallScene, "--threads", "-2"}, {"voxelize", "mesh.obj", "--count", "-5"},
+      {"bench", "--falling-steps", "-5"},      {"bench", "--sizes", "16384,-5"},
+      {"bench", "--cloth-sides", "1"},         {"render-bench", "--frames", "-3"},
+  };
+  for (const std::vector<std::string>& args : cases) {
+    const Outcome o = run_motes(tmp, args);
+    EXPECT_NE(o.exit_code, 0) << describe(o);
+    EXPECT_NE(o.exit_code, 2) << "usage errors keep CLI11's exit codes\n" << describe(o);
+    EXPECT_TRUE(contains(o.err, "is not a whole number >=")) << describe(o);
+    EXPECT_FALSE(contains(o.err, "18446744073709551")) << describe(o);
+    EXPECT_FALSE(contains(o.err, "179769313486231570")) << describe(o);
+  }
+}
+
 TEST(Cli, RunWritesVtuFramesAndSeries) {
   TempDir tmp;
   const std::string out = tmp / "out";
