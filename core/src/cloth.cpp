@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace motes {
 
@@ -32,6 +33,10 @@ Status check_side(const char* what, const char* name, int count, int least) {
 }
 
 }  // namespace
+
+double linked_particle_mass(double density, double diameter) {
+  return density * std::numbers::pi / 6.0 * diameter * diameter * diameter;
+}
 
 Result<LinkedSpec> make_rope(const RopeOptions& o) {
   if (Status s = check_common("rope", o.diameter, o.stiffness, o.bend_stiffness); !s) return s;

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <limits>
 #include <map>
-#include <numbers>
 #include <utility>
 
 #include "contact_laws.h"
+#include "motes/cloth.h"
 #include "scene_parts.h"
 
 namespace motes::scene_detail {
@@ -71,8 +71,7 @@ void check_stability(const Scene& scene, const std::vector<BodyEntry>& entries) 
     const char* kind = l.kind == LinkedKind::Cloth ? "cloth" : "rope";
     const std::string name = fmt::format("{} \"{}\"", kind, l.name);
     if (!l.pinned.empty()) partners.emplace(l.material, "a pinned particle of " + name);
-    const double d = l.diameter;
-    const double m = mat.density * std::numbers::pi / 6.0 * d * d * d;
+    const double m = linked_particle_mass(mat.density, l.diameter);
     BodyClass& c = dynamic[{l.material, m}];
     if (c.copies == 0) c = BodyClass{l.material, m, 0, name};
     c.copies += 1;

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <numbers>
 
 #include "contact_laws.h"
 #include "motes/cloth.h"
@@ -254,7 +253,7 @@ Status Simulation::upload(const Scene& scene) {
       return Status::error(fmt::format("{}: '{}' has no valid material", scene.source, spec.name));
     }
     const Material& mat = scene.materials[static_cast<std::size_t>(spec.material)];
-    const double particle_mass = mat.density * std::numbers::pi / 6.0 * std::pow(spec.diameter, 3);
+    const double particle_mass = linked_particle_mass(mat.density, spec.diameter);
     if (!(particle_mass > 0.0) || !std::isfinite(particle_mass)) {
       return Status::error(fmt::format("{}: '{}' has no mass (density {}, diameter {})",
                                        scene.source, spec.name, mat.density, spec.diameter));

@@ -36,6 +36,21 @@ PlaneSpec plane(const char* name, Eigen::Vector3d normal, Eigen::Vector3d point)
 }
 
 /// The W1 scene without bodies: settings, material, floor and walls of a box lx x lz.
+/// The scene's only material, also its default contact law: k = 2000 N/m, the given dashpot
+/// coefficients (1/s) and a Coulomb cap of 0.5.
+void add_material(Scene& scene, const char* name, double density, double damping,
+                  double tangential) {
+  Material m;
+  m.name = name;
+  m.density = density;
+  m.stiffness = 2000.0;
+  m.damping = damping;
+  m.tangential = tangential;
+  m.friction = 0.5;
+  scene.materials.push_back(m);
+  scene.settings.contact = m;
+}
+
 Scene settle_base(const std::string& source, double lx, double lz) {
   constexpr double d = 0.01;
   Scene scene;
@@ -45,15 +60,7 @@ Scene settle_base(const std::string& source, double lx, double lz) {
   scene.settings.gravity = {0.0, -9.81, 0.0};
   scene.settings.particle_diameter = d;
   scene.settings.duration = 1.2;
-  Material m;
-  m.name = "glass";
-  m.density = 2500.0;
-  m.stiffness = 2000.0;
-  m.damping = 50.0;
-  m.tangential = 25.0;
-  m.friction = 0.5;
-  scene.materials.push_back(m);
-  scene.settings.contact = m;
+  add_material(scene, "glass", 2500.0, 50.0, 25.0);
   scene.planes.push_back(plane("floor", {0, 1, 0}, {0, 0, 0}));
   scene.planes.push_back(plane("x0", {1, 0, 0}, {0, 0, 0}));
   scene.planes.push_back(plane("x1", {-1, 0, 0}, {lx, 0, 0}));
@@ -195,15 +202,7 @@ Scene dominoes_workload(int count, int rows) {
   scene.settings.dt = 2e-5;
   scene.settings.particle_diameter = d;
   scene.settings.duration = 1.0;
-  Material m;
-  m.name = "wood";
-  m.density = 700.0;
-  m.stiffness = 2000.0;
-  m.damping = 1000.0;
-  m.tangential = 500.0;
-  m.friction = 0.5;
-  scene.materials.push_back(m);
-  scene.settings.contact = m;
+  add_material(scene, "wood", 700.0, 1000.0, 500.0);
 
   auto domino = std::make_shared<ParticleSet>();
   domino->diameter = d;
@@ -240,15 +239,7 @@ Scene cloth_workload(int side) {
   scene.settings.duration = 1.0;
   scene.settings.constraint_iterations = 8;
   scene.settings.link_damping = 1.0;
-  Material m;
-  m.name = "cloth";
-  m.density = 1000.0;
-  m.stiffness = 2000.0;
-  m.damping = 500.0;
-  m.tangential = 200.0;
-  m.friction = 0.5;
-  scene.materials.push_back(m);
-  scene.settings.contact = m;
+  add_material(scene, "cloth", 1000.0, 500.0, 200.0);
   ClothOptions o;
   o.corner = {0.0, 0.1 + d * side, 0.0};
   o.edge_u = {d * (side - 1), 0.0, 0.0};

@@ -120,16 +120,4 @@ motes::Status capture(motes::Simulation& sim, OracleRun& out) {
   return s;
 }
 
-double max_distance(const std::vector<vec4>& a, const std::vector<vec4>& b) {
-  double worst = a.size() == b.size() ? 0.0 : HUGE_VAL;
-  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
-    const double dx = static_cast<double>(a[i].x) - static_cast<double>(b[i].x);
-    const double dy = static_cast<double>(a[i].y) - static_cast<double>(b[i].y);
-    const double dz = static_cast<double>(a[i].z) - static_cast<double>(b[i].z);
-    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
-    worst = std::isnan(d) ? HUGE_VAL : std::max(worst, d);
-  }
-  return worst;
-}
-
 }  // namespace motes_conf

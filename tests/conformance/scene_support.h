@@ -53,7 +53,4 @@ struct OracleRun {
 };
 motes::Status capture(motes::Simulation& sim, OracleRun& out);
 
-/// Largest distance (m) between corresponding positions.
-double max_distance(const std::vector<vec4>& a, const std::vector<vec4>& b);
-
 }  // namespace motes_conf

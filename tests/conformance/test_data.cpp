@@ -297,4 +297,24 @@ World random_world(std::uint32_t seed, std::size_t n, std::uint32_t flags, float
   return make_world(rng, std::move(pos), flags, true, skin);
 }
 
+double max_distance(const std::vector<vec4>& a, const std::vector<vec4>& b) {
+  double worst = a.size() == b.size() ? 0.0 : HUGE_VAL;
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    const double dx = static_cast<double>(a[i].x) - static_cast<double>(b[i].x);
+    const double dy = static_cast<double>(a[i].y) - static_cast<double>(b[i].y);
+    const double dz = static_cast<double>(a[i].z) - static_cast<double>(b[i].z);
+    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    worst = std::isnan(d) ? HUGE_VAL : std::max(worst, d);
+  }
+  return worst;
+}
+
+double coordinate_ulp(const std::vector<vec4>& pos) {
+  float largest = 0.0f;
+  for (const vec4& x : pos) {
+    largest = std::max({largest, std::abs(x.x), std::abs(x.y), std::abs(x.z)});
+  }
+  return static_cast<double>(std::nextafter(largest, HUGE_VALF) - largest);
+}
+
 }  // namespace motes_conf

@@ -102,6 +102,14 @@ std::vector<T> slice(const std::vector<T>& v, std::size_t from, std::size_t to) 
 /// last neighbour-list build, as seen from `pos`, or later positions as seen from a build.
 std::vector<vec4> moved_by(Rng& rng, const std::vector<vec4>& pos, float skin, float fraction);
 
+/// Largest distance between corresponding xyz (HUGE_VAL when the sizes differ or one is NaN).
+double max_distance(const std::vector<vec4>& a, const std::vector<vec4>& b);
+
+/// One unit in the last place of the largest |coordinate| of `pos`: a position that rounds the
+/// other way on another backend moves by this much, a Verlet velocity (x - x_prev) / dt by this
+/// over dt.
+double coordinate_ulp(const std::vector<vec4>& pos);
+
 /// The skin the neighbour-list cases use with random_world's radii (rmax = 5 mm): 1 mm.
 constexpr float kTestSkin = 0.001f;
 

@@ -171,11 +171,7 @@ class Scenes : public DeviceTest {
   /// The velocity bound of cloth and rope particles after `steps` steps: `ulps` units in the last
   /// place of the largest coordinate, divided by dt (see the file comment).
   static double linked_velocity_bound(const std::vector<vec4>& pos, double dt, double ulps) {
-    float largest = 0.0f;
-    for (const vec4& x : pos)
-      largest = std::max({largest, std::abs(x.x), std::abs(x.y), std::abs(x.z)});
-    const double ulp = std::nextafter(largest, HUGE_VALF) - largest;
-    return ulps * ulp / dt;
+    return ulps * coordinate_ulp(pos) / dt;
   }
 
   void run_window(const std::string& name) {

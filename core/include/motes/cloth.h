@@ -20,6 +20,9 @@ namespace motes {
 constexpr std::uint32_t kLinkedMaxSide = MOTES_LINKED_MAX_SIDE;
 constexpr std::uint32_t kLinkedMaxObjects = MOTES_LINKED_MAX_OBJECTS;
 
+/// Mass of one cloth or rope particle: density x pi/6 diameter^3, a lone sphere's.
+double linked_particle_mass(double density, double diameter);
+
 /// Options of a rope: `count` particles evenly spaced by arc length along a polyline (`path`, or
 /// the segment from `from` to `to` when `path` is empty), each joined to the next; with `bend`,
 /// also each to the one after next (resists folding). A link's rest length is the straight
