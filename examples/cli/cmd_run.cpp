@@ -7,6 +7,7 @@
 #include <csignal>
 #include <cstdint>
 #include <memory>
+#include <set>
 #include <string>
 
 #include "cli_util.h"
@@ -102,6 +103,15 @@ class Runner {
     Result<Scene> scene =
         args_.scene.empty() ? builtin_default_scene() : load_scene_file(args_.scene);
     if (!scene) fail(scene.message());
+    // Mesh shapes filled by their winding number (open or non-manifold meshes) carry a warning;
+    // bodies that share a mesh share it, so each is printed once.
+    std::set<std::string> warned;
+    for (const BodySpec& body : scene->bodies) {
+      if (!body.shape) continue;
+      for (const std::string& warning : body.shape->warnings) {
+        if (warned.insert(warning).second) fmt::print(stderr, "motes: warning: {}\n", warning);
+      }
+    }
     scene_name_ = args_.scene.empty() ? "built-in default scene (examples/scenes/dominoes.json)"
                                       : args_.scene;
     Result<OutputFormat> format = parse_output_format(args_.format);

@@ -1,4 +1,4 @@
-// `motes voxelize MESH`: fills a closed mesh with equal particles and prints what came out.
+// `motes voxelize MESH`: fills a mesh with equal particles and prints what came out.
 #include <fmt/format.h>
 
 #include <Eigen/Core>
@@ -53,6 +53,10 @@ void run_voxelize(const VoxelizeArgs& a) {
   Result<ParticleSet> voxelized = voxelize(mesh, options);
   if (!voxelized) fail(voxelized.message());
   const ParticleSet& particles = voxelized.value();
+  // An open or non-manifold mesh is filled by its winding number: say so, once, on stderr.
+  for (const std::string& warning : particles.warnings) {
+    fmt::print(stderr, "motes: warning: {}\n", warning);
+  }
   if (particles.points.empty()) fail(fmt::format("{}: voxelization gave no particles", a.mesh));
 
   Eigen::Vector3d mesh_lo = mesh.vertices.front(), mesh_hi = mesh.vertices.front();
@@ -101,8 +105,8 @@ void run_voxelize(const VoxelizeArgs& a) {
 
 void add_voxelize_command(CLI::App& app) {
   auto args = std::make_shared<VoxelizeArgs>();
-  CLI::App* sub = app.add_subcommand(
-      "voxelize", "Fill a closed mesh (OBJ, PLY, STL, OFF...) with equal particles");
+  CLI::App* sub =
+      app.add_subcommand("voxelize", "Fill a mesh (OBJ, PLY, STL, OFF...) with equal particles");
   sub->add_option("MESH", args->mesh, "mesh file")->required();
   CLI::Option_group* size = sub->add_option_group("particle size", "exactly one of these");
   size->add_option("--diameter", args->diameter, "particle diameter (mesh units, metres)")

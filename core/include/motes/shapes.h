@@ -20,6 +20,9 @@ struct ParticleSet {
   /// Volume that gives each particle its mass (density x volume). 0: diameter^3, the particle's
   /// lattice cell, so a filled shape weighs density x its volume. A lone sphere uses pi/6 d^3.
   double particle_volume = 0.0;
+  /// Things the user should know about how the particles were made, one sentence each, naming
+  /// the mesh file (e.g. an open mesh filled by its winding number). Empty for primitives.
+  std::vector<std::string> warnings;
 };
 
 /// A box of size sx x sy x sz, centred at the origin: the centres of the cells of a lattice of
@@ -54,9 +57,12 @@ struct VoxelizeOptions {
   std::size_t target_count = 0;  ///< choose the diameter that gives the count nearest to this
 };
 
-/// Fills a closed mesh with particles: a lattice of diameter-sized cells, rays along z through the
-/// cell centres, odd crossing count = inside. A mesh that is not closed, an empty result or a bad
-/// option is an error naming mesh.source.
+/// Fills a mesh with particles: the centres of a lattice of diameter-sized cells that lie inside.
+/// A closed, manifold mesh: rays along z through the cell centres, odd crossing count = inside
+/// (where its surface overlaps itself, a non-zero crossing count). An open or non-manifold mesh:
+/// generalized winding number |w| > 0.5 = inside, with a note in ParticleSet::warnings
+/// (docs/scene-format.md, "Open and non-manifold meshes"). A mesh that encloses no volume, an
+/// empty result or a bad option is an error naming mesh.source.
 Result<ParticleSet> voxelize(const TriangleMesh& mesh, const VoxelizeOptions& options);
 
 /// Mass, centre of mass and inertia of equal spheres of the given density, each of mass
