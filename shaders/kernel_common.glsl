@@ -6,6 +6,7 @@
 #include "shared/common.h"
 #include "shared/links.h"
 #include "shared/params.h"
+#include "shared/shape_matching.h"
 #include "vulkan_bindings.h"
 
 layout(local_size_x = WORKGROUP_SIZE) in;
@@ -43,6 +44,10 @@ layout(std430, binding = B_NEIGHBOUR_STATE) buffer NeighbourStateBuf { uint neig
 layout(std430, binding = B_CONTACT_LAWS) readonly buffer ContactLawsBuf { ContactLaw contact_laws[]; };
 layout(std430, binding = B_PLANES) readonly buffer PlanesBuf { PlaneData planes[]; };
 layout(std430, binding = B_CONSTRAINTS) readonly buffer ConstraintsBuf { Constraint constraints[]; };
+layout(std430, binding = B_CLUSTERS) readonly buffer ClustersBuf { Cluster clusters[]; };
+layout(std430, binding = B_CLUSTER_MEMBERS) readonly buffer ClusterMembersBuf { ClusterMember cluster_members[]; };
+layout(std430, binding = B_CLUSTER_FRAMES) buffer ClusterFramesBuf { ClusterFrame cluster_frames[]; };
+layout(std430, binding = B_CLUSTER_GATHER) readonly buffer ClusterGatherBuf { uint cluster_gather[]; };
 layout(std430, binding = B_GRID_ARRIVAL) buffer GridArrivalBuf { uint grid_arrival[]; };
 layout(std430, binding = B_GRID_UNSORTED) buffer GridUnsortedBuf { uint grid_unsorted[]; };
 layout(std430, binding = B_SCAN_SCRATCH) buffer ScanScratchBuf { uint scan_scratch[]; };

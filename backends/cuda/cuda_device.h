@@ -60,6 +60,8 @@ class CudaDevice final : public Device {
   void constraints_solve(const shared::StepParams& p) override {
     enqueue(Kernel::ConstraintsSolve, p);
   }
+  void clusters_fit(const shared::StepParams& p) override { enqueue(Kernel::ClustersFit, p); }
+  void clusters_goal(const shared::StepParams& p) override { enqueue(Kernel::ClustersGoal, p); }
 
   Status synchronize() override;
   Status check_guards() override;
@@ -110,6 +112,8 @@ class CudaDevice final : public Device {
   void launch_bodies_integrate(const shared::StepParams& p);
   void launch_particles_update(const shared::StepParams& p);
   void launch_constraints_solve(const shared::StepParams& p);
+  void launch_clusters_fit(const shared::StepParams& p);
+  void launch_clusters_goal(const shared::StepParams& p);
   /// bodies_reduce, bodies_integrate and particles_update in one pass (bodies_step.cu), for scenes
   /// whose bodies are small; the same arithmetic as the three kernels.
   void launch_bodies_step(const shared::StepParams& p);

@@ -83,6 +83,12 @@ std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t
     case Kernel::ParticlesIntegrate:
       launch_particles_integrate(p);
       return 1;
+    case Kernel::ClustersFit:
+      launch_clusters_fit(p);
+      return 1;
+    case Kernel::ClustersGoal:
+      launch_clusters_goal(p);
+      return 1;
     case Kernel::ConstraintsSolve:
       launch_constraints_solve(p);
       return 1;

@@ -5,9 +5,11 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "vulkan_backend.h"
 #include "vulkan_shaders.h"
@@ -27,6 +29,8 @@ static_assert(B_NEIGHBOUR_STATE == static_cast<int>(Buffer::NeighbourState));
 static_assert(B_CONTACT_LAWS == static_cast<int>(Buffer::ContactLaws));
 static_assert(B_PLANES == static_cast<int>(Buffer::Planes));
 static_assert(B_CONSTRAINTS == static_cast<int>(Buffer::Constraints));
+static_assert(B_CLUSTERS == static_cast<int>(Buffer::Clusters));
+static_assert(B_CLUSTER_GATHER == static_cast<int>(Buffer::ClusterGather));
 static_assert(B_GRID_ARRIVAL == static_cast<int>(Buffer::Count));
 
 namespace {
@@ -35,7 +39,8 @@ constexpr const char* kPipelineShaders[kPipelineCount] = {
     "neighbours_decide",   "grid_build_clear",    "grid_build_count", "grid_build_scan_block",
     "grid_build_scan_add", "grid_build_scatter",  "grid_build_place", "neighbours_begin",
     "neighbours_build",    "contacts_compute",    "bodies_reduce",    "bodies_integrate",
-    "particles_update",    "particles_integrate", "constraints_solve"};
+    "particles_update",    "particles_integrate", "clusters_fit",     "clusters_goal",
+    "constraints_solve"};
 
 const char* binding_name(std::uint32_t binding) {
   if (binding < kBufferCount) return buffer_name(static_cast<Buffer>(binding));
@@ -51,6 +56,43 @@ const char* binding_name(std::uint32_t binding) {
     default:
       return "?";
   }
+}
+
+/// The storage-buffer bindings a SPIR-V module uses: the Binding decorations of the variables
+/// that an instruction inside a function names (glslang declares every block of
+/// kernel_common.glsl in every shader, and lists them all in the entry point's interface). A
+/// literal that happens to equal a variable's id only adds a binding, which is harmless.
+std::uint64_t spirv_bindings(const std::uint32_t* words, std::size_t count) {
+  constexpr std::uint32_t kOpFunction = 54;
+  constexpr std::uint32_t kOpFunctionEnd = 56;
+  constexpr std::uint32_t kOpDecorate = 71;
+  constexpr std::uint32_t kDecorationBinding = 33;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> binding_of;  // (variable id, binding)
+  for (std::size_t at = 5; at < count;) {
+    const std::uint32_t length = words[at] >> 16;
+    if (length == 0 || at + length > count) break;
+    if ((words[at] & 0xffffu) == kOpDecorate && length >= 4 &&
+        words[at + 2] == kDecorationBinding) {
+      binding_of.emplace_back(words[at + 1], words[at + 3]);
+    }
+    at += length;
+  }
+  std::uint64_t mask = 0;
+  bool in_function = false;
+  for (std::size_t at = 5; at < count;) {
+    const std::uint32_t op = words[at] & 0xffffu;
+    const std::uint32_t length = words[at] >> 16;
+    if (length == 0 || at + length > count) break;
+    if (op == kOpFunction) in_function = true;
+    if (op == kOpFunctionEnd) in_function = false;
+    for (std::size_t k = at + 1; in_function && k < at + length; ++k) {
+      for (const auto& [id, binding] : binding_of) {
+        if (words[k] == id && binding < 64) mask |= std::uint64_t{1} << binding;
+      }
+    }
+    at += length;
+  }
+  return mask;
 }
 
 VkDeviceSize round_up(VkDeviceSize x, VkDeviceSize to) { return (x + to - 1) / to * to; }
@@ -127,40 +169,32 @@ Status VulkanDevice::init(std::shared_ptr<Instance> instance, int physical) {
 }
 
 Status VulkanDevice::create_pipelines() {
-  std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
-  for (std::uint32_t i = 0; i < kBindingCount; ++i) {
-    bindings[i].binding = i;
-    bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    bindings[i].descriptorCount = 1;
-    bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  // The block scan uses subgroup arithmetic where the device has it (MOTES_VULKAN_NO_SUBGROUPS=1
+  // forces the shared-memory version, so that tests cover both).
+  const char* no_subgroups = std::getenv("MOTES_VULKAN_NO_SUBGROUPS");
+  use_subgroups_ = physical_.subgroup_arithmetic &&
+                   (no_subgroups == nullptr || std::strcmp(no_subgroups, "1") != 0);
+  std::array<const Shader*, kPipelineCount> shaders{};
+  std::uint32_t descriptors = 0;
+  for (std::size_t i = 0; i < kPipelineCount; ++i) {
+    std::string name = kPipelineShaders[i];
+    if (use_subgroups_ && static_cast<Pipeline>(i) == Pipeline::GridBuildScanBlock) {
+      name += "_subgroup";
+    }
+    shaders[i] = find_shader(name);
+    if (shaders[i] == nullptr) {
+      return Status::error(fmt::format("vulkan: shader {} is not embedded in this build", name));
+    }
+    used_bindings_[i] = spirv_bindings(shaders[i]->words, shaders[i]->word_count);
+    descriptors += static_cast<std::uint32_t>(std::popcount(used_bindings_[i]));
   }
-  VkDescriptorSetLayoutCreateInfo set_info{};
-  set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  set_info.bindingCount = kBindingCount;
-  set_info.pBindings = bindings.data();
-  if (Status s = check(vkCreateDescriptorSetLayout(device_, &set_info, nullptr, &set_layout_),
-                       "vkCreateDescriptorSetLayout");
-      !s) {
-    return s;
-  }
-  VkPushConstantRange push{};
-  push.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-  push.size = sizeof(PushConstants);
-  VkPipelineLayoutCreateInfo layout{};
-  layout.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-  layout.setLayoutCount = 1;
-  layout.pSetLayouts = &set_layout_;
-  layout.pushConstantRangeCount = 1;
-  layout.pPushConstantRanges = &push;
-  if (Status s = check(vkCreatePipelineLayout(device_, &layout, nullptr, &pipeline_layout_),
-                       "vkCreatePipelineLayout");
-      !s) {
-    return s;
-  }
-  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount};
+
+  // One descriptor set per pipeline holding only the buffers its shader uses: devices may allow
+  // as few as 32 storage buffers per stage (lavapipe does), fewer than the backend has.
+  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, std::max(descriptors, 1u)};
   VkDescriptorPoolCreateInfo pool{};
   pool.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-  pool.maxSets = 1;
+  pool.maxSets = static_cast<std::uint32_t>(kPipelineCount);
   pool.poolSizeCount = 1;
   pool.pPoolSizes = &pool_size;
   if (Status s = check(vkCreateDescriptorPool(device_, &pool, nullptr, &descriptor_pool_),
@@ -168,31 +202,54 @@ Status VulkanDevice::create_pipelines() {
       !s) {
     return s;
   }
-  VkDescriptorSetAllocateInfo alloc{};
-  alloc.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  alloc.descriptorPool = descriptor_pool_;
-  alloc.descriptorSetCount = 1;
-  alloc.pSetLayouts = &set_layout_;
-  if (Status s =
-          check(vkAllocateDescriptorSets(device_, &alloc, &set_), "vkAllocateDescriptorSets");
-      !s) {
-    return s;
+  for (std::size_t i = 0; i < kPipelineCount; ++i) {
+    std::vector<VkDescriptorSetLayoutBinding> bindings;
+    for (std::uint32_t b = 0; b < kBindingCount; ++b) {
+      if ((used_bindings_[i] >> b & 1u) == 0) continue;
+      VkDescriptorSetLayoutBinding binding{};
+      binding.binding = b;
+      binding.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      binding.descriptorCount = 1;
+      binding.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+      bindings.push_back(binding);
+    }
+    VkDescriptorSetLayoutCreateInfo set_info{};
+    set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+    set_info.bindingCount = static_cast<std::uint32_t>(bindings.size());
+    set_info.pBindings = bindings.data();
+    if (Status s = check(vkCreateDescriptorSetLayout(device_, &set_info, nullptr, &set_layouts_[i]),
+                         "vkCreateDescriptorSetLayout");
+        !s) {
+      return s;
+    }
+    VkPushConstantRange push{};
+    push.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    push.size = sizeof(PushConstants);
+    VkPipelineLayoutCreateInfo layout{};
+    layout.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+    layout.setLayoutCount = 1;
+    layout.pSetLayouts = &set_layouts_[i];
+    layout.pushConstantRangeCount = 1;
+    layout.pPushConstantRanges = &push;
+    if (Status s = check(vkCreatePipelineLayout(device_, &layout, nullptr, &pipeline_layouts_[i]),
+                         "vkCreatePipelineLayout");
+        !s) {
+      return s;
+    }
+    VkDescriptorSetAllocateInfo alloc{};
+    alloc.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+    alloc.descriptorPool = descriptor_pool_;
+    alloc.descriptorSetCount = 1;
+    alloc.pSetLayouts = &set_layouts_[i];
+    if (Status s =
+            check(vkAllocateDescriptorSets(device_, &alloc, &sets_[i]), "vkAllocateDescriptorSets");
+        !s) {
+      return s;
+    }
   }
 
-  // The block scan uses subgroup arithmetic where the device has it (MOTES_VULKAN_NO_SUBGROUPS=1
-  // forces the shared-memory version, so that tests cover both).
-  const char* no_subgroups = std::getenv("MOTES_VULKAN_NO_SUBGROUPS");
-  use_subgroups_ = physical_.subgroup_arithmetic &&
-                   (no_subgroups == nullptr || std::strcmp(no_subgroups, "1") != 0);
   for (std::size_t i = 0; i < kPipelineCount; ++i) {
-    std::string name = kPipelineShaders[i];
-    if (use_subgroups_ && static_cast<Pipeline>(i) == Pipeline::GridBuildScanBlock) {
-      name += "_subgroup";
-    }
-    const Shader* shader = find_shader(name);
-    if (shader == nullptr) {
-      return Status::error(fmt::format("vulkan: shader {} is not embedded in this build", name));
-    }
+    const Shader* shader = shaders[i];
     VkShaderModuleCreateInfo module_info{};
     module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
     module_info.codeSize = shader->word_count * 4;
@@ -209,7 +266,7 @@ Status VulkanDevice::create_pipelines() {
     pipe.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     pipe.stage.module = module;
     pipe.stage.pName = "main";
-    pipe.layout = pipeline_layout_;
+    pipe.layout = pipeline_layouts_[i];
     const VkResult r =
         vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipe, nullptr, &pipelines_[i]);
     vkDestroyShaderModule(device_, module, nullptr);
@@ -231,10 +288,12 @@ VulkanDevice::~VulkanDevice() {
     if (descriptor_pool_ != VK_NULL_HANDLE) {
       vkDestroyDescriptorPool(device_, descriptor_pool_, nullptr);
     }
-    if (pipeline_layout_ != VK_NULL_HANDLE) {
-      vkDestroyPipelineLayout(device_, pipeline_layout_, nullptr);
+    for (VkPipelineLayout l : pipeline_layouts_) {
+      if (l != VK_NULL_HANDLE) vkDestroyPipelineLayout(device_, l, nullptr);
     }
-    if (set_layout_ != VK_NULL_HANDLE) vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
+    for (VkDescriptorSetLayout l : set_layouts_) {
+      if (l != VK_NULL_HANDLE) vkDestroyDescriptorSetLayout(device_, l, nullptr);
+    }
     if (fence_ != VK_NULL_HANDLE) vkDestroyFence(device_, fence_, nullptr);
     if (pool_ != VK_NULL_HANDLE) vkDestroyCommandPool(device_, pool_, nullptr);
     vkDestroyDevice(device_, nullptr);
@@ -396,17 +455,25 @@ Status VulkanDevice::allocate(const Sizes& sizes) {
   allocated_ = true;
 
   std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
-  std::array<VkWriteDescriptorSet, kBindingCount> writes{};
   for (std::uint32_t i = 0; i < kBindingCount; ++i) {
     infos[i] = {buffers_[i].buffer, 0, padded(buffers_[i].data_bytes)};
-    writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    writes[i].dstSet = set_;
-    writes[i].dstBinding = i;
-    writes[i].descriptorCount = 1;
-    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[i].pBufferInfo = &infos[i];
   }
-  vkUpdateDescriptorSets(device_, kBindingCount, writes.data(), 0, nullptr);
+  std::vector<VkWriteDescriptorSet> writes;
+  for (std::size_t p = 0; p < kPipelineCount; ++p) {
+    for (std::uint32_t i = 0; i < kBindingCount; ++i) {
+      if ((used_bindings_[p] >> i & 1u) == 0) continue;
+      VkWriteDescriptorSet w{};
+      w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+      w.dstSet = sets_[p];
+      w.dstBinding = i;
+      w.descriptorCount = 1;
+      w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      w.pBufferInfo = &infos[i];
+      writes.push_back(w);
+    }
+  }
+  vkUpdateDescriptorSets(device_, static_cast<std::uint32_t>(writes.size()), writes.data(), 0,
+                         nullptr);
 
   // Zero every buffer and write the guard words after it; then the rebuild's template.
   const VkDeviceSize template_bytes = rebuild_args.size() * 4;
@@ -547,6 +614,8 @@ void VulkanDevice::particles_integrate(const shared::StepParams& p) {
 void VulkanDevice::constraints_solve(const shared::StepParams& p) {
   enqueue(Kernel::ConstraintsSolve, p);
 }
+void VulkanDevice::clusters_fit(const shared::StepParams& p) { enqueue(Kernel::ClustersFit, p); }
+void VulkanDevice::clusters_goal(const shared::StepParams& p) { enqueue(Kernel::ClustersGoal, p); }
 
 Listing list_devices() {
   Listing out;

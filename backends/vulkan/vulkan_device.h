@@ -37,6 +37,8 @@ enum class Pipeline : std::uint32_t {
   BodiesIntegrate,
   ParticlesUpdate,
   ParticlesIntegrate,
+  ClustersFit,
+  ClustersGoal,
   ConstraintsSolve,
   Count
 };
@@ -48,7 +50,7 @@ struct PushConstants {
   shared::StepParams params;
   std::uint32_t args[4];
 };
-static_assert(sizeof(PushConstants) == 96, "PushConstants layout");
+static_assert(sizeof(PushConstants) == 112, "PushConstants layout");
 
 class VulkanDevice final : public Device {
  public:
@@ -76,6 +78,8 @@ class VulkanDevice final : public Device {
   void particles_update(const shared::StepParams& p) override;
   void particles_integrate(const shared::StepParams& p) override;
   void constraints_solve(const shared::StepParams& p) override;
+  void clusters_fit(const shared::StepParams& p) override;
+  void clusters_goal(const shared::StepParams& p) override;
 
   Status synchronize() override;
   Status check_guards() override;
@@ -140,6 +144,8 @@ class VulkanDevice final : public Device {
   /// to everything, transfers and the host included (where a command buffer starts and ends).
   enum class Sync { Compute, Indirect, All };
   void barrier(VkCommandBuffer cb, Sync sync = Sync::Compute) const;
+  /// Binds a pipeline, its descriptor set and the push constants.
+  void bind(VkCommandBuffer cb, Pipeline pipeline, const PushConstants& push) const;
   void dispatch(VkCommandBuffer cb, Pipeline pipeline, const shared::StepParams& p,
                 std::uint64_t threads, std::uint32_t a0 = 0, std::uint32_t a1 = 0,
                 std::uint32_t a2 = 0, std::uint32_t a3 = 0) const;
@@ -164,6 +170,8 @@ class VulkanDevice final : public Device {
   void record_neighbours_build(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_particles_integrate(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_constraints_solve(VkCommandBuffer cb, const shared::StepParams& p) const;
+  void record_clusters_fit(VkCommandBuffer cb, const shared::StepParams& p) const;
+  void record_clusters_goal(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_contacts_compute(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_bodies_reduce(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_bodies_integrate(VkCommandBuffer cb, const shared::StepParams& p) const;
@@ -178,10 +186,13 @@ class VulkanDevice final : public Device {
   VkFence fence_ = VK_NULL_HANDLE;
   VkQueryPool queries_ = VK_NULL_HANDLE;
   std::uint32_t query_capacity_ = 0;
-  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
-  VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
+  // Per pipeline: the bindings its shader uses (bit k = binding k), and a descriptor set of
+  // only those (create_pipelines).
+  std::array<std::uint64_t, kPipelineCount> used_bindings_{};
+  std::array<VkDescriptorSetLayout, kPipelineCount> set_layouts_{};
+  std::array<VkPipelineLayout, kPipelineCount> pipeline_layouts_{};
+  std::array<VkDescriptorSet, kPipelineCount> sets_{};
   VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
-  VkDescriptorSet set_ = VK_NULL_HANDLE;
   std::array<VkPipeline, kPipelineCount> pipelines_{};
   VkPhysicalDeviceMemoryProperties memory_{};
 

@@ -69,13 +69,19 @@ void VulkanDevice::record_passes(VkCommandBuffer cb, const std::vector<Pass>& pa
       PushConstants push{};
       push.params = p;
       std::copy(pass.args, pass.args + 4, push.args);
-      vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE,
-                        pipelines_[static_cast<std::size_t>(pass.pipeline)]);
-      vkCmdPushConstants(cb, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+      bind(cb, pass.pipeline, push);
       const auto slot = static_cast<VkDeviceSize>(indirect_first) + k;
       vkCmdDispatchIndirect(cb, buffer(B_INDIRECT_ARGS), slot * 16);
     }
   }
+}
+
+void VulkanDevice::bind(VkCommandBuffer cb, Pipeline pipeline, const PushConstants& push) const {
+  const auto i = static_cast<std::size_t>(pipeline);
+  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipelines_[i]);
+  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layouts_[i], 0, 1, &sets_[i],
+                          0, nullptr);
+  vkCmdPushConstants(cb, pipeline_layouts_[i], VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
 }
 
 void VulkanDevice::dispatch_groups(VkCommandBuffer cb, Pipeline pipeline,
@@ -85,9 +91,7 @@ void VulkanDevice::dispatch_groups(VkCommandBuffer cb, Pipeline pipeline,
   PushConstants push{};
   push.params = p;
   std::copy(args, args + 4, push.args);
-  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE,
-                    pipelines_[static_cast<std::size_t>(pipeline)]);
-  vkCmdPushConstants(cb, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+  bind(cb, pipeline, push);
   // More than 65,535 workgroups (the smallest limit Vulkan allows per dimension) go as a 2D grid;
   // shaders flatten it (kernel_common.glsl: flat_group) and skip the padding groups.
   const std::array<std::uint32_t, 3> grid = group_grid(groups);
@@ -135,8 +139,6 @@ Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool ti
   if (!began) return began;
   VkCommandBuffer cb = began.value();
   if (timing) vkCmdResetQueryPool(cb, queries_, 0, timestamps_for(ops));
-  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set_, 0,
-                          nullptr);
   barrier(cb, Sync::All);
   std::uint32_t q = 0;
   for (std::size_t i = 0; i < ops.size(); ++i) {
@@ -170,6 +172,12 @@ Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool ti
         break;
       case Kernel::ParticlesIntegrate:
         record_particles_integrate(cb, p);
+        break;
+      case Kernel::ClustersFit:
+        record_clusters_fit(cb, p);
+        break;
+      case Kernel::ClustersGoal:
+        record_clusters_goal(cb, p);
         break;
       case Kernel::ConstraintsSolve:
         record_constraints_solve(cb, p);

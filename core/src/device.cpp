@@ -4,6 +4,7 @@
 #include <bit>
 
 #include "shared/links.h"
+#include "shared/shape_matching.h"
 
 namespace motes {
 
@@ -63,6 +64,14 @@ const char* buffer_name(Buffer b) {
       return "Planes";
     case Buffer::Constraints:
       return "Constraints";
+    case Buffer::Clusters:
+      return "Clusters";
+    case Buffer::ClusterMembers:
+      return "ClusterMembers";
+    case Buffer::ClusterFrames:
+      return "ClusterFrames";
+    case Buffer::ClusterGather:
+      return "ClusterGather";
     case Buffer::Count:
       break;
   }
@@ -87,6 +96,10 @@ const char* kernel_name(Kernel k) {
       return "particles_update";
     case Kernel::ParticlesIntegrate:
       return "particles_integrate";
+    case Kernel::ClustersFit:
+      return "clusters_fit";
+    case Kernel::ClustersGoal:
+      return "clusters_goal";
     case Kernel::ConstraintsSolve:
       return "constraints_solve";
     case Kernel::Count:
@@ -137,6 +150,14 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
       return {sizeof(shared::PlaneData), s.planes};
     case Buffer::Constraints:
       return {sizeof(shared::Constraint), s.constraints};
+    case Buffer::Clusters:
+      return {sizeof(shared::Cluster), s.clusters};
+    case Buffer::ClusterMembers:
+      return {sizeof(shared::ClusterMember), s.cluster_members};
+    case Buffer::ClusterFrames:
+      return {sizeof(shared::ClusterFrame), s.clusters};
+    case Buffer::ClusterGather:
+      return {kUint, s.clusters > 0 ? std::size_t{s.soft_particles} + 1 + s.cluster_members : 0};
     case Buffer::Count:
       break;
   }

@@ -54,6 +54,46 @@ Repeat read_repeat(const Node& node, std::int64_t max_copies) {
   return r;
 }
 
+/// The "soft" object of a soft body (docs/scene-format.md, "Soft bodies").
+SoftSpec read_soft(const Node& node) {
+  node.expect_object({"stiffness", "frequency", "damping", "mode", "beta", "clusters"});
+  SoftSpec soft;
+  if (node.has("stiffness") && node.has("frequency")) {
+    node.at("frequency").fail("give \"stiffness\" (per substep) or \"frequency\" (Hz), not both");
+  }
+  if (auto a = node.find("stiffness")) {
+    soft.stiffness = a->number(Sign::Positive);
+    if (soft.stiffness > 1.0) a->fail("the stiffness is a fraction per substep, in (0, 1]");
+  }
+  if (auto f = node.find("frequency")) soft.frequency = f->number(Sign::Positive);
+  if (auto d = node.find("damping")) soft.damping = d->number(Sign::NonNegative);
+  if (auto m = node.find("mode")) {
+    const std::string mode = m->string();
+    if (mode == "rigid") {
+      soft.mode = SoftMode::Rigid;
+    } else if (mode == "linear") {
+      soft.mode = SoftMode::Linear;
+    } else if (mode == "quadratic") {
+      soft.mode = SoftMode::Quadratic;
+    } else {
+      m->fail(fmt::format("must be \"rigid\", \"linear\" or \"quadratic\", got \"{}\"", mode));
+    }
+  }
+  if (auto b = node.find("beta")) {
+    soft.beta = b->number(Sign::NonNegative);
+    if (soft.beta > 1.0) b->fail("beta blends the fitted deformation in: it must be in [0, 1]");
+    if (soft.mode == SoftMode::Rigid && soft.beta > 0.0) {
+      b->fail("beta needs \"mode\": \"linear\" or \"quadratic\" (a rigid goal has no fit)");
+    }
+  }
+  if (auto c = node.find("clusters")) {
+    const auto cells = c->int3(1, 64);
+    soft.clusters = {static_cast<int>(cells[0]), static_cast<int>(cells[1]),
+                     static_cast<int>(cells[2])};
+  }
+  return soft;
+}
+
 Eigen::Vector3d read_vector_or_zero(const Node& body, std::string_view key) {
   if (auto v = body.find(key)) return v->vec3();
   return Eigen::Vector3d::Zero();
@@ -139,17 +179,23 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
       continue;
     }
     body.expect_object({"name", "kind", "shape", "material", "position", "rotation", "velocity",
-                        "angular_velocity", "repeat", "color"});
+                        "angular_velocity", "repeat", "color", "soft"});
     BodySpec spec;
     spec.name = body.has("name") ? body.at("name").string() : fmt::format("body{}", i);
     if (auto kind = body.find("kind")) {
       const std::string k = kind->string();
       if (k == "static") {
         spec.kind = BodyKind::Static;
+      } else if (k == "soft") {
+        spec.soft = SoftSpec{};
       } else if (k != "dynamic") {
-        kind->fail(
-            fmt::format("must be \"dynamic\", \"static\", \"cloth\" or \"rope\", got \"{}\"", k));
+        kind->fail(fmt::format(
+            "must be \"dynamic\", \"static\", \"soft\", \"cloth\" or \"rope\", got \"{}\"", k));
       }
+    }
+    if (auto soft = body.find("soft")) {
+      if (!spec.soft) soft->fail("\"soft\" settings need \"kind\": \"soft\"");
+      spec.soft = read_soft(*soft);
     }
     if (auto color = body.find("color")) spec.color = read_color(*color);
     spec.material = body.has("material") ? find_material(body.at("material"), scene.materials) : 0;

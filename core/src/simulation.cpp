@@ -7,9 +7,11 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numbers>
 
 #include "contact_laws.h"
 #include "motes/cloth.h"
+#include "motes/soft.h"
 #include "shared/body_math.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
@@ -69,9 +71,10 @@ Status Simulation::upload(const Scene& scene) {
   std::uint64_t n = 0;
   std::uint64_t rigid_particles = 0;
   std::uint64_t rigid_bodies = 0;
+  std::uint64_t soft_particles = 0;
   double max_diameter = 0.0;
   const auto is_free_sphere = [](const BodySpec& b) {
-    return b.kind == BodyKind::Dynamic && b.shape->points.size() == 1 &&
+    return b.kind == BodyKind::Dynamic && !b.soft && b.shape->points.size() == 1 &&
            b.angular_velocity.isZero(0.0);
   };
   for (const BodySpec& b : scene.bodies) {
@@ -79,7 +82,15 @@ Status Simulation::upload(const Scene& scene) {
       return Status::error(fmt::format("{}: body '{}' has no particles", scene.source, b.name));
     }
     n += b.shape->points.size();
-    if (!is_free_sphere(b)) {
+    if (b.soft) {
+      if (b.kind != BodyKind::Dynamic) {
+        return Status::error(
+            fmt::format("{}: body '{}' is static and soft: a static body is "
+                        "rigid (remove \"soft\" or make it dynamic)",
+                        scene.source, b.name));
+      }
+      soft_particles += b.shape->points.size();
+    } else if (!is_free_sphere(b)) {
       rigid_particles += b.shape->points.size();
       ++rigid_bodies;
     }
@@ -125,20 +136,26 @@ Status Simulation::upload(const Scene& scene) {
         scene.source, settings_.constraint_iterations, settings_.link_damping));
   }
 
+  sizes_.soft_particles = static_cast<std::uint32_t>(soft_particles);
   Device& d = *device_;
-  // Device memory: refuse before allocating anything, with both numbers.
-  const std::uint64_t need = d.required_bytes(sizes_);
-  const std::uint64_t have = d.available_bytes();
-  if (need > have) {
-    const double per_particle =
-        static_cast<double>(need) / static_cast<double>(std::max<std::uint64_t>(n, 1));
-    return Status::error(fmt::format(
-        "{}: {} particles need {:.2f} GiB on {} device {} ({}), which has {:.2f} GiB available; "
-        "at {:.0f} bytes per particle about {} particles fit",
-        scene.source, n, static_cast<double>(need) / 1073741824.0, d.info().backend, d.info().index,
-        d.info().name, static_cast<double>(have) / 1073741824.0, per_particle,
-        static_cast<std::uint64_t>(static_cast<double>(have) / per_particle)));
-  }
+  // Device memory: refuse before allocating anything, with both numbers (again once the clusters
+  // are known, before the device allocates).
+  const auto check_memory = [&]() -> Status {
+    const std::uint64_t need = d.required_bytes(sizes_);
+    const std::uint64_t have = d.available_bytes();
+    if (need > have) {
+      const double per_particle =
+          static_cast<double>(need) / static_cast<double>(std::max<std::uint64_t>(n, 1));
+      return Status::error(fmt::format(
+          "{}: {} particles need {:.2f} GiB on {} device {} ({}), which has {:.2f} GiB available; "
+          "at {:.0f} bytes per particle about {} particles fit",
+          scene.source, n, static_cast<double>(need) / 1073741824.0, d.info().backend,
+          d.info().index, d.info().name, static_cast<double>(have) / 1073741824.0, per_particle,
+          static_cast<std::uint64_t>(static_cast<double>(have) / per_particle)));
+    }
+    return Status::ok();
+  };
+  if (Status st = check_memory(); !st) return st;
 
   std::vector<vec4> ppos, pvel, plocal, bpos, bquat, bvel, bangmom, bangvel, binertia;
   std::vector<std::uint32_t> pbody, pmat;
@@ -161,8 +178,13 @@ Status Simulation::upload(const Scene& scene) {
   int last_material = -1;
   MassProperties mp;
   std::uint32_t scene_particle = 0;
-  std::uint32_t next_rigid = 0;                                  // device particles
-  auto next_free = static_cast<std::uint32_t>(rigid_particles);  // device particles
+  // Device particles: rigid [0, Nr), free spheres [Nr, Ns), soft [Ns, Nl), linked [Nl, N).
+  std::uint32_t next_rigid = 0;
+  auto next_free = static_cast<std::uint32_t>(rigid_particles);
+  const auto soft_first = static_cast<std::uint32_t>(body_particles - soft_particles);
+  std::uint32_t next_soft = soft_first;
+  std::uint32_t soft_bodies = 0;
+  SoftClusters soft;
   for (std::size_t bi = 0; bi < scene.bodies.size(); ++bi) {
     const BodySpec& spec = scene.bodies[bi];
     if (spec.material < 0 || static_cast<std::size_t>(spec.material) >= scene.materials.size()) {
@@ -196,11 +218,43 @@ Status Simulation::upload(const Scene& scene) {
     info.first_particle = scene_particle;
     info.particle_count = static_cast<std::uint32_t>(spec.shape->points.size());
     info.free_sphere = free;
+    info.soft = spec.soft.has_value();
     bodies_.push_back(info);
     scene_particle += info.particle_count;
 
     const double radius = 0.5 * spec.shape->diameter;
     const double inv_pm = dynamic ? 1.0 / mp.particle_mass : 0.0;
+    if (spec.soft) {
+      // Free particles of one body (no contact among themselves), pulled to their clusters' goals.
+      device_index_[bi] = next_soft;
+      std::vector<Eigen::Vector3d> world;
+      world.reserve(spec.shape->points.size());
+      const std::uint32_t body_word =
+          sizes_.bodies + (soft_first - sizes_.rigid_particles) + soft_bodies++;
+      for (const Eigen::Vector3f& pt : spec.shape->points) {
+        const Eigen::Vector3d offset = rot * (to_body * (pt.cast<double>() - mp.center));
+        const std::uint32_t i = next_soft++;
+        world.push_back(spec.position + offset);
+        ppos[i] = to_vec4(world.back(), radius);
+        pvel[i] = to_vec4(vel + spec.angular_velocity.cross(offset), inv_pm);
+        pbody[i] = body_word;
+        pmat[i] = static_cast<std::uint32_t>(spec.material);
+      }
+      SoftSpec soft_spec = *spec.soft;
+      if (soft_spec.frequency > 0.0) {
+        const double turn = 2.0 * std::numbers::pi * soft_spec.frequency * settings_.dt /
+                            static_cast<double>(settings_.substeps);
+        soft_spec.stiffness = std::min(1.0, turn * turn);
+      }
+      if (Status st = add_soft_body(soft_spec, world, mp.particle_mass,
+                                    settings_.dt / static_cast<double>(settings_.substeps),
+                                    device_index_[bi], soft);
+          !st) {
+        return Status::error(
+            fmt::format("{}: body '{}': {}", scene.source, spec.name, st.message()));
+      }
+      continue;
+    }
     if (free) {
       // The particle is the body: its state is the body's; it never turns.
       const std::uint32_t i = next_free++;
@@ -305,6 +359,10 @@ Status Simulation::upload(const Scene& scene) {
   }
   ConstraintColouring colouring = colour_constraints(constraints, sizes_.particles);
   colour_first_ = colouring.first;
+  const std::vector<std::uint32_t> gather =
+      soft.clusters.empty() ? std::vector<std::uint32_t>{} : cluster_gather(soft);
+  std::vector<shared::ClusterFrame> frames(soft.clusters.size());
+  for (shared::ClusterFrame& f : frames) f.rotation = vec4(0.0f, 0.0f, 0.0f, 1.0f);
 
   std::vector<shared::PlaneData> planes;
   for (const PlaneSpec& pl : scene.planes) {
@@ -331,9 +389,14 @@ Status Simulation::upload(const Scene& scene) {
   params_.neighbour_capacity = sizes_.neighbour_capacity;
   params_.neighbour_skin = static_cast<float>(skin);
   params_.linked_first = linked_first;
+  params_.soft_first = soft_first;
+  params_.cluster_count = static_cast<std::uint32_t>(soft.clusters.size());
   params_.linked_damping =
       static_cast<float>(-std::expm1(-settings_.link_damping * settings_.dt / settings_.substeps));
 
+  sizes_.clusters = static_cast<std::uint32_t>(soft.clusters.size());
+  sizes_.cluster_members = static_cast<std::uint32_t>(soft.members.size());
+  if (Status st = check_memory(); !st) return st;
   const std::uint32_t neighbour_state[4] = {1u, 0u, 0u, 0u};  // build at the first step
   Status s = d.allocate(sizes_);
   if (s) s = write_vector(d, Buffer::ParticlePos, ppos);
@@ -354,6 +417,10 @@ Status Simulation::upload(const Scene& scene) {
   if (s) s = write_vector(d, Buffer::ContactLaws, laws);
   if (s) s = write_vector(d, Buffer::Planes, planes);
   if (s) s = write_vector(d, Buffer::Constraints, colouring.constraints);
+  if (s) s = write_vector(d, Buffer::Clusters, soft.clusters);
+  if (s) s = write_vector(d, Buffer::ClusterMembers, soft.members);
+  if (s) s = write_vector(d, Buffer::ClusterFrames, frames);
+  if (s) s = write_vector(d, Buffer::ClusterGather, gather);
   if (!s) return s;
   // Rigid particles take their pose from the bodies with the device's own arithmetic.
   if (sizes_.rigid_particles > 0) d.particles_update(params_);
@@ -374,6 +441,10 @@ Status Simulation::step(std::uint64_t count) {
         d.particles_update(params_);
       }
       if (free) d.particles_integrate(params_);
+      if (params_.cluster_count > 0) {
+        d.clusters_fit(params_);
+        d.clusters_goal(params_);
+      }
       for (int it = 0; it < settings_.constraint_iterations && colour_first_.size() > 1; ++it) {
         for (std::size_t c = 0; c + 1 < colour_first_.size(); ++c) {
           shared::StepParams colour = params_;
@@ -401,9 +472,13 @@ Result<Snapshot> Simulation::snapshot() {
   if (st) st = read_vector(d, Buffer::BodyVel, bvel, nb);
   if (st) st = read_vector(d, Buffer::BodyAngMom, bangmom, nb);
   if (st) st = read_vector(d, Buffer::BodyAngVel, bangvel, nb);
+  std::vector<shared::ClusterFrame> frames;
+  if (st) st = read_vector(d, Buffer::ClusterFrames, frames, sizes_.clusters);
   if (!st) return st;
 
   Snapshot s;
+  s.cluster_rotation.reserve(frames.size());
+  for (const shared::ClusterFrame& f : frames) s.cluster_rotation.push_back(f.rotation);
   s.time = time_;
   s.step = steps_;
   const std::size_t scene_bodies = bodies_.size();
@@ -418,13 +493,14 @@ Result<Snapshot> Simulation::snapshot() {
   for (std::size_t b = 0; b < scene_bodies; ++b) {
     const BodyInfo& info = bodies_[b];
     const std::uint32_t at = device_index_[b];
-    const std::uint32_t first = info.free_sphere || info.linked ? at : rigid_first_[at];
+    const std::uint32_t first =
+        info.free_sphere || info.linked || info.soft ? at : rigid_first_[at];
     for (std::uint32_t k = 0; k < info.particle_count; ++k) {
       s.particle_pos[info.first_particle + k] = ppos[first + k];
       s.particle_vel[info.first_particle + k] = pvel[first + k];
       s.particle_body[info.first_particle + k] = static_cast<std::uint32_t>(b);
     }
-    if (info.linked) {  // the mean of its particles, in double
+    if (info.linked || info.soft) {  // the mean of its particles, in double
       Eigen::Vector3d x = Eigen::Vector3d::Zero();
       Eigen::Vector3d v = Eigen::Vector3d::Zero();
       for (std::uint32_t k = 0; k < info.particle_count; ++k) {
@@ -467,12 +543,13 @@ Status Simulation::restore(const Snapshot& state) {
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     const BodyInfo& info = bodies_[b];
     const std::uint32_t at = device_index_[b];
-    const std::uint32_t first = info.free_sphere || info.linked ? at : rigid_first_[at];
+    const std::uint32_t first =
+        info.free_sphere || info.linked || info.soft ? at : rigid_first_[at];
     for (std::uint32_t k = 0; k < info.particle_count; ++k) {
       ppos[first + k] = state.particle_pos[info.first_particle + k];
       pvel[first + k] = state.particle_vel[info.first_particle + k];
     }
-    if (info.free_sphere || info.linked) continue;
+    if (info.free_sphere || info.linked || info.soft) continue;
     bpos[at] = state.body_pos[b];
     bquat[at] = state.body_quat[b];
     bvel[at] = state.body_vel[b];
@@ -488,6 +565,14 @@ Status Simulation::restore(const Snapshot& state) {
   if (s) s = write_vector(d, Buffer::BodyAngMom, bangmom);
   if (s) s = write_vector(d, Buffer::BodyAngVel, bangvel);
   if (s) s = d.write(Buffer::NeighbourState, neighbour_state, sizeof neighbour_state);
+  if (s && state.cluster_rotation.size() == sizes_.clusters && sizes_.clusters > 0) {
+    std::vector<shared::ClusterFrame> frames;
+    s = read_vector(d, Buffer::ClusterFrames, frames, sizes_.clusters);
+    for (std::size_t k = 0; s && k < frames.size(); ++k) {
+      frames[k].rotation = state.cluster_rotation[k];
+    }
+    if (s) s = write_vector(d, Buffer::ClusterFrames, frames);
+  }
   if (!s) return s;
   return d.synchronize();
 }
@@ -525,11 +610,18 @@ Status Simulation::set_body_velocities(const std::vector<Eigen::Vector3d>& veloc
   for (std::size_t b = 0; b < count; ++b) {
     const BodyInfo& info = bodies_[b];
     const vec4 v = to_vec4(velocity[b], 0.0);
-    if (info.free_sphere || info.linked) {  // every particle that is not pinned
+    if (info.free_sphere || info.linked || info.soft) {  // every particle that is not pinned
+      // A soft body turns about the mean of its particles: v + w x (x - mean).
+      const vec4 mean = state.body_pos[b];
+      const Eigen::Vector3d w =
+          info.soft && !angular.empty() ? angular[b] : Eigen::Vector3d::Zero();
       for (std::uint32_t k = info.first_particle; k < info.first_particle + info.particle_count;
            ++k) {
         const vec4 old = state.particle_vel[k];
-        if (old.w != 0.0f) state.particle_vel[k] = vec4(v.x, v.y, v.z, old.w);
+        const vec4 x = state.particle_pos[k];
+        const Eigen::Vector3d r(x.x - mean.x, x.y - mean.y, x.z - mean.z);
+        const vec4 spin = to_vec4(velocity[b] + w.cross(r), 0.0);
+        if (old.w != 0.0f) state.particle_vel[k] = vec4(spin.x, spin.y, spin.z, old.w);
       }
       continue;
     }

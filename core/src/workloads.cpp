@@ -1,4 +1,5 @@
-// Benchmark workloads W1 "settle", W2 "dominoes" and W3 "cloth" (docs/benchmarks.md).
+// Benchmark workloads W1 "settle", W2 "dominoes", W3 "cloth" and W4 "soft"
+// (docs/benchmarks.md).
 #include "motes/workloads.h"
 
 #include <array>
@@ -253,6 +254,37 @@ Scene cloth_workload(int side) {
   c.name = "cloth";
   c.pinned = {0u, static_cast<std::uint32_t>(side - 1)};
   scene.linked.push_back(std::move(c));
+  scene.planes.push_back(plane("floor", {0, 1, 0}, {0, 0, 0}));
+  return scene;
+}
+
+Scene soft_workload(int count) {
+  constexpr double d = 0.01;
+  Scene scene;
+  scene.source = fmt::format("<soft workload {} cubes>", count);
+  scene.settings.dt = 1e-4;
+  scene.settings.particle_diameter = d;
+  scene.settings.duration = 1.0;
+  add_material(scene, "rubber", 1100.0, 500.0, 200.0);
+  Result<ParticleSet> box = box_lattice(Eigen::Vector3i(7, 7, 8), d);
+  if (!box) return scene;
+  const auto shape = std::make_shared<const ParticleSet>(std::move(box).value());
+  SoftSpec soft;
+  soft.frequency = 20.0;
+  soft.damping = 40.0;
+  soft.mode = SoftMode::Linear;
+  soft.beta = 0.3;
+  const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(count))));
+  for (int k = 0; k < count; ++k) {
+    BodySpec b;
+    b.name = fmt::format("cube{}", k);
+    b.shape = shape;
+    b.material = 0;
+    b.soft = soft;
+    b.position = {0.12 * (k % side), 0.1, 0.12 * (k / side)};
+    b.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * (k % 7), Eigen::Vector3d::UnitY()));
+    scene.bodies.push_back(std::move(b));
+  }
   scene.planes.push_back(plane("floor", {0, 1, 0}, {0, 0, 0}));
   return scene;
 }

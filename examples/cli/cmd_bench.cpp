@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -37,6 +38,8 @@ struct BenchOptions {
   std::uint64_t domino_steps = 2000;
   std::vector<int> cloth_sides = {256};
   std::uint64_t cloth_steps = 1000;
+  std::vector<int> soft_counts = {1000};
+  std::uint64_t soft_steps = 200;
   std::string cache = "bench-cache";
   std::string dense_from;  // LAMMPS data file: the dense phase starts from LAMMPS's settled state
   std::string json_path;
@@ -48,10 +51,11 @@ struct Measurement {
   std::uint32_t rigid_particles = 0, rigid_bodies = 0;
   std::uint32_t table = 0;
   std::uint64_t constraint_sweeps = 0;  // constraints projected per step (C x iterations)
-  std::uint64_t steps = 0;              // per timed repeat
-  std::vector<double> seconds;          // per repeat, kernel timing off
-  std::uint64_t kernel_steps = 0;       // of the run with kernel timing on
-  motes::KernelTimes kernels;           // of that run
+  std::uint32_t soft_particles = 0, clusters = 0, cluster_members = 0;
+  std::uint64_t steps = 0;         // per timed repeat
+  std::vector<double> seconds;     // per repeat, kernel timing off
+  std::uint64_t kernel_steps = 0;  // of the run with kernel timing on
+  motes::KernelTimes kernels;      // of that run
   std::string backend, device, detail;
   std::uint64_t device_bytes = 0;    // what the simulation holds on the device
   motes::NeighbourStats neighbours;  // after the first timed repeat
@@ -107,6 +111,9 @@ Measurement measure(const motes::Scene& scene, const BenchOptions& o, std::uint6
       m.rigid_particles = sim->sizes().rigid_particles;
       m.rigid_bodies = sim->sizes().bodies;
       m.table = sim->sizes().table;
+      m.soft_particles = sim->sizes().soft_particles;
+      m.clusters = sim->sizes().clusters;
+      m.cluster_members = sim->sizes().cluster_members;
       m.constraint_sweeps = std::uint64_t{sim->sizes().constraints} *
                             static_cast<std::uint64_t>(sim->settings().constraint_iterations) *
                             static_cast<std::uint64_t>(sim->settings().substeps);
@@ -156,6 +163,12 @@ double compulsory_bytes(motes::Kernel k, const Measurement& m) {
       return (4 + 16 + 48) * nr + 64 * b + 32 * nr;
     case motes::Kernel::ParticlesIntegrate:  // read pos, vel, force, ref; write pos, vel
       return 96 * nf;
+    case motes::Kernel::ClustersFit:  // read each cluster, its members and their pos; write frames
+      return (368.0 + 272.0) * m.clusters + (48.0 + 32.0) * m.cluster_members;
+    case motes::Kernel::ClustersGoal:  // read pos, vel, ref, gather offset per soft particle, a
+                                       // gather id and member per membership, each frame once;
+                                       // write pos, vel
+      return (52.0 + 32.0) * m.soft_particles + 52.0 * m.cluster_members + 272.0 * m.clusters;
     case motes::Kernel::ConstraintsSolve:  // per projection: read the constraint, both
                                            // particles' pos, vel, ref; write their pos, vel
       return (16.0 + 96.0 + 64.0) * static_cast<double>(m.constraint_sweeps);
@@ -263,8 +276,14 @@ void print_row(const Measurement& m) {
 
 void run_bench(const BenchOptions& o) {
   if (o.workload != "all" && o.workload != "settle" && o.workload != "dominoes" &&
-      o.workload != "cloth") {
-    fail(fmt::format("--workload must be settle, dominoes, cloth or all, got '{}'", o.workload));
+      o.workload != "cloth" && o.workload != "soft") {
+    fail(fmt::format("--workload must be settle, dominoes, cloth, soft or all, got '{}'",
+                     o.workload));
+  }
+  for (const int count : o.soft_counts) {
+    if (count < 1 || count > 100000) {
+      fail(fmt::format("--soft-counts: {} is not from 1 to 100000 cubes", count));
+    }
   }
   for (const int side : o.cloth_sides) {
     if (side < 2 || side > 1024) {
@@ -292,9 +311,10 @@ void run_bench(const BenchOptions& o) {
         o.repeats);
   }
   // Column labels of the kernel families, in motes::Kernel order (JSON has the full names).
-  constexpr const char* kLabels[motes::kKernelCount] = {"nb_upd",   "grid",     "nb_build",
-                                                        "contacts", "b_reduce", "b_integr",
-                                                        "p_update", "p_integr", "constr"};
+  constexpr std::array kLabels = {"nb_upd",   "grid",     "nb_build", "contacts",
+                                  "b_reduce", "b_integr", "p_update", "p_integr",
+                                  "cl_fit",   "cl_goal",  "constr"};
+  static_assert(kLabels.size() == motes::kKernelCount, "a label per kernel family");
   std::string ks;
   for (const char* label : kLabels) ks += fmt::format(" {:>8}", label);
   fmt::print(
@@ -375,6 +395,18 @@ void run_bench(const BenchOptions& o) {
       });
     }
   }
+  if (o.workload == "soft") {
+    for (const int count : o.soft_counts) {
+      attempt([&] {
+        const motes::Scene scene = motes::soft_workload(count);
+        Measurement m = measure(scene, o, o.soft_steps, [](motes::Simulation&) {});
+        m.workload = "soft";
+        m.phase = "falling";
+        print_row(m);
+        results.push_back(to_json(m));
+      });
+    }
+  }
   if (!o.json_path.empty()) {
     std::ofstream out(o.json_path);
     out << results.dump(2) << "\n";
@@ -390,9 +422,10 @@ void add_bench_command(CLI::App& app) {
   auto opts = std::make_shared<BenchOptions>();
   CLI::App* cmd = app.add_subcommand(
       "bench",
-      "Run the fixed benchmark workloads (docs/benchmarks.md): W1 settle, W2 dominoes, W3 cloth");
+      "Run the fixed benchmark workloads (docs/benchmarks.md): W1 settle, W2 dominoes, W3 cloth, "
+      "W4 soft");
   cmd->add_option("--workload", opts->workload,
-                  "settle, dominoes, all (settle and dominoes) or cloth")
+                  "settle, dominoes, all (settle and dominoes), cloth or soft")
       ->capture_default_str();
   cmd->add_option("--cloth-sides", opts->cloth_sides,
                   "W3: cloth sides in particles (a side x side cloth each)")
@@ -400,6 +433,13 @@ void add_bench_command(CLI::App& app) {
       ->check(whole_number(2))
       ->capture_default_str();
   cmd->add_option("--cloth-steps", opts->cloth_steps, "W3: steps timed")
+      ->check(whole_number(1))
+      ->capture_default_str();
+  cmd->add_option("--soft-counts", opts->soft_counts, "W4: numbers of soft cubes (392 particles)")
+      ->delimiter(',')
+      ->check(whole_number(1))
+      ->capture_default_str();
+  cmd->add_option("--soft-steps", opts->soft_steps, "W4: steps timed")
       ->check(whole_number(1))
       ->capture_default_str();
   cmd->add_option("--sizes", opts->sizes, "W1 particle counts")

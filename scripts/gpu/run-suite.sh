@@ -10,11 +10,12 @@
 #   MOTES_BENCH_RUNS="cuda:falling cuda:dominoes cuda:dense vulkan:falling ..."   what is measured
 #     (also BACKEND:huge: W1 at 67 M and 134 M particles, one short repeat; BACKEND:dominoes-1m:
 #     W2 with 1,000,000 dominoes; BACKEND:cloth: W3 at 256 x 256 and 1024 x 1024;
+#     BACKEND:soft: W4 with 1,000 and 10,000 soft cubes;
 #     openmp:scaling: W1 at 1 M on 1, 2, 4, 8 and 16 threads)
 #   MOTES_GPU_SIZES, MOTES_GPU_DENSE_SIZES   W1 sizes of the falling and dense phases
 #   MOTES_SANITIZE_TOOLS="memcheck racecheck"   compute-sanitizer tools
 #   LIMIT_CONFORMANCE, LIMIT_SANITIZE, LIMIT_FALLING, LIMIT_DENSE, LIMIT_DOMINOES, LIMIT_HUGE,
-#   LIMIT_SCALING, LIMIT_CLOTH   seconds
+#   LIMIT_SCALING, LIMIT_CLOTH, LIMIT_SOFT   seconds
 set -uo pipefail
 parts=${*:-all}
 out=${OUT:-gpu-out}
@@ -84,6 +85,9 @@ if want bench; then
       cloth)
         part "${LIMIT_CLOTH:-120}" bench motes bench --backend "$backend" --workload cloth \
           --cloth-sides 256,1024 --json "$j" ;;
+      soft)
+        part "${LIMIT_SOFT:-120}" bench motes bench --backend "$backend" --workload soft \
+          --soft-counts 1000,10000 --json "$j" ;;
       dominoes-1m)
         part "${LIMIT_DOMINOES:-60}" bench motes bench --backend "$backend" --workload dominoes \
           --dominoes 1000000 --domino-rows 1000 --json "$j" ;;

@@ -28,7 +28,10 @@ struct StepParams {
   float linked_damping;       // fraction of their velocity the linked particles lose per substep
   uint constraint_first;      // constraints_solve: the colour's first constraint
   uint constraint_count;      // constraints_solve: its number of constraints
-  uint reserved;              // 0
+  uint soft_first;            // Ns: particles [Ns, Nl) are soft-body particles (shape matching)
+  uint cluster_count;         // S: shape-matching clusters (shared/shape_matching.h)
+  uint reserved0;             // 0
+  uint reserved1;             // 0
 };
 
 /// Contact law of one pair of materials (symmetric): F_n = k d - gamma_n m* v_n,
@@ -52,11 +55,12 @@ struct PlaneData {
 MOTES_SHARED_END
 
 #ifdef __cplusplus
-static_assert(sizeof(motes::shared::StepParams) == 80, "StepParams layout");
+static_assert(sizeof(motes::shared::StepParams) == 96, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, particle_count) == 16, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, flags) == 44, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, neighbour_skin) == 56, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, constraint_count) == 72, "StepParams layout");
+static_assert(offsetof(motes::shared::StepParams, cluster_count) == 80, "StepParams layout");
 static_assert(sizeof(motes::shared::ContactLaw) == 16, "ContactLaw layout");
 static_assert(sizeof(motes::shared::PlaneData) == 32, "PlaneData layout");
 #endif

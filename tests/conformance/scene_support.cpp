@@ -66,6 +66,7 @@ motes::Status read_state(motes::Simulation& sim, DynamicState& out) {
   if (s) s = read_all(sim, motes::Buffer::BodyVel, out.body_vel);
   if (s) s = read_all(sim, motes::Buffer::BodyAngMom, out.body_angmom);
   if (s) s = read_all(sim, motes::Buffer::BodyAngVel, out.body_angvel);
+  if (s) s = read_all(sim, motes::Buffer::ClusterFrames, out.cluster_frames);
   return s;
 }
 
@@ -77,6 +78,7 @@ motes::Status write_state(motes::Simulation& sim, const DynamicState& state) {
   if (s) s = write_all(sim, motes::Buffer::BodyVel, state.body_vel);
   if (s) s = write_all(sim, motes::Buffer::BodyAngMom, state.body_angmom);
   if (s) s = write_all(sim, motes::Buffer::BodyAngVel, state.body_angvel);
+  if (s) s = write_all(sim, motes::Buffer::ClusterFrames, state.cluster_frames);
   return s;
 }
 
@@ -84,6 +86,10 @@ void OracleRun::step(std::uint64_t steps) {
   for (std::uint64_t k = 0; k < steps; ++k) {
     for (int sub = 0; sub < substeps; ++sub) {
       motes_ref::step(particles, bodies, laws, planes, params);
+      if (!clusters.empty()) {
+        motes_ref::clusters_fit(particles.pos, particles.vel, clusters, members, frames);
+        motes_ref::clusters_goal(particles, members, frames, params);
+      }
       for (int it = 0; it < iterations; ++it) {
         for (std::size_t c = 0; c + 1 < colour_first.size(); ++c) {
           StepParams colour = params;
@@ -112,6 +118,9 @@ motes::Status capture(motes::Simulation& sim, OracleRun& out) {
   if (s) s = read_all(sim, motes::Buffer::ContactLaws, out.laws);
   if (s) s = read_all(sim, motes::Buffer::Planes, out.planes);
   if (s) s = read_all(sim, motes::Buffer::Constraints, out.constraints);
+  if (s) s = read_all(sim, motes::Buffer::Clusters, out.clusters);
+  if (s) s = read_all(sim, motes::Buffer::ClusterMembers, out.members);
+  if (s) s = read_all(sim, motes::Buffer::ClusterFrames, out.frames);
   out.colour_first = sim.constraint_colours();
   out.iterations = sim.settings().constraint_iterations;
   out.particles.rigid = sim.sizes().rigid_particles;

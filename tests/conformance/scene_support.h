@@ -31,6 +31,7 @@ motes::Result<std::unique_ptr<motes::Simulation>> simulate(const motes::Scene& s
 struct DynamicState {
   std::vector<vec4> particle_pos, particle_vel;
   std::vector<vec4> body_pos, body_quat, body_vel, body_angmom, body_angvel;
+  std::vector<motes_ref::ClusterFrame> cluster_frames;  ///< soft bodies: the rotations start fits
 };
 motes::Status read_state(motes::Simulation& sim, DynamicState& out);
 motes::Status write_state(motes::Simulation& sim, const DynamicState& state);
@@ -47,8 +48,13 @@ struct OracleRun {
   std::vector<motes_ref::Constraint> constraints;
   std::vector<uint> colour_first;
   int iterations = 0;
+  /// Soft bodies: clusters, members and the last fit.
+  std::vector<motes_ref::Cluster> clusters;
+  std::vector<motes_ref::ClusterMember> members;
+  std::vector<motes_ref::ClusterFrame> frames;
   /// Advances `steps` steps with motes_ref::step (each settings.substeps substeps), then the
-  /// constraints colour by colour (motes_ref::constraints_solve), as Simulation::step does.
+  /// soft bodies' clusters (motes_ref::clusters_fit, clusters_goal) and the constraints colour by
+  /// colour (motes_ref::constraints_solve), as Simulation::step does.
   void step(std::uint64_t steps);
 };
 motes::Status capture(motes::Simulation& sim, OracleRun& out);

@@ -231,6 +231,64 @@ bool constraints_solve(Particles& particles, const std::vector<Constraint>& cons
   return moved;
 }
 
+void clusters_fit(const std::vector<vec4>& pos, const std::vector<vec4>& vel,
+                  const std::vector<Cluster>& clusters, const std::vector<ClusterMember>& members,
+                  std::vector<ClusterFrame>& frames) {
+  for (std::size_t k = 0; k < clusters.size(); ++k) {
+    const Cluster& cl = clusters[k];
+    vec4 sum(0.0f);
+    vec3 momentum(0.0f);
+    for (uint j = cl.first; j < cl.first + cl.count; ++j) {
+      sum = motes::shared::cluster_centre_add(sum, pos[members[j].particle], members[j].mass);
+      momentum =
+          motes::shared::cluster_momentum_add(momentum, vel[members[j].particle], members[j].mass);
+    }
+    const vec3 centre = motes::shared::xyz(sum) / sum.w;
+    const vec3 mean_v = momentum / sum.w;
+    motes::shared::ClusterSums sums = motes::shared::cluster_sums_zero();
+    for (uint j = cl.first; j < cl.first + cl.count; ++j) {
+      motes::shared::cluster_sums_add(sums, motes::shared::xyz(pos[members[j].particle]) - centre,
+                                      motes::shared::xyz(vel[members[j].particle]), mean_v,
+                                      members[j], cl.mode);
+    }
+    ClusterFrame f =
+        motes::shared::cluster_frame(cl, sums, vec4(centre, sum.w), mean_v, frames[k].rotation);
+    motes::shared::ClusterPulls pulls = motes::shared::cluster_pulls_zero();
+    for (uint j = cl.first; j < cl.first + cl.count; ++j) {
+      motes::shared::cluster_pulls_add(pulls, f, members[j], xyz(pos[members[j].particle]),
+                                       xyz(vel[members[j].particle]));
+    }
+    frames[k] = motes::shared::cluster_frame_finish(f, sums, pulls);
+  }
+}
+
+bool clusters_goal(Particles& particles, const std::vector<ClusterMember>& members,
+                   const std::vector<ClusterFrame>& frames, const StepParams& p,
+                   const std::vector<vec4>& ref) {
+  std::vector<vec3> shift(particles.size(), vec3(0.0f));
+  std::vector<vec3> damp(particles.size(), vec3(0.0f));
+  for (const ClusterMember& m : members) {
+    if (m.particle < p.soft_first || m.particle >= p.linked_first) {
+      throw std::invalid_argument("clusters_goal: a member outside the soft particles");
+    }
+    const vec3 x = xyz(particles.pos[m.particle]);
+    const vec4 v = particles.vel[m.particle];
+    shift[m.particle] += motes::shared::cluster_shift(frames[m.cluster], m, x, v.w);
+    damp[m.particle] += motes::shared::cluster_damp(frames[m.cluster], m, x, xyz(v), v.w);
+  }
+  const float inv_dt = 1.0f / p.gravity_dt.w;
+  bool moved = false;
+  for (uint i = p.soft_first; i < p.linked_first; ++i) {
+    particles.vel[i] = vec4(xyz(particles.vel[i]) + damp[i], particles.vel[i].w);
+    motes::shared::constraint_apply(particles.pos[i], particles.vel[i], shift[i], inv_dt);
+    if (!ref.empty()) {
+      moved = motes::shared::neighbour_moved_too_far(particles.pos[i], ref[i], p.neighbour_skin) ||
+              moved;
+    }
+  }
+  return moved;
+}
+
 void step(Particles& particles, Bodies& bodies, const std::vector<ContactLaw>& laws,
           const std::vector<PlaneData>& planes, const StepParams& p) {
   const std::vector<vec4> force = contacts_compute(particles, laws, planes, p);

@@ -13,9 +13,13 @@
 #include "shared/common.h"
 #include "shared/links.h"
 #include "shared/params.h"
+#include "shared/shape_matching.h"
 
 namespace motes_ref {
 
+using motes::shared::Cluster;
+using motes::shared::ClusterFrame;
+using motes::shared::ClusterMember;
 using motes::shared::Constraint;
 using motes::shared::ContactLaw;
 using motes::shared::PlaneData;
@@ -120,6 +124,23 @@ bool particles_integrate(Particles& particles, const std::vector<vec4>& force, c
 /// moved ends too far from `ref` (empty ref: false).
 bool constraints_solve(Particles& particles, const std::vector<Constraint>& constraints,
                        const StepParams& p, const std::vector<vec4>& ref = {});
+
+/// clusters_fit: for each cluster, its members' centre of mass (shared::cluster_centre_add) and
+/// sums of positions and velocities (cluster_sums_add) in member order, in float as the device
+/// does, then cluster_frame from the cluster's rotation in `frames`, and the third pass
+/// (cluster_pull_add, cluster_frame_finish). Replaces `frames`.
+void clusters_fit(const std::vector<vec4>& pos, const std::vector<vec4>& vel,
+                  const std::vector<Cluster>& clusters, const std::vector<ClusterMember>& members,
+                  std::vector<ClusterFrame>& frames);
+
+/// clusters_goal: every particle in [p.soft_first, p.linked_first) damped by the sum of
+/// shared::cluster_damp, then moved by the sum of cluster_shift over its members, found by scanning
+/// all members in order (not through ClusterGather), its velocity by the same / dt
+/// (constraint_apply). Returns whether one ends too
+/// far from `ref` (empty ref: false).
+bool clusters_goal(Particles& particles, const std::vector<ClusterMember>& members,
+                   const std::vector<ClusterFrame>& frames, const StepParams& p,
+                   const std::vector<vec4>& ref = {});
 
 /// One whole step in the core's order (the grid and the lists are skipped: the brute-force
 /// contacts do not need them).

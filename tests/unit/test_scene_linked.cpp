@@ -379,7 +379,8 @@ std::vector<BadLinked> bad_cases() {
        {"s.json: /bodies/1/name: duplicate body name \"r\" (also made by /bodies/0)"}},
       {"BadKind",
        scene_text(R"({"kind": "curtain", "shape": {"type": "particle"}})"),
-       {"s.json: /bodies/0/kind: must be \"dynamic\", \"static\", \"cloth\" or \"rope\", got "
+       {"s.json: /bodies/0/kind: must be \"dynamic\", \"static\", \"soft\", \"cloth\" or \"rope\", "
+        "got "
         "\"curtain\""}},
       {"MaxParticles",
        scene_text(ball + ", " + rope(R"(, "particles": 100)"), R"("max_particles": 100)"),

@@ -447,7 +447,7 @@ const BadCase kBadCases[] = {
     {"shape_too_small.json", {": /bodies/0/shape: ", "no particle fits"}},
     {"zero_axis.json", {": /bodies/0/rotation/axis: must be a non-zero vector"}},
     {"bad_kind.json",
-     {": /bodies/0/kind: must be \"dynamic\", \"static\", \"cloth\" or \"rope\", got "
+     {": /bodies/0/kind: must be \"dynamic\", \"static\", \"soft\", \"cloth\" or \"rope\", got "
       "\"kinematic\""}},
     {"camera_same_point.json", {": /camera/target: must differ from /camera/position"}},
     {"camera_bad_fov.json",

@@ -50,7 +50,32 @@ struct Settings {
 
 enum class BodyKind { Dynamic, Static };
 
-/// One rigid body (a repeated body in the file becomes several BodySpecs).
+/// What a soft body's goal shape may do besides rotating and translating (Mueller et al. 2005).
+enum class SoftMode {
+  Rigid,     ///< the rest shape, rotated and moved
+  Linear,    ///< blended with the best linear fit (volume kept)
+  Quadratic  ///< blended with the best quadratic fit (twists and bends)
+};
+
+/// A dynamic body made soft by shape matching: its particles move freely under their contact
+/// forces, then each is pulled toward the goal of its clusters (docs/architecture.md, "Soft
+/// bodies"). Clusters split the body's bounding box into a grid of cells, each grown by half a
+/// cell on every side so that neighbouring clusters overlap and a long body can bend.
+struct SoftSpec {
+  double stiffness = 0.5;  ///< alpha: fraction of the way to the goal per substep, in (0, 1]
+  /// > 0: the shape's natural frequency (Hz) instead of `stiffness`, the same at any time step:
+  /// alpha = (2 pi frequency dt / substeps)^2 (at most 1); a body then sags g / (2 pi f)^2 under
+  /// its own weight.
+  double frequency = 0.0;
+  /// Rate (1/s) at which the particles' velocities relative to their cluster's rigid motion decay
+  /// (momentum-conserving internal damping; 0: none, the body rings).
+  double damping = 0.0;
+  SoftMode mode = SoftMode::Rigid;
+  double beta = 0.0;                     ///< linear and quadratic modes: weight of the fit
+  std::array<int, 3> clusters{1, 1, 1};  ///< cells along the body's x, y, z (rest frame)
+};
+
+/// One rigid or soft body (a repeated body in the file becomes several BodySpecs).
 struct BodySpec {
   std::string name;
   BodyKind kind = BodyKind::Dynamic;
@@ -61,6 +86,7 @@ struct BodySpec {
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< rad/s, world frame
   std::optional<Eigen::Vector3d> color;  ///< sRGB, each 0..1, for pictures (docs/rendering.md)
+  std::optional<SoftSpec> soft;          ///< set: a soft body (dynamic only), no angular velocity
 };
 
 enum class LinkedKind { Rope, Cloth };

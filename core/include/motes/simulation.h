@@ -31,6 +31,9 @@ struct Snapshot {
   std::vector<shared::vec4> body_vel;
   std::vector<shared::vec4> body_angmom;
   std::vector<shared::vec4> body_angvel;
+  /// Rotation of each shape-matching cluster's last fit (device order): the next fit starts
+  /// from it, so a bitwise resume needs it.
+  std::vector<shared::vec4> cluster_rotation;
 };
 
 /// Static facts about a body, kept on the host.
@@ -46,6 +49,9 @@ struct BodyInfo {
   /// A cloth or a rope (Scene::linked; they follow the scene's bodies): its body state in a
   /// Snapshot is the mean position and velocity of its particles (orientation fixed).
   bool linked = false;
+  /// A soft body (shape matching): like a cloth, its body state in a Snapshot is the mean
+  /// position and velocity of its particles.
+  bool soft = false;
 };
 
 /// Neighbour-list figures since the simulation was created (NeighbourState).

@@ -36,5 +36,11 @@ Scene dominoes_workload(int count, int rows);
 /// side: 2 to 1024.
 Scene cloth_workload(int side);
 
+/// W4 "soft": `count` soft cubes of 7 x 7 x 8 = 392 particles (d = 0.01 m; linear goals, beta 0.3,
+/// 20 Hz, internal damping 40/s) in a square grid, 0.12 m apart, falling from 0.06 m above the
+/// floor so that they land within the first 0.1 s; k = 2000 N/m, gamma_n = 500/s, dt = 1e-4 s.
+/// count: 1 to 100,000.
+Scene soft_workload(int count);
+
 }  // namespace motes
 MOTES_API_END

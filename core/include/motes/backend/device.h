@@ -53,6 +53,13 @@ enum class Buffer : std::uint32_t {
   Planes,       ///< PlaneData (P)
   // Cloth and ropes: their particles are [Nl, N) (StepParams.linked_first).
   Constraints,  ///< Constraint (C): distance constraints, grouped by colour (shared/links.h)
+  // Soft bodies (shape matching): their particles are [Ns, Nl) (StepParams.soft_first).
+  Clusters,        ///< Cluster (S): clusters of soft-body particles (shared/shape_matching.h)
+  ClusterMembers,  ///< ClusterMember (Sm): every cluster's members, cluster by cluster
+  ClusterFrames,   ///< ClusterFrame (S): the last fit; its rotation starts the next one
+  /// uint (Ns + 1 + Sm): soft particle Ns + k is in the members ClusterGather[j] for j in
+  /// [ClusterGather[k], ClusterGather[k + 1]) (the offsets count from the buffer's start).
+  ClusterGather,
   Count
 };
 
@@ -67,6 +74,8 @@ enum class Kernel : std::uint32_t {
   BodiesIntegrate,
   ParticlesUpdate,
   ParticlesIntegrate,
+  ClustersFit,
+  ClustersGoal,
   ConstraintsSolve,
   Count
 };
@@ -87,6 +96,9 @@ struct Sizes {
   std::uint32_t planes = 0;              ///< P
   std::uint32_t neighbour_capacity = 0;  ///< K: list entries per particle
   std::uint32_t constraints = 0;         ///< C: distance constraints of cloth and ropes
+  std::uint32_t soft_particles = 0;      ///< Ns: particles of soft bodies
+  std::uint32_t clusters = 0;            ///< S: shape-matching clusters
+  std::uint32_t cluster_members = 0;     ///< Sm: their members (a particle may be in several)
 };
 
 /// Bytes of one element and number of elements of a buffer.
@@ -170,6 +182,14 @@ class Device {
   /// constraint_correction) on ParticlePos and ParticleVel; asks for a rebuild when a particle it
   /// moved is too far from its NeighbourRefPos.
   virtual void constraints_solve(const shared::StepParams& p) = 0;
+  /// ClusterFrames: for each of the p.cluster_count clusters, the centre of mass of its members
+  /// and A_pq (cluster_centre_add, cluster_moment_add), summed in member order, then
+  /// shared/shape_matching.h: cluster_frame, from the cluster's last rotation.
+  virtual void clusters_fit(const shared::StepParams& p) = 0;
+  /// Every soft particle [p.soft_first, p.linked_first) moved by the sum of cluster_shift over
+  /// its members in ClusterGather order (its velocity by the same / dt); asks for a rebuild when
+  /// one ends too far from its NeighbourRefPos.
+  virtual void clusters_goal(const shared::StepParams& p) = 0;
 
   /// Waits for queued work; reports any error it raised.
   virtual Status synchronize() = 0;
