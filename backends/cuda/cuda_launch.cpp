@@ -46,6 +46,15 @@ void CudaDevice::enqueue(Kernel k, const shared::StepParams& p) {
         sizes_.materials, sizes_.neighbour_capacity));
     return;
   }
+  if (p.cluster_count > sizes_.clusters || p.linked_first > p.particle_count ||
+      p.soft_first > p.linked_first || p.linked_first - p.soft_first > sizes_.soft_particles) {
+    error_ = Status::error(fmt::format(
+        "cuda: {} launched with {} clusters and soft particles [{}, {}) of {} on buffers "
+        "allocated for {} clusters and {} soft particles",
+        kernel_name(k), p.cluster_count, p.soft_first, p.linked_first, p.particle_count,
+        sizes_.clusters, sizes_.soft_particles));
+    return;
+  }
   pending_.push_back({k, p});
 }
 

@@ -32,6 +32,7 @@ struct StepParams {
   uint cluster_count;         // S: shape-matching clusters (shared/shape_matching.h)
   uint reserved0;             // 0
   uint reserved1;             // 0
+  uint reserved2;             // 0: the struct has no padding (calls are compared bytewise)
 };
 
 /// Contact law of one pair of materials (symmetric): F_n = k d - gamma_n m* v_n,
@@ -61,6 +62,11 @@ static_assert(offsetof(motes::shared::StepParams, flags) == 44, "StepParams layo
 static_assert(offsetof(motes::shared::StepParams, neighbour_skin) == 56, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, constraint_count) == 72, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, cluster_count) == 80, "StepParams layout");
+// No padding bytes: queued calls are compared with memcmp to find the step's repeating cycle
+// (kernel_queue.cpp), and a padding byte's garbage would hide it (every flush a new graph).
+static_assert(offsetof(motes::shared::StepParams, reserved2) + sizeof(motes::shared::uint) ==
+                  sizeof(motes::shared::StepParams),
+              "StepParams must have no padding");
 static_assert(sizeof(motes::shared::ContactLaw) == 16, "ContactLaw layout");
 static_assert(sizeof(motes::shared::PlaneData) == 32, "PlaneData layout");
 #endif

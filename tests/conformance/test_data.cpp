@@ -285,6 +285,7 @@ World with_linked(World w, std::uint32_t seed) {
     p.body[i] = motes::shared::linked_body(rng.below(3), rng.below(6), rng.below(6));
   }
   w.params.linked_first = static_cast<uint>(p.rigid);
+  w.params.soft_first = w.params.linked_first;  // no soft bodies
   w.params.linked_damping = 0.25f;
   return w;
 }
