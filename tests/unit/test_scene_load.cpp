@@ -147,6 +147,55 @@ TEST(SceneExamples, BuiltInSceneIsTheDominoChain) {
 
 // ---- defaults, repeats, shapes and planes ----
 
+TEST(SceneLoad, SoftBodiesAreReadAndCheckedWithLocatedErrors) {
+  const auto load = [](const std::string& soft, const std::string& kind = "soft") {
+    const std::string text = R"({"settings": {"contact": {"stiffness": 1000}}, "bodies": [
+      {"kind": ")" + kind + R"(", "shape": {"type": "box", "particles": [3, 3, 3]}, "soft": )" +
+                             soft + "}]}";
+    return load_scene_text(text, "s.json", ".");
+  };
+  Result<Scene> ok = load(
+      R"({"frequency": 20, "damping": 40, "mode": "quadratic", "beta": 0.3, "clusters": [2, 1, 3]})");
+  ASSERT_TRUE(ok) << ok.message();
+  ASSERT_TRUE(ok->bodies[0].soft.has_value());
+  const motes::SoftSpec& soft = *ok->bodies[0].soft;
+  EXPECT_EQ(soft.frequency, 20.0);
+  EXPECT_EQ(soft.damping, 40.0);
+  EXPECT_EQ(soft.mode, motes::SoftMode::Quadratic);
+  EXPECT_EQ(soft.beta, 0.3);
+  EXPECT_EQ(soft.clusters, (std::array<int, 3>{2, 1, 3}));
+  // "kind": "soft" alone: the defaults.
+  Result<Scene> plain = load_scene_text(
+      R"({"settings": {"contact": {"stiffness": 1000}}, "bodies": [
+        {"kind": "soft", "shape": {"type": "box", "particles": [2, 2, 2]}}]})",
+      "s.json", ".");
+  ASSERT_TRUE(plain) << plain.message();
+  EXPECT_EQ(plain->bodies[0].soft->stiffness, 0.5);
+  EXPECT_EQ(plain->bodies[0].soft->mode, motes::SoftMode::Rigid);
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {R"({"stiffness": 1.5})", "s.json: /bodies/0/soft/stiffness: the stiffness is a fraction"},
+      {R"({"stiffness": 0})", "s.json: /bodies/0/soft/stiffness: must be a positive number"},
+      {R"({"stiffness": 0.5, "frequency": 10})",
+       "s.json: /bodies/0/soft/frequency: give \"stiffness\" (per substep) or \"frequency\""},
+      {R"({"mode": "cubic"})", "s.json: /bodies/0/soft/mode: must be \"rigid\", \"linear\" or"},
+      {R"({"beta": 0.5})", "s.json: /bodies/0/soft/beta: beta needs \"mode\""},
+      {R"({"mode": "linear", "beta": 2})", "s.json: /bodies/0/soft/beta: beta blends"},
+      {R"({"damping": -1})", "s.json: /bodies/0/soft/damping:"},
+      {R"({"clusters": [0, 1, 1]})", "s.json: /bodies/0/soft/clusters/0:"},
+      {R"({"stiffnes": 0.5})", "s.json: /bodies/0/soft/stiffnes: unknown key \"stiffnes\""},
+  };
+  for (const auto& [soft_text, want] : bad) {
+    Result<Scene> r = load(soft_text);
+    ASSERT_FALSE(r) << soft_text;
+    EXPECT_NE(r.message().find(want), std::string::npos) << soft_text << ": " << r.message();
+  }
+  Result<Scene> not_soft = load("{}", "dynamic");
+  ASSERT_FALSE(not_soft);
+  EXPECT_NE(not_soft.message().find("s.json: /bodies/0/soft: \"soft\" settings need"),
+            std::string::npos)
+      << not_soft.message();
+}
+
 TEST(SceneLoad, OpenMeshIsFilledWithAWarning) {
   // A box without its top (4 open edges): filled by the generalized winding number, with a warning
   // naming the file and the condition.
