@@ -41,3 +41,11 @@ if [ "${MOTES_SANITIZER_STAGE:-1}" = 1 ]; then
   /usr/bin/python3 "$root/scripts/check-test-counts.py" "$build/ctest-results.xml" \
     "$build-sanitize/ctest-results.xml"
 fi
+
+# The fuzzing stage (docs/fuzzing.md): every libFuzzer target for 60 s from seeds made from the
+# repository's scenes, meshes and test data, in a clang build of its own (MOTES_FUZZ=ON, ASan +
+# UBSan); any crash, leak, timeout or sanitizer report fails it and names the reproducer.
+# MOTES_FUZZ_STAGE=0 skips it.
+if [ "${MOTES_FUZZ_STAGE:-1}" = 1 ]; then
+  MOTES_FUZZ_BUILD="$build-fuzz" "$root/scripts/fuzz.sh" all 60
+fi

@@ -82,13 +82,26 @@ Result<TriangleMesh> load_mesh(const std::string& path) {
   // Points and lines (which Triangulate leaves alone) are removed: only surfaces enclose volume.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  // The file is read and validated first (aiProcess_ValidateDataStructure, alone): assimp's
+  // post-processing steps trust the structure an importer built, and a malformed file (an OFF
+  // with faces but no indices, found by fuzzing: docs/fuzzing.md) crashes them. A file with no
+  // mesh at all fails validation too; it gets our own message below, not aiScene's internals.
+  const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
+  if (scene == nullptr) {
+    const std::string why = importer.GetErrorString();
+    if (why.find("mNumMeshes") != std::string::npos || why.find("no meshes") != std::string::npos) {
+      return Status::error(fmt::format(
+          "{}: the file contains no triangles (points, lines and faces without area do not "
+          "count): it encloses no volume",
+          path));
+    }
+    return Status::error(fmt::format("{}: cannot read mesh: {}", path, why));
+  }
   // PreTransformVertices applies the node transforms of formats that have a scene graph, so the
-  // particles come out where the file places the mesh. aiProcess_ValidateDataStructure is left
-  // out: it rejects a file without meshes with a message about aiScene internals; the indices
-  // are range-checked below instead.
+  // particles come out where the file places the mesh; the indices are range-checked below too.
   const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                          aiProcess_SortByPType | aiProcess_PreTransformVertices;
-  const aiScene* scene = importer.ReadFile(path, flags);
+  scene = importer.ApplyPostProcessing(flags);
   if (scene == nullptr) {
     return Status::error(fmt::format("{}: cannot read mesh: {}", path, importer.GetErrorString()));
   }

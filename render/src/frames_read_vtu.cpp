@@ -53,6 +53,12 @@ class VtuFile {
     if (points.empty() || *end != '\0') {
       return Status::error(fmt::format("'{}': no NumberOfPoints in its <Piece>", path));
     }
+    // The Points array alone holds 12 bytes per point: a larger count is a corrupt file, refused
+    // before anything is allocated for it.
+    if (f.points_ > f.bytes_.size() / 12) {
+      return Status::error(fmt::format("'{}': NumberOfPoints {} does not fit in its {} bytes", path,
+                                       points, f.bytes_.size()));
+    }
     return f;
   }
 
@@ -65,7 +71,12 @@ class VtuFile {
     const std::size_t at = header_.find(key);
     if (at == std::string::npos) return false;
     const std::size_t open = header_.rfind('<', at);
-    const std::string tag = header_.substr(open, header_.find('>', at) - open);
+    const std::size_t close = header_.find('>', at);
+    if (open == std::string::npos || close == std::string::npos) {
+      return Status::error(
+          fmt::format("'{}': array \"{}\" is not named inside a tag", path_, name));
+    }
+    const std::string tag = header_.substr(open, close - open);
     if (attribute(tag, "type") != type || attribute(tag, "format") != "appended") {
       return Status::error(
           fmt::format("'{}': array \"{}\" is not {} in appended format", path_, name, type));

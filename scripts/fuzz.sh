@@ -1,0 +1,167 @@
+#!/usr/bin/env bash
+# Fuzzing (docs/fuzzing.md): scripts/fuzz.sh TARGET SECONDS, TARGET one of scene, mesh, checkpoint,
+# frames or all. Configures and builds the fuzz build with clang if needed (only the fuzz targets),
+# seeds each target's corpus from the repository's scenes, meshes and test data (checkpoints and
+# frames from the targets' own small simulation), runs libFuzzer for SECONDS seconds per target and
+# fails on any crash, leak, timeout, out-of-memory or sanitizer report, printing the reproducer.
+# Environment: MOTES_FUZZ_BUILD (default build-fuzz), JOBS (build parallelism), MOTES_FUZZ_ARGS
+# (more libFuzzer flags, e.g. -jobs=2 -workers=2).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${MOTES_FUZZ_BUILD:-$root/build-fuzz}
+all_targets=(scene mesh checkpoint frames)
+
+usage() {
+  echo "usage: scripts/fuzz.sh TARGET SECONDS   (TARGET: ${all_targets[*]} or all)" >&2
+  exit 2
+}
+[ $# -eq 2 ] || usage
+case "$1" in
+  all) targets=("${all_targets[@]}") ;;
+  scene | mesh | checkpoint | frames) targets=("$1") ;;
+  *) usage ;;
+esac
+seconds=$2
+[[ "$seconds" =~ ^[1-9][0-9]*$ ]] || usage
+
+for tool in clang clang++; do
+  command -v "$tool" >/dev/null || {
+    echo "fuzz: $tool not found (Debian: apt-get install clang libclang-rt-14-dev)" >&2
+    exit 1
+  }
+done
+
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  echo "== configuring $build (clang, libFuzzer, ASan + UBSan)"
+  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMOTES_FUZZ=ON -DMOTES_BUILD_TESTS=OFF \
+    -DMOTES_WITH_CUDA=OFF -DMOTES_WITH_VULKAN=OFF -DMOTES_WITH_PYTHON=OFF >/dev/null
+fi
+grep -q '^MOTES_FUZZ:BOOL=ON' "$build/CMakeCache.txt" || {
+  echo "fuzz: $build is not a fuzz build (configure it with -DMOTES_FUZZ=ON and clang, or remove it)" >&2
+  exit 1
+}
+echo "== building ${targets[*]/#/fuzz_}"
+cmake --build "$build" -j "${JOBS:-$(nproc)}" --target "${targets[@]/#/fuzz_}"
+
+# Seeds: written afresh each run, never kept in the repository.
+seed_scene() {
+  cp "$root"/examples/scenes/*.json "$root"/tests/data/scenes/*.json \
+    "$root"/tests/data/scenes/bad/*.json "$root"/tests/data/cli/*.json "$1/"
+}
+seed_mesh() {
+  # The first byte picks the importer (tests/fuzz/fuzz_mesh.cpp): 0 obj, 1 ply, 2 stl, 3 off.
+  local f name ext byte
+  for f in "$root"/tests/data/meshes/* "$root"/tests/data/scenes/*.obj \
+    "$root"/tests/data/scenes/bad/*.obj "$root"/examples/assets/*.obj; do
+    name=$(basename "$f")
+    ext=${name##*.}
+    case "$ext" in obj) byte='\000' ;; ply) byte='\001' ;; stl) byte='\002' ;; off) byte='\003' ;; *) continue ;; esac
+    { printf '%b' "$byte"; cat "$f"; } >"$1/$(basename "$(dirname "$f")")_$name"
+  done
+  # Binary STL and binary PLY of tests/data/meshes/cube.obj (the text seeds cover the rest).
+  /usr/bin/python3 - "$root/tests/data/meshes/cube.obj" "$1" <<'EOF'
+import struct, sys
+v, f = [], []
+for line in open(sys.argv[1]):
+    p = line.split()
+    if p and p[0] == "v":
+        v.append(tuple(float(x) for x in p[1:4]))
+    elif p and p[0] == "f":
+        idx = [int(x.split("/")[0]) - 1 for x in p[1:]]
+        f += [(idx[0], idx[i], idx[i + 1]) for i in range(1, len(idx) - 1)]
+stl = bytearray(b"\x02" + b"motes fuzz seed: cube".ljust(80, b" ") + struct.pack("<I", len(f)))
+for t in f:
+    stl += struct.pack("<3f", 0, 0, 0)
+    for i in t:
+        stl += struct.pack("<3f", *v[i])
+    stl += b"\0\0"
+open(sys.argv[2] + "/cube_binary.stl", "wb").write(stl)
+ply = (b"\x01ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty float x\n"
+       b"property float y\nproperty float z\nelement face %d\n"
+       b"property list uchar int vertex_indices\nend_header\n" % (len(v), len(f)))
+ply += b"".join(struct.pack("<3f", *p) for p in v)
+ply += b"".join(struct.pack("<B3i", 3, *t) for t in f)
+open(sys.argv[2] + "/cube_binary.ply", "wb").write(ply)
+# Meshes built without assimp (selector 4): vertex count, int8 coordinates, index triples.
+def raw(name, verts, tris):
+    out = bytearray(b"\x04" + bytes([len(verts) - 1]))
+    out += b"".join(struct.pack("<3b", *p) for p in verts)
+    out += b"".join(bytes(t) for t in tris)
+    open(sys.argv[2] + "/raw_" + name, "wb").write(out)
+raw("cube", [tuple(int(4 * c) for c in p) for p in v], f)
+raw("tetrahedron", [(0, 0, 0), (6, 0, 0), (0, 6, 0), (0, 0, 6)],
+    [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)])
+raw("octahedron", [(3, 0, 0), (-3, 0, 0), (0, 3, 0), (0, -3, 0), (0, 0, 3), (0, 0, -3)],
+    [(0, 2, 4), (2, 1, 4), (1, 3, 4), (3, 0, 4), (2, 0, 5), (1, 2, 5), (3, 1, 5), (0, 3, 5)])
+EOF
+}
+# The checkpoint and frame targets write their own seeds (valid files from a small simulation).
+seed_generated() {
+  MOTES_FUZZ_WRITE_SEEDS="$1" "$build/tests/fuzz/fuzz_$2" >"$1.log" 2>&1 || {
+    cat "$1.log" >&2
+    echo "fuzz: fuzz_$2 could not write its seeds" >&2
+    exit 1
+  }
+}
+
+# Per target: extra libFuzzer flags (the mesh target's seeds include the 110 KB bunny, which
+# would otherwise set the mutation length limit).
+flags_for() {
+  case "$1" in
+    mesh) echo "-max_len=16384" ;;
+    *) echo "" ;;
+  esac
+}
+
+files() { find "$1" -type f | wc -l; }
+
+status=0
+summary=()
+for t in "${targets[@]}"; do
+  work="$build/fuzz/$t"
+  rm -rf "$work/seeds"
+  mkdir -p "$work/seeds" "$work/corpus" "$work/artifacts"
+  case "$t" in
+    scene) seed_scene "$work/seeds" ;;
+    mesh) seed_mesh "$work/seeds" ;;
+    checkpoint | frames) seed_generated "$work/seeds" "$t" ;;
+  esac
+  dict=()
+  [ -f "$root/tests/fuzz/$t.dict" ] && dict=("-dict=$root/tests/fuzz/$t.dict")
+  log="$work/fuzz.log"
+  echo "== fuzz_$t for ${seconds} s ($(files "$work/seeds") seeds, $(files "$work/corpus") in the corpus; log: $log)"
+  rm -rf "$work"/artifacts/* "$work/tmp"
+  mkdir -p "$work/tmp"  # the targets' files; a crashed run leaves its folder here
+  rc=0
+  # Every UB report aborts (the targets are built with -fno-sanitize-recover); leaks inside
+  # assimp's own error paths are suppressed (tests/fuzz/lsan.supp says why).
+  export LSAN_OPTIONS="suppressions=$root/tests/fuzz/lsan.supp:print_suppressions=0"
+  export ASAN_OPTIONS="${ASAN_OPTIONS:-fast_unwind_on_malloc=0}"
+  # shellcheck disable=SC2046,SC2086
+  (cd "$work" && TMPDIR="$work/tmp" "$build/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout=25 \
+    -rss_limit_mb=2560 -print_final_stats=1 -artifact_prefix="$work/artifacts/" \
+    "${dict[@]}" $(flags_for "$t") ${MOTES_FUZZ_ARGS:-} "$work/corpus" "$work/seeds") \
+    >"$log" 2>&1 || rc=$?
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
+  mapfile -t found < <(find "$work/artifacts" -type f | sort)
+  if [ "$rc" -ne 0 ] || [ ${#found[@]} -gt 0 ] ||
+    grep -qE "ERROR: (AddressSanitizer|LeakSanitizer|libFuzzer)|runtime error:|SUMMARY: " "$log"; then
+    status=1
+    echo "!! fuzz_$t FAILED (exit $rc): the report:" >&2
+    awk '/ERROR:|runtime error:|ai_assert|terminate called|^motes fuzz|Test unit written/ {p = 1} p' \
+      "$log" | head -60 >&2 || true
+    for a in "${found[@]}"; do
+      echo "!! reproducer: $a" >&2
+      echo "!!   replay: LSAN_OPTIONS=$LSAN_OPTIONS $build/tests/fuzz/fuzz_$t $a" >&2
+    done
+    summary+=("fuzz_$t: FAILED after ${execs:-?} executions (${found[*]:-no reproducer; see $log})")
+  else
+    summary+=("fuzz_$t: ${execs:-?} executions in ${seconds} s (${rate:-?}/s), corpus $(files "$work/corpus") inputs, no findings")
+  fi
+done
+
+echo "== fuzz summary"
+printf '  %s\n' "${summary[@]}"
+exit "$status"

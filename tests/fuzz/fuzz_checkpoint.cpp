@@ -1,0 +1,133 @@
+// Fuzz target: checkpoint bytes -> motes::Simulation::load_state (docs/fuzzing.md).
+//
+// One Simulation of a small fixed scene (a repeated box, a static box, a free sphere, a rope and a
+// cloth: every kind of body a checkpoint restores) on the OpenMP backend with one thread. Each
+// input is loaded as it is, and again with its last 8 bytes replaced by the FNV-1a hash of the
+// bytes between the 48-byte header and them, so that mutations get past the hash check and reach
+// the payload. A state that loads is stepped once and checked (check_finite, snapshot, save_state).
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fuzz_targets.h"
+#include "motes/devices.h"
+#include "motes/simulation.h"
+
+namespace motes::fuzz {
+
+namespace {
+
+// Particle diameter 1 cm, k = 1000 N/m on 1 g particles: t_c = 2.2 ms, dt = 20 us.
+constexpr const char* kScene = R"({
+  "settings": {"dt": 2e-5, "particle_diameter": 0.01,
+               "contact": {"stiffness": 1000, "damping": 20, "tangential": 10, "friction": 0.5}},
+  "planes": [{"name": "floor", "normal": [0, 1, 0], "point": [0, 0, 0]}],
+  "bodies": [
+    {"name": "box", "shape": {"type": "box", "particles": [2, 2, 2]}, "position": [0, 0.03, 0],
+     "rotation": {"axis": [0, 0, 1], "degrees": 20},
+     "repeat": {"count": 2, "offset": [0.05, 0, 0]}},
+    {"name": "wall", "kind": "static", "shape": {"type": "box", "particles": [2, 1, 2]},
+     "position": [0, 0.005, 0.1]},
+    {"name": "ball", "shape": {"type": "particle"}, "position": [0.2, 0.05, 0],
+     "velocity": [0.1, 0, 0]},
+    {"name": "rope", "kind": "rope",
+     "rope": {"from": [0, 0.2, 0], "to": [0.04, 0.2, 0], "particles": 5, "pin": [0]}},
+    {"name": "cloth", "kind": "cloth",
+     "cloth": {"corner": [0, 0.3, 0], "edge_u": [0.02, 0, 0], "edge_v": [0, 0, 0.02],
+               "particles": [3, 3], "pin": [[0, 0]]}}
+  ]
+})";
+
+/// Size of checkpoint.cpp's header: magic, version, particles, bodies, reserved, step, time,
+/// payload bytes.
+constexpr std::size_t kHeaderBytes = 48;
+
+[[noreturn]] void broken(const char* what, const std::string& message = {}) {
+  std::fprintf(stderr, "motes fuzz checkpoint: %s %s\n", what, message.c_str());
+  std::abort();
+}
+
+/// The simulation every input is loaded into (built once per process).
+Simulation& simulation() {
+  static const std::unique_ptr<Simulation> sim = [] {
+    Result<Scene> scene = load_scene_text(kScene, "fuzz_checkpoint.json", "");
+    if (!scene) broken("the fixed scene does not load:", scene.message());
+    DeviceOptions options;
+    options.cpu_threads = 1;
+    Result<std::unique_ptr<Device>> device = open_device("openmp", -1, options);
+    if (!device) broken("no OpenMP device:", device.message());
+    Result<std::unique_ptr<Simulation>> made =
+        Simulation::create(scene.value(), std::move(device).value());
+    if (!made) broken("the fixed scene does not build:", made.message());
+    return std::move(made).value();
+  }();
+  return *sim;
+}
+
+std::uint64_t fnv1a(const std::uint8_t* data, std::size_t size) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (std::size_t i = 0; i < size; ++i) {
+    h ^= data[i];
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+/// Loads `path`; a state that loads is stepped and read back.
+void load(Simulation& sim, const std::filesystem::path& path) {
+  const Status loaded = sim.load_state(path.string());
+  if (!loaded) {
+    if (loaded.message().empty()) broken("an error without a message");
+    return;
+  }
+  // A loaded state is one the simulation must be able to go on from, or refuse with a message.
+  (void)sim.step(1);
+  (void)sim.check_finite();
+  const Result<Snapshot> snap = sim.snapshot();
+  if (!snap) broken("snapshot after a load failed:", snap.message());
+  if (snap->particle_pos.size() != sim.particle_count()) broken("snapshot size");
+  if (!sim.save_state((work_dir() / "saved.ck").string())) broken("save_state after a load");
+}
+
+}  // namespace
+
+int checkpoint(const std::uint8_t* data, std::size_t size) {
+  Simulation& sim = simulation();
+  const std::filesystem::path path = work_dir() / "state.ck";
+  write_file(path, data, size);
+  load(sim, path);
+  if (size >= kHeaderBytes + 8) {
+    std::vector<std::uint8_t> fixed(data, data + size);
+    const std::uint64_t hash = fnv1a(fixed.data() + kHeaderBytes, size - kHeaderBytes - 8);
+    std::memcpy(fixed.data() + size - 8, &hash, sizeof hash);
+    write_file(path, fixed.data(), fixed.size());
+    load(sim, path);
+  }
+  return 0;
+}
+
+void write_checkpoint_seeds(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  Simulation& sim = simulation();
+  for (int i = 0; i < 3; ++i) {
+    const std::string path = (dir / ("state_" + std::to_string(i) + ".ck")).string();
+    if (const Status s = sim.save_state(path); !s) broken("cannot write a seed:", s.message());
+    if (const Status s = sim.step(100); !s) broken("cannot step:", s.message());
+  }
+}
+
+}  // namespace motes::fuzz
+
+#ifndef MOTES_FUZZ_REPLAY
+extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
+  motes::fuzz::write_seeds_if_asked(motes::fuzz::write_checkpoint_seeds);
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  return motes::fuzz::checkpoint(data, size);
+}
+#endif
