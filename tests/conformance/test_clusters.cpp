@@ -115,9 +115,8 @@ SoftCase make_case(std::uint32_t seed, const std::vector<BodyPlan>& bodies, std:
   c.params.linked_first = static_cast<uint>(p.size());
   add_free(after, motes::shared::linked_body(0u, 0u, 0u));
   p.rigid = 0;
-  for (const Cluster& cl : c.soft.clusters) {
-    (void)cl;
-    // Last rotations near the identity, as after a step of a slowly turning body.
+  // Last rotations near the identity, as after a step of a slowly turning body.
+  for (std::size_t k = 0; k < c.soft.clusters.size(); ++k) {
     const float a = rng.uniform(-0.05f, 0.05f);
     ClusterFrame f{};
     f.rotation = motes::shared::quat_normalize(vec4(a, -0.5f * a, 0.3f * a, 1.0f));

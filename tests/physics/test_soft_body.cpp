@@ -137,26 +137,43 @@ TEST(SoftBody, SpinningRigidGoalKeepsTheShape) {
   EXPECT_GT((after[0] - before[0] - Eigen::Vector3d(0.02, 0.0, 0.0)).norm(), 5e-3);
 }
 
+/// Momenta of a free 6 x 4 x 3 soft box (alpha 0.3, beta 0.5 unless rigid, two clusters,
+/// damping 50/s) at the start and after `steps` substeps of 1e-4 s.
+struct FreeRun {
+  Momenta before;
+  Momenta after;
+  double mass = 0.0;
+};
+
+FreeRun free_soft_box(motes::SoftMode mode, const Eigen::Vector3d& at, const Eigen::Vector3d& v,
+                      const Eigen::Vector3d& w, std::uint64_t steps) {
+  motes::Scene scene = soft_scene(1.0e-4);
+  motes::SoftSpec soft = soft_spec(0.3, mode, mode == motes::SoftMode::Rigid ? 0.0 : 0.5);
+  soft.clusters = {2, 1, 1};
+  soft.damping = 50.0;
+  scene.bodies.push_back(soft_box(6, 4, 3, soft, at, v, w, tilt()));
+  FreeRun run;
+  auto sim = motes_test::simulate(scene);
+  EXPECT_TRUE(sim) << sim.message();
+  if (!sim) return run;
+  run.mass = (*sim)->bodies()[0].mass;
+  run.before = momenta((*sim)->snapshot().value(), run.mass / 72.0);
+  EXPECT_TRUE((*sim)->step(steps));
+  run.after = momenta((*sim)->snapshot().value(), run.mass / 72.0);
+  return run;
+}
+
 TEST(SoftBody, FreeBodyConservesLinearMomentum) {
   for (const motes::SoftMode mode :
        {motes::SoftMode::Rigid, motes::SoftMode::Linear, motes::SoftMode::Quadratic}) {
     SCOPED_TRACE(static_cast<int>(mode));
-    motes::Scene scene = soft_scene(1.0e-4);
-    motes::SoftSpec soft = soft_spec(0.3, mode, mode == motes::SoftMode::Rigid ? 0.0 : 0.5);
-    soft.clusters = {2, 1, 1};
-    soft.damping = 50.0;
-    scene.bodies.push_back(soft_box(6, 4, 3, soft, Eigen::Vector3d(0.1, 0.2, 0.3),
-                                    Eigen::Vector3d(0.5, -0.2, 0.1),
-                                    Eigen::Vector3d(3.0, -2.0, 5.0), tilt()));
-    auto sim = motes_test::simulate(scene);
-    ASSERT_TRUE(sim) << sim.message();
-    const double m = (*sim)->bodies()[0].mass / 72.0;
-    const Momenta m0 = momenta((*sim)->snapshot().value(), m);
-    ASSERT_TRUE((*sim)->step(2000));
-    const Momenta m1 = momenta((*sim)->snapshot().value(), m);
+    const FreeRun r =
+        free_soft_box(mode, Eigen::Vector3d(0.1, 0.2, 0.3), Eigen::Vector3d(0.5, -0.2, 0.1),
+                      Eigen::Vector3d(3.0, -2.0, 5.0), 2000);
+    const double change = (r.after.linear - r.before.linear).norm();
     std::printf("[soft] mode %d: momentum change %.3g relative\n", static_cast<int>(mode),
-                (m1.linear - m0.linear).norm() / m0.linear.norm());
-    EXPECT_LT((m1.linear - m0.linear).norm(), 1e-6 * m0.linear.norm());
+                change / r.before.linear.norm());
+    EXPECT_LT(change, 1e-6 * r.before.linear.norm());
   }
 }
 
@@ -164,22 +181,13 @@ TEST(SoftBody, FreeBodyConservesAngularMomentum) {
   for (const motes::SoftMode mode :
        {motes::SoftMode::Rigid, motes::SoftMode::Linear, motes::SoftMode::Quadratic}) {
     SCOPED_TRACE(static_cast<int>(mode));
-    motes::Scene scene = soft_scene(1.0e-4);
-    motes::SoftSpec soft = soft_spec(0.3, mode, mode == motes::SoftMode::Rigid ? 0.0 : 0.5);
-    soft.clusters = {2, 1, 1};
-    soft.damping = 50.0;
-    scene.bodies.push_back(soft_box(6, 4, 3, soft, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
-                                    Eigen::Vector3d(1.0, -0.5, 1.0), tilt()));
-    auto sim = motes_test::simulate(scene);
-    ASSERT_TRUE(sim) << sim.message();
-    const double m = (*sim)->bodies()[0].mass / 72.0;
-    const Momenta m0 = momenta((*sim)->snapshot().value(), m);
-    ASSERT_TRUE((*sim)->step(1000));
-    const Momenta m1 = momenta((*sim)->snapshot().value(), m);
+    const FreeRun r = free_soft_box(mode, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                    Eigen::Vector3d(1.0, -0.5, 1.0), 1000);
+    const double change = (r.after.spin - r.before.spin).norm();
     std::printf("[soft] mode %d: angular momentum change %.3g relative\n", static_cast<int>(mode),
-                (m1.spin - m0.spin).norm() / m0.spin.norm());
-    EXPECT_LT((m1.spin - m0.spin).norm(), 1e-4 * m0.spin.norm());
-    EXPECT_LT(m1.linear.norm(), 1e-6 * m * 72.0 * 0.01);  // at rest: below 1e-6 of 1 cm/s
+                change / r.before.spin.norm());
+    EXPECT_LT(change, 1e-4 * r.before.spin.norm());
+    EXPECT_LT(r.after.linear.norm(), 1e-6 * r.mass * 0.01);  // at rest: below 1e-6 of 1 cm/s
   }
 }
 
