@@ -1,7 +1,11 @@
 // Output formats by name, and the writer for each.
 #include "motes/output.h"
+#include "output_file.h"
 
 #include <fmt/format.h>
+
+#include <filesystem>
+#include <system_error>
 
 namespace motes {
 
@@ -35,6 +39,32 @@ Result<std::unique_ptr<FrameWriter>> open_frame_writer(OutputFormat format, cons
       break;
   }
   return Status::error(fmt::format("output format 'none' writes no files (directory '{}')", dir));
+}
+
+Result<std::unique_ptr<FrameWriter>> continue_frame_writer(OutputFormat format,
+                                                           const std::string& dir,
+                                                           std::vector<std::string> body_names,
+                                                           const SeriesState& state) {
+  switch (format) {
+    case OutputFormat::Vtu:
+      return output::continue_vtu_writer(dir, state.frame_times);
+    case OutputFormat::Csv:
+      return output::continue_csv_writer(dir, std::move(body_names), state);
+    case OutputFormat::None:
+      break;
+  }
+  return Status::error(fmt::format("output format 'none' writes no files (directory '{}')", dir));
+}
+
+Status csv_series_sizes(const std::string& dir, SeriesState& state) {
+  std::error_code ec;
+  const std::filesystem::path d(dir);
+  state.particles_csv_bytes = std::filesystem::file_size(d / "particles.csv", ec);
+  if (!ec) state.bodies_csv_bytes = std::filesystem::file_size(d / "bodies.csv", ec);
+  if (ec)
+    return Status::error(
+        fmt::format("cannot read the size of the CSV files in '{}': {}", dir, ec.message()));
+  return Status::ok();
 }
 
 Snapshot particle_set_snapshot(const std::vector<Eigen::Vector3f>& points, double diameter) {

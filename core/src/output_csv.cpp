@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <iterator>
+#include <system_error>
 #include <utility>
 
 #include "motes/output.h"
@@ -38,11 +39,13 @@ Status drain(OutputFile& file, fmt::memory_buffer& buf, bool force) {
 
 class CsvWriter final : public FrameWriter {
  public:
-  CsvWriter(OutputFile file, OutputFile bodies, std::vector<std::string> body_names)
+  CsvWriter(OutputFile file, OutputFile bodies, std::vector<std::string> body_names,
+            std::size_t frames = 0)
       : file_(std::move(file)),
         bodies_(std::move(bodies)),
         path_(file_.path()),
-        body_names_(std::move(body_names)) {}
+        body_names_(std::move(body_names)),
+        frames_(frames) {}
 
   Status write_frame(const Snapshot& s) override {
     if (Status st = output::check_snapshot(s); !st) return st;
@@ -117,6 +120,33 @@ Result<std::unique_ptr<FrameWriter>> open_csv_writer(const std::string& dir,
   if (Status s = bodies.flush(); !s) return s;
   return std::unique_ptr<FrameWriter>(
       std::make_unique<CsvWriter>(std::move(file), std::move(bodies), std::move(body_names)));
+}
+
+Result<std::unique_ptr<FrameWriter>> output::continue_csv_writer(
+    const std::string& dir, std::vector<std::string> body_names, const SeriesState& state) {
+  const std::string particles = (std::filesystem::path(dir) / "particles.csv").string();
+  const std::string bodies = (std::filesystem::path(dir) / "bodies.csv").string();
+  // Both sizes are checked before either file is cut.
+  for (const auto& [path, bytes] : {std::pair{particles, state.particles_csv_bytes},
+                                    std::pair{bodies, state.bodies_csv_bytes}}) {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec) return Status::error(fmt::format("cannot continue '{}': {}", path, ec.message()));
+    if (size < bytes) {
+      return Status::error(fmt::format(
+          "cannot continue '{}': it has {} bytes, fewer than the {} written before the checkpoint",
+          path, size, bytes));
+    }
+  }
+  if (Status s = output::cut_file(particles, state.particles_csv_bytes); !s) return s;
+  if (Status s = output::cut_file(bodies, state.bodies_csv_bytes); !s) return s;
+  auto file = OutputFile::append(particles);
+  if (!file) return file.status();
+  auto body_file = OutputFile::append(bodies);
+  if (!body_file) return body_file.status();
+  return std::unique_ptr<FrameWriter>(
+      std::make_unique<CsvWriter>(std::move(file).value(), std::move(body_file).value(),
+                                  std::move(body_names), state.frame_times.size()));
 }
 
 Status write_points_csv(const std::string& path, const std::vector<Eigen::Vector3f>& points) {

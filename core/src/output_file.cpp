@@ -44,6 +44,20 @@ Result<OutputFile> OutputFile::create(const std::string& path) {
   return f;
 }
 
+Result<OutputFile> OutputFile::append(const std::string& path) {
+  OutputFile f;
+  f.path_ = path;
+  errno = 0;
+  f.file_ = std::fopen(path.c_str(), "ab");
+  if (f.file_ == nullptr) {
+    const int error = errno;
+    return Status::error(fmt::format("cannot open '{}' to append: {}", path,
+                                     error != 0 ? std::strerror(error) : "unknown error"));
+  }
+  std::setvbuf(f.file_, nullptr, _IOFBF, std::size_t{1} << 20);
+  return f;
+}
+
 Status OutputFile::fail(const char* what, int error) {
   return Status::error(fmt::format("cannot {} '{}': {}", what, path_,
                                    error != 0 ? std::strerror(error) : "write error"));
@@ -109,6 +123,22 @@ Status replace_file(const std::string& from, const std::string& to) {
   if (ec) {
     return Status::error(fmt::format("cannot rename '{}' to '{}': {}", from, to, ec.message()));
   }
+  return Status::ok();
+}
+
+Status cut_file(const std::string& path, std::uint64_t bytes) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) return Status::error(fmt::format("cannot continue '{}': {}", path, ec.message()));
+  if (size < bytes) {
+    return Status::error(fmt::format(
+        "cannot continue '{}': it has {} bytes, fewer than the {} written before the checkpoint",
+        path, size, bytes));
+  }
+  if (size == bytes) return Status::ok();
+  std::filesystem::resize_file(path, bytes, ec);
+  if (ec)
+    return Status::error(fmt::format("cannot cut '{}' to {} bytes: {}", path, bytes, ec.message()));
   return Status::ok();
 }
 

@@ -2,9 +2,13 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <string>
+#include <vector>
 
+#include "motes/output.h"
 #include "motes/simulation.h"
 #include "motes/status.h"
 
@@ -23,6 +27,8 @@ class OutputFile {
 
   /// Creates or truncates `path`.
   static Result<OutputFile> create(const std::string& path);
+  /// Opens an existing `path` for writing at its end.
+  static Result<OutputFile> append(const std::string& path);
 
   Status write(const void* data, std::size_t bytes);
   Status write(const std::string& text) { return write(text.data(), text.size()); }
@@ -43,6 +49,17 @@ class OutputFile {
 
 /// Renames `from` to `to`, replacing `to` atomically.
 Status replace_file(const std::string& from, const std::string& to);
+
+/// Cuts `path` to `bytes` (it must hold at least that many): the rows of a CSV series written
+/// after a checkpoint go. A shorter file is an error naming it and both sizes.
+Status cut_file(const std::string& path, std::uint64_t bytes);
+
+/// continue_frame_writer for each format (output_vtu.cpp, output_csv.cpp).
+Result<std::unique_ptr<FrameWriter>> continue_vtu_writer(const std::string& dir,
+                                                         const std::vector<double>& times);
+Result<std::unique_ptr<FrameWriter>> continue_csv_writer(const std::string& dir,
+                                                         std::vector<std::string> body_names,
+                                                         const SeriesState& state);
 
 /// Checks that a snapshot's particle arrays have one entry per particle.
 Status check_snapshot(const Snapshot& snapshot);

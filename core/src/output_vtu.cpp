@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -241,6 +242,28 @@ class VtuWriter final : public FrameWriter {
     return write_collections();
   }
 
+  /// Lists the first `times.size()` frames of an earlier run in `dir_` (their files must exist):
+  /// the next frame is numbered after them.
+  Status adopt(const std::vector<double>& times) {
+    for (std::size_t k = 0; k < times.size(); ++k) {
+      const std::string name = fmt::format("particles_{:06}.vtu", k);
+      const std::string bodies = fmt::format("bodies_{:06}.vtu", k);
+      for (const std::string& file : {name, bodies}) {
+        const std::filesystem::path path = std::filesystem::path(dir_) / file;
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(path, ec)) {
+          return Status::error(fmt::format(
+              "cannot continue the series in '{}': '{}' (frame {} of {} written before the "
+              "checkpoint) is missing",
+              dir_, path.string(), k, times.size()));
+        }
+      }
+      frames_.emplace_back(times[k], name);
+      body_frames_.emplace_back(times[k], bodies);
+    }
+    return Status::ok();
+  }
+
   Status finish() override { return Status::ok(); }
   [[nodiscard]] std::size_t frames() const override { return frames_.size(); }
   [[nodiscard]] const std::string& main_path() const override { return pvd_path_; }
@@ -265,6 +288,14 @@ Result<std::unique_ptr<FrameWriter>> open_vtu_writer(const std::string& dir) {
   if (Status s = create_output_directory(dir); !s) return s;
   auto writer = std::make_unique<VtuWriter>(dir);
   // Empty collections at once: a bad directory fails here, before any step runs.
+  if (Status s = writer->write_collections(); !s) return s;
+  return std::unique_ptr<FrameWriter>(std::move(writer));
+}
+
+Result<std::unique_ptr<FrameWriter>> output::continue_vtu_writer(const std::string& dir,
+                                                                 const std::vector<double>& times) {
+  auto writer = std::make_unique<VtuWriter>(dir);
+  if (Status s = writer->adopt(times); !s) return s;
   if (Status s = writer->write_collections(); !s) return s;
   return std::unique_ptr<FrameWriter>(std::move(writer));
 }

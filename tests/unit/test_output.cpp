@@ -449,3 +449,87 @@ TEST(OutputCsv, InconsistentBodyArraysAreRefused) {
   EXPECT_NE(st.message().find("inconsistent snapshot at step 3"), std::string::npos)
       << st.message();
 }
+
+// A series continued by another writer (motes resume): the same files, byte for byte, as one
+// writer that wrote every frame; rows and frames written after the recorded point are replaced.
+TEST(OutputContinue, CsvAndVtuSeriesGoOnAsIfUninterrupted) {
+  const std::vector<std::string> names = {"a", "b", "c"};
+  std::vector<motes::Snapshot> frames;
+  for (int k = 0; k < 5; ++k) {
+    frames.push_back(with_bodies(
+        sample_snapshot(static_cast<std::uint64_t>(k) * 10, 0.1 * k, static_cast<float>(k)),
+        static_cast<float>(k)));
+  }
+  for (const motes::OutputFormat format : {motes::OutputFormat::Csv, motes::OutputFormat::Vtu}) {
+    SCOPED_TRACE(motes::output_format_name(format));
+    TempDir whole;
+    TempDir parts;
+    auto one = motes::open_frame_writer(format, whole.path().string(), names);
+    ASSERT_TRUE(one) << one.message();
+    for (const auto& f : frames) ASSERT_TRUE(one.value()->write_frame(f));
+    ASSERT_TRUE(one.value()->finish());
+
+    // Three frames, the state after them recorded, then a fourth written before the "crash".
+    auto first = motes::open_frame_writer(format, parts.path().string(), names);
+    ASSERT_TRUE(first) << first.message();
+    motes::SeriesState state;
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_TRUE(first.value()->write_frame(frames[static_cast<std::size_t>(k)]));
+      state.frame_times.push_back(frames[static_cast<std::size_t>(k)].time);
+    }
+    if (format == motes::OutputFormat::Csv) {
+      ASSERT_TRUE(motes::csv_series_sizes(parts.path().string(), state));
+    }
+    ASSERT_TRUE(first.value()->write_frame(with_bodies(sample_snapshot(99, 9.9, 9.0f), 9.0f)));
+    first.value().reset();
+
+    auto next = motes::continue_frame_writer(format, parts.path().string(), names, state);
+    ASSERT_TRUE(next) << next.message();
+    EXPECT_EQ(next.value()->frames(), 3u);
+    for (std::size_t k = 3; k < frames.size(); ++k)
+      ASSERT_TRUE(next.value()->write_frame(frames[k]));
+    EXPECT_EQ(next.value()->frames(), 5u);
+    ASSERT_TRUE(next.value()->finish());
+    std::size_t files = 0;
+    for (const auto& e : fs::directory_iterator(whole.path())) {
+      ++files;
+      EXPECT_EQ(read_text(e.path()), read_text(parts.path() / e.path().filename()))
+          << e.path().filename();
+    }
+    EXPECT_EQ(files, format == motes::OutputFormat::Csv ? 2u : 12u);
+  }
+}
+
+TEST(OutputContinue, MissingOrShortFilesAreRefusedAndNothingIsWritten) {
+  TempDir tmp;
+  const std::string dir = tmp.path().string();
+  motes::SeriesState state;
+  state.frame_times = {0.0, 0.1};
+  // VTU: frame 1's files are missing.
+  {
+    auto w = motes::open_vtu_writer(dir);
+    ASSERT_TRUE(w);
+    ASSERT_TRUE(w.value()->write_frame(with_bodies(sample_snapshot(0, 0.0, 0.0f), 0.0f)));
+  }
+  const std::string pvd = read_text(tmp.path() / "particles.pvd");
+  auto vtu = motes::continue_frame_writer(motes::OutputFormat::Vtu, dir, {}, state);
+  ASSERT_FALSE(vtu);
+  EXPECT_NE(vtu.message().find("particles_000001.vtu"), std::string::npos) << vtu.message();
+  EXPECT_NE(vtu.message().find("missing"), std::string::npos) << vtu.message();
+  EXPECT_EQ(read_text(tmp.path() / "particles.pvd"), pvd);
+  // CSV: bodies.csv shorter than recorded; particles.csv is not cut either.
+  {
+    auto w = motes::open_csv_writer(dir);
+    ASSERT_TRUE(w);
+    ASSERT_TRUE(w.value()->write_frame(with_bodies(sample_snapshot(0, 0.0, 0.0f), 0.0f)));
+  }
+  ASSERT_TRUE(motes::csv_series_sizes(dir, state));
+  const std::string particles = read_text(tmp.path() / "particles.csv");
+  state.particles_csv_bytes -= 10;
+  state.bodies_csv_bytes += 1;
+  auto csv = motes::continue_frame_writer(motes::OutputFormat::Csv, dir, {}, state);
+  ASSERT_FALSE(csv);
+  EXPECT_NE(csv.message().find("bodies.csv"), std::string::npos) << csv.message();
+  EXPECT_NE(csv.message().find("fewer than"), std::string::npos) << csv.message();
+  EXPECT_EQ(read_text(tmp.path() / "particles.csv"), particles);
+}

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -69,6 +70,30 @@ Result<std::unique_ptr<FrameWriter>> open_csv_writer(const std::string& dir,
 /// open_vtu_writer or open_csv_writer; OutputFormat::None is an error (write nothing instead).
 Result<std::unique_ptr<FrameWriter>> open_frame_writer(OutputFormat format, const std::string& dir,
                                                        std::vector<std::string> body_names = {});
+
+/// Where a series of frames stands, so that another process can continue it (motes resume): the
+/// frames written so far and, for CSV, the files' sizes after the last of them.
+struct SeriesState {
+  std::vector<double> frame_times;        ///< simulated time of every frame written, in order
+  std::uint64_t particles_csv_bytes = 0;  ///< CSV: size of particles.csv after the last frame
+  std::uint64_t bodies_csv_bytes = 0;     ///< CSV: size of bodies.csv after the last frame
+};
+
+/// Sizes of particles.csv and bodies.csv in `dir` now (the CSV writer flushes after each frame):
+/// the SeriesState of a CSV series after its last frame.
+Status csv_series_sizes(const std::string& dir, SeriesState& state);
+
+/// Continues a series that open_frame_writer started in `dir`, whose first
+/// state.frame_times.size() frames are kept: the next frame is numbered after them. VTU: those
+/// frames' files must exist (they are not rewritten) and the .pvd files are rewritten to list
+/// them; files of later frames are replaced as the frames come. CSV: particles.csv and bodies.csv
+/// must hold at least the recorded sizes; they are cut to them (rows written after that point
+/// go) and appended to. A missing or short file is an error naming it, and then nothing has been
+/// written. OutputFormat::None is an error, as for open_frame_writer.
+Result<std::unique_ptr<FrameWriter>> continue_frame_writer(OutputFormat format,
+                                                           const std::string& dir,
+                                                           std::vector<std::string> body_names,
+                                                           const SeriesState& state);
 
 /// Writes one snapshot as a single .vtu file (same layout as the series), not listed in any .pvd.
 Status write_vtu_file(const std::string& path, const Snapshot& snapshot);
