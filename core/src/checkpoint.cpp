@@ -1,25 +1,95 @@
-// Checkpoints: the dynamic state of a Simulation in one binary file.
-// Layout: header {magic "MOTESCK1", version, particles, bodies, step, time, payload bytes}, then
-// the body positions, orientations, velocities, angular momenta and angular velocities (B vec4
-// each, the scene's bodies in the scene's order, as in a Snapshot), the particle positions and
-// velocities (N vec4 each, the scene's order), then an FNV-1a 64 hash of the payload.
-#include <fmt/format.h>
+// Checkpoints (docs/reliability.md, "Checkpoint and resume"): everything that defines the future of
+// a run, as raw bits, in one file written atomically.
+//
+// Version 2, in the machine's byte order (little-endian on every supported machine):
+//   header (96 bytes): magic "MOTESCK1", version, header bytes, file bytes, step, time, setup hash,
+//     scene hash, particles, scene bodies, rigid bodies, rigid particles, hash table size T,
+//     neighbour capacity K, clusters, section count, run record bytes;
+//   run record: the backend, then CheckpointRun (strings as u32 length + bytes);
+//   sections: {u32 buffer, u32 element bytes, u64 bytes, the buffer's first `bytes` bytes}, one per
+//     buffer of state_buffers(), in that order, in the device's order (the same on every backend);
+//   checksum: FNV-1a 64 of every byte before it.
+// Version 1 (still read by load_state): a 48-byte header {magic, version, particles, bodies,
+// reserved, step, time, payload bytes}, the scene-ordered body and particle arrays of a Snapshot,
+// and the FNV-1a 64 of that payload.
+#include "motes/checkpoint.h"
 
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <limits>
+#include <sstream>
 #include <vector>
 
 #include "motes/simulation.h"
+#include "shared/neighbours.h"
+#include "shared/shape_matching.h"
 
 namespace motes {
 
 namespace {
 
 constexpr std::array<char, 8> kMagic = {'M', 'O', 'T', 'E', 'S', 'C', 'K', '1'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::size_t kHeaderBytes = 96;
+constexpr std::size_t kSectionHeaderBytes = 16;
+constexpr std::size_t kV1HeaderBytes = 48;
 
+/// The device buffers a checkpoint holds: every buffer that a step reads before it writes it
+/// (docs/architecture.md, "The step"). Not here: the fixed inputs (covered by the setup hash),
+/// forces (written before they are read in every substep) and GridBucket and SortedPos (read only
+/// by the list build that rewrites them).
+constexpr std::array<Buffer, 15> kStateBuffers = {
+    Buffer::ParticlePos,     Buffer::ParticleVel,    Buffer::BodyPos,       Buffer::BodyQuat,
+    Buffer::BodyVel,         Buffer::BodyAngMom,     Buffer::BodyAngVel,    Buffer::ClusterFrames,
+    Buffer::NeighbourRefPos, Buffer::NeighbourState, Buffer::NeighbourList, Buffer::NeighbourCount,
+    Buffer::GridOrder,       Buffer::GridCellStart,  Buffer::SortedBody,
+};
+// load_state checks these sections by position.
+constexpr std::size_t kPosSection = 0;
+constexpr std::size_t kVelSection = 1;
+constexpr std::size_t kListSection = 10;
+constexpr std::size_t kCountSection = 11;
+constexpr std::size_t kOrderSection = 12;
+constexpr std::size_t kStartSection = 13;
+static_assert(kStateBuffers[kPosSection] == Buffer::ParticlePos &&
+              kStateBuffers[kVelSection] == Buffer::ParticleVel &&
+              kStateBuffers[kListSection] == Buffer::NeighbourList &&
+              kStateBuffers[kCountSection] == Buffer::NeighbourCount &&
+              kStateBuffers[kOrderSection] == Buffer::GridOrder &&
+              kStateBuffers[kStartSection] == Buffer::GridCellStart);
+
+/// The fixed part of a version 2 file.
 struct Header {
+  std::array<char, 8> magic{};
+  std::uint32_t version = 0;
+  std::uint32_t header_bytes = 0;
+  std::uint64_t file_bytes = 0;
+  std::uint64_t step = 0;
+  double time = 0.0;
+  std::uint64_t setup_hash = 0;
+  std::uint64_t scene_hash = 0;
+  std::uint32_t particles = 0;
+  std::uint32_t bodies = 0;
+  std::uint32_t rigid_bodies = 0;
+  std::uint32_t rigid_particles = 0;
+  std::uint32_t table = 0;
+  std::uint32_t neighbour_capacity = 0;
+  std::uint32_t clusters = 0;
+  std::uint32_t section_count = 0;
+  std::uint64_t record_bytes = 0;
+};
+static_assert(sizeof(Header) == kHeaderBytes, "checkpoint header layout");
+
+/// Version 1's header.
+struct HeaderV1 {
   std::array<char, 8> magic;
   std::uint32_t version;
   std::uint32_t particles;
@@ -29,99 +99,534 @@ struct Header {
   double time;
   std::uint64_t payload_bytes;
 };
+static_assert(sizeof(HeaderV1) == kV1HeaderBytes, "checkpoint version 1 header layout");
 
-/// The snapshot's arrays in the order the payload stores them.
-std::array<std::vector<shared::vec4>*, 7> payload_arrays(Snapshot& s) {
+/// Appends the run record's fields.
+class RecordWriter {
+ public:
+  void u64(std::uint64_t v) { raw(&v, sizeof v); }
+  void f64(double v) { raw(&v, sizeof v); }
+  void str(const std::string& s) {
+    const auto n = static_cast<std::uint32_t>(s.size());
+    raw(&n, sizeof n);
+    raw(s.data(), s.size());
+  }
+  void raw(const void* p, std::size_t n) {
+    const auto* c = static_cast<const unsigned char*>(p);
+    bytes.insert(bytes.end(), c, c + n);
+  }
+  std::vector<unsigned char> bytes;
+};
+
+/// Reads the run record's fields; any read past its end sets `bad`.
+class RecordReader {
+ public:
+  RecordReader(const unsigned char* p, std::size_t n) : p_(p), n_(n) {}
+  std::uint64_t u64() {
+    std::uint64_t v = 0;
+    raw(&v, sizeof v);
+    return v;
+  }
+  double f64() {
+    double v = 0.0;
+    raw(&v, sizeof v);
+    return v;
+  }
+  std::string str() {
+    std::uint32_t n = 0;
+    raw(&n, sizeof n);
+    if (bad || n > n_ - at_) {
+      bad = true;
+      return {};
+    }
+    std::string s(reinterpret_cast<const char*>(p_ + at_), n);
+    at_ += n;
+    return s;
+  }
+  void raw(void* out, std::size_t n) {
+    if (bad || n > n_ - at_) {
+      bad = true;
+      return;
+    }
+    std::memcpy(out, p_ + at_, n);
+    at_ += n;
+  }
+  [[nodiscard]] std::size_t left() const { return n_ - at_; }
+  bool bad = false;
+
+ private:
+  const unsigned char* p_;
+  std::size_t n_;
+  std::size_t at_ = 0;
+};
+
+std::vector<unsigned char> encode_record(const std::string& backend, const CheckpointRun& run) {
+  RecordWriter w;
+  w.str(backend);
+  w.str(run.scene_path);
+  w.str(run.scene_file);
+  w.u64(run.scene_hash);
+  w.str(run.output_dir);
+  w.str(run.output_format);
+  w.u64(run.every);
+  w.u64(run.total_steps);
+  w.u64(run.checkpoint_every);
+  w.str(run.checkpoint_dir);
+  w.u64(run.series.particles_csv_bytes);
+  w.u64(run.series.bodies_csv_bytes);
+  w.u64(run.series.frame_times.size());
+  for (const double t : run.series.frame_times) w.f64(t);
+  return std::move(w.bytes);
+}
+
+bool decode_record(const unsigned char* p, std::size_t n, CheckpointInfo& info) {
+  RecordReader r(p, n);
+  CheckpointRun& run = info.run;
+  info.backend = r.str();
+  run.scene_path = r.str();
+  run.scene_file = r.str();
+  run.scene_hash = r.u64();
+  run.output_dir = r.str();
+  run.output_format = r.str();
+  run.every = r.u64();
+  run.total_steps = r.u64();
+  run.checkpoint_every = r.u64();
+  run.checkpoint_dir = r.str();
+  run.series.particles_csv_bytes = r.u64();
+  run.series.bodies_csv_bytes = r.u64();
+  const std::uint64_t frames = r.u64();
+  if (r.bad || frames > r.left() / sizeof(double)) return false;
+  run.series.frame_times.resize(frames);
+  for (double& t : run.series.frame_times) t = r.f64();
+  return !r.bad && r.left() == 0;
+}
+
+/// One section of a parsed version 2 file.
+struct Section {
+  std::uint32_t buffer = 0;
+  std::uint32_t element_bytes = 0;
+  std::size_t offset = 0;  ///< of its bytes in the file
+  std::size_t bytes = 0;
+};
+
+/// A checked version 2 file, or a version 1 file's info.
+struct Parsed {
+  Header header;
+  CheckpointInfo info;
+  std::vector<Section> sections;
+};
+
+Result<std::vector<unsigned char>> read_whole_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    return Status::error(fmt::format("{}: cannot read checkpoint: is a directory", path));
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    return Status::error(fmt::format("{}: cannot open checkpoint: {}", path, std::strerror(errno)));
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) {
+    return Status::error(fmt::format("{}: cannot read checkpoint: {}", path, std::strerror(errno)));
+  }
+  const std::string s = std::move(text).str();
+  return std::vector<unsigned char>(s.begin(), s.end());
+}
+
+/// Magic, version, size and checksum, then the record and the section table. Version 1 files get
+/// their magic, size and payload hash checked and their header returned in `info`.
+Result<Parsed> parse(const std::string& path, const std::vector<unsigned char>& bytes) {
+  Parsed out;
+  const std::size_t size = bytes.size();
+  if (size < 12 || std::memcmp(bytes.data(), kMagic.data(), kMagic.size()) != 0) {
+    return Status::error(fmt::format(
+        "{}: not a motes checkpoint (it does not start with \"MOTESCK1\"; {} bytes)", path, size));
+  }
+  std::uint32_t version = 0;
+  std::memcpy(&version, bytes.data() + 8, sizeof version);
+  out.info.version = version;
+  out.info.file_bytes = size;
+  if (version == 1) {
+    HeaderV1 h{};
+    if (size < kV1HeaderBytes + 8) {
+      return Status::error(fmt::format("{}: truncated checkpoint ({} bytes)", path, size));
+    }
+    std::memcpy(&h, bytes.data(), sizeof h);
+    if (h.payload_bytes != size - kV1HeaderBytes - 8) {
+      return Status::error(
+          fmt::format("{}: truncated or corrupt checkpoint ({} bytes; its header says {})", path,
+                      size, h.payload_bytes + kV1HeaderBytes + 8));
+    }
+    std::uint64_t stored = 0;
+    std::memcpy(&stored, bytes.data() + size - 8, sizeof stored);
+    if (stored != fnv1a64(bytes.data() + kV1HeaderBytes, size - kV1HeaderBytes - 8)) {
+      return Status::error(fmt::format("{}: corrupt checkpoint (checksum mismatch)", path));
+    }
+    out.info.step = h.step;
+    out.info.time = h.time;
+    out.info.particles = h.particles;
+    out.info.bodies = h.bodies;
+    return out;
+  }
+  if (version != kCheckpointVersion) {
+    return Status::error(
+        fmt::format("{}: checkpoint format version {}; this motes reads versions 1 and {}", path,
+                    version, kCheckpointVersion));
+  }
+  if (size < kHeaderBytes + 8) {
+    return Status::error(
+        fmt::format("{}: truncated checkpoint ({} bytes, less than its {}-byte header)", path, size,
+                    kHeaderBytes + 8));
+  }
+  Header& h = out.header;
+  std::memcpy(&h, bytes.data(), sizeof h);
+  if (h.file_bytes > size) {
+    return Status::error(
+        fmt::format("{}: truncated checkpoint ({} of {} bytes)", path, size, h.file_bytes));
+  }
+  if (h.file_bytes != size || h.header_bytes != kHeaderBytes) {
+    return Status::error(fmt::format(
+        "{}: corrupt checkpoint ({} bytes, but its header says {} with a {}-byte header)", path,
+        size, h.file_bytes, h.header_bytes));
+  }
+  std::uint64_t stored = 0;
+  std::memcpy(&stored, bytes.data() + size - 8, sizeof stored);
+  const std::uint64_t computed = fnv1a64(bytes.data(), size - 8);
+  if (stored != computed) {
+    return Status::error(fmt::format(
+        "{}: corrupt checkpoint (checksum mismatch: stored {:016x}, computed {:016x}): the file "
+        "was changed or damaged after it was written",
+        path, stored, computed));
+  }
+  // The checksum is right: what follows fails only for a file made to pass it.
+  const auto corrupt = [&](const char* what) {
+    return Status::error(fmt::format("{}: corrupt checkpoint ({})", path, what));
+  };
+  const std::size_t body_end = size - 8;
+  if (h.record_bytes > body_end - kHeaderBytes) return corrupt("run record size");
+  if (!decode_record(bytes.data() + kHeaderBytes, h.record_bytes, out.info)) {
+    return corrupt("run record");
+  }
+  std::size_t at = kHeaderBytes + h.record_bytes;
+  if (h.section_count > kStateBuffers.size() * 4) return corrupt("section count");
+  for (std::uint32_t k = 0; k < h.section_count; ++k) {
+    if (body_end - at < kSectionHeaderBytes) return corrupt("section table");
+    Section s;
+    std::uint64_t n = 0;
+    std::memcpy(&s.buffer, bytes.data() + at, 4);
+    std::memcpy(&s.element_bytes, bytes.data() + at + 4, 4);
+    std::memcpy(&n, bytes.data() + at + 8, 8);
+    at += kSectionHeaderBytes;
+    if (n > body_end - at) return corrupt("section size");
+    s.offset = at;
+    s.bytes = static_cast<std::size_t>(n);
+    at += s.bytes;
+    out.sections.push_back(s);
+  }
+  if (at != body_end) return corrupt("bytes after the last section");
+  out.info.step = h.step;
+  out.info.time = h.time;
+  out.info.particles = h.particles;
+  out.info.bodies = h.bodies;
+  out.info.setup_hash = h.setup_hash;
+  out.info.run.scene_hash = h.scene_hash;
+  return out;
+}
+
+/// A file written through a POSIX descriptor, hashing every byte; errors name the file.
+class HashedFile {
+ public:
+  explicit HashedFile(std::string path) : path_(std::move(path)) {}
+  HashedFile(const HashedFile&) = delete;
+  HashedFile& operator=(const HashedFile&) = delete;
+  ~HashedFile() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+
+  Status open() {
+    fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd_ < 0) return error("create");
+    return Status::ok();
+  }
+  Status write(const void* data, std::size_t n, bool hashed = true) {
+    if (hashed) hash_ = fnv1a64(data, n, hash_);
+    const auto* p = static_cast<const unsigned char*>(data);
+    while (n > 0) {
+      const ::ssize_t w = ::write(fd_, p, n);
+      if (w < 0 && errno == EINTR) continue;
+      if (w <= 0) return error("write");
+      p += w;
+      n -= static_cast<std::size_t>(w);
+    }
+    return Status::ok();
+  }
+  /// fsync, then close.
+  Status sync_and_close() {
+    if (::fsync(fd_) != 0) return error("flush (fsync)");
+    const int fd = fd_;
+    fd_ = -1;
+    if (::close(fd) != 0) return error("close");
+    return Status::ok();
+  }
+  [[nodiscard]] std::uint64_t hash() const { return hash_; }
+
+ private:
+  Status error(const char* what) const {
+    return Status::error(
+        fmt::format("cannot {} checkpoint '{}': {}", what, path_, std::strerror(errno)));
+  }
+  std::string path_;
+  int fd_ = -1;
+  std::uint64_t hash_ = fnv1a64(nullptr, 0);
+};
+
+/// fsync on the directory that holds `path`, so that a rename in it is on the disk.
+Status sync_directory_of(const std::string& path) {
+  std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) {
+    return Status::error(fmt::format("cannot open directory '{}' to flush it: {}", dir.string(),
+                                     std::strerror(errno)));
+  }
+  const int r = ::fsync(fd);
+  const int error = errno;
+  ::close(fd);
+  // Some file systems cannot fsync a directory (EINVAL): the rename is then as safe as they make
+  // it.
+  if (r != 0 && error != EINVAL) {
+    return Status::error(
+        fmt::format("cannot flush directory '{}': {}", dir.string(), std::strerror(error)));
+  }
+  return Status::ok();
+}
+
+/// The snapshot's arrays in the order a version 1 payload stores them.
+std::array<std::vector<shared::vec4>*, 7> payload_arrays_v1(Snapshot& s) {
   return {&s.body_pos,    &s.body_quat,    &s.body_vel,    &s.body_angmom,
           &s.body_angvel, &s.particle_pos, &s.particle_vel};
 }
 
-std::uint64_t hash_bytes(const std::vector<unsigned char>& v) {
-  std::uint64_t h = 14695981039346656037ull;
-  for (unsigned char c : v) {
-    h ^= c;
+}  // namespace
+
+std::uint64_t fnv1a64(const void* data, std::size_t bytes, std::uint64_t seed) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  std::uint64_t h = seed;
+  for (std::size_t i = 0; i < bytes; ++i) {
+    h ^= p[i];
     h *= 1099511628211ull;
   }
   return h;
 }
 
-}  // namespace
-
-Status Simulation::save_state(const std::string& path) {
-  Result<Snapshot> snap = snapshot();
-  if (!snap) return snap.status();
-  const std::size_t b_bytes = bodies_.size() * 16;
-  const std::size_t p_bytes = std::size_t{sizes_.particles} * 16;
-  std::vector<unsigned char> payload(5 * b_bytes + 2 * p_bytes);
-  std::size_t at = 0;
-  for (const std::vector<shared::vec4>* v : payload_arrays(snap.value())) {
-    std::memcpy(payload.data() + at, v->data(), v->size() * 16);
-    at += v->size() * 16;
+Result<std::uint64_t> scene_file_hash(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::error(fmt::format("{}: cannot open: {}", path, std::strerror(errno)));
+  std::uint64_t h = fnv1a64(nullptr, 0);
+  std::vector<char> buf(std::size_t{1} << 16);
+  while (in) {
+    in.read(buf.data(), static_cast<std::streamsize>(buf.size()));
+    h = fnv1a64(buf.data(), static_cast<std::size_t>(in.gcount()), h);
   }
-  Header h{};
+  if (in.bad())
+    return Status::error(fmt::format("{}: cannot read: {}", path, std::strerror(errno)));
+  return h;
+}
+
+Result<CheckpointInfo> read_checkpoint_info(const std::string& path) {
+  Result<std::vector<unsigned char>> bytes = read_whole_file(path);
+  if (!bytes) return bytes.status();
+  Result<Parsed> parsed = parse(path, bytes.value());
+  if (!parsed) return parsed.status();
+  return parsed->info;
+}
+
+Status Simulation::save_state(const std::string& path) { return save_state(path, CheckpointRun{}); }
+
+Status Simulation::save_state(const std::string& path, const CheckpointRun& run) {
+  if (Status s = device_->synchronize(); !s) return s;
+  const std::vector<unsigned char> record = encode_record(device_->info().backend, run);
+  Header h;
   h.magic = kMagic;
-  h.version = kVersion;
-  h.particles = sizes_.particles;
-  h.bodies = static_cast<std::uint32_t>(bodies_.size());
+  h.version = kCheckpointVersion;
+  h.header_bytes = kHeaderBytes;
   h.step = steps_;
   h.time = time_;
-  h.payload_bytes = payload.size();
-  const std::uint64_t hash = hash_bytes(payload);
+  h.setup_hash = setup_hash_;
+  h.scene_hash = run.scene_hash;
+  h.particles = sizes_.particles;
+  h.bodies = static_cast<std::uint32_t>(bodies_.size());
+  h.rigid_bodies = sizes_.bodies;
+  h.rigid_particles = sizes_.rigid_particles;
+  h.table = sizes_.table;
+  h.neighbour_capacity = sizes_.neighbour_capacity;
+  h.clusters = sizes_.clusters;
+  h.section_count = static_cast<std::uint32_t>(kStateBuffers.size());
+  h.record_bytes = record.size();
+  std::uint64_t file_bytes = kHeaderBytes + record.size() + 8;
+  for (const Buffer b : kStateBuffers) {
+    file_bytes += kSectionHeaderBytes + buffer_layout(b, sizes_).bytes();
+  }
+  h.file_bytes = file_bytes;
+
+  // Written beside the target and renamed over it only when complete and on the disk.
   const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return Status::error(fmt::format("{}: cannot create checkpoint", path));
-    out.write(reinterpret_cast<const char*>(&h), sizeof h);
-    out.write(reinterpret_cast<const char*>(payload.data()),
-              static_cast<std::streamsize>(payload.size()));
-    out.write(reinterpret_cast<const char*>(&hash), sizeof hash);
-    if (!out.flush()) return Status::error(fmt::format("{}: write failed", tmp));
+  Status s = [&]() -> Status {
+    HashedFile file(tmp);
+    if (Status st = file.open(); !st) return st;
+    if (Status st = file.write(&h, sizeof h); !st) return st;
+    if (Status st = file.write(record.data(), record.size()); !st) return st;
+    std::vector<unsigned char> data;
+    for (const Buffer b : kStateBuffers) {
+      const BufferLayout layout = buffer_layout(b, sizes_);
+      const std::uint32_t section[2] = {static_cast<std::uint32_t>(b),
+                                        static_cast<std::uint32_t>(layout.element_bytes)};
+      const std::uint64_t bytes = layout.bytes();
+      if (Status st = file.write(section, sizeof section); !st) return st;
+      if (Status st = file.write(&bytes, sizeof bytes); !st) return st;
+      if (bytes == 0) continue;
+      data.resize(layout.bytes());
+      if (Status st = device_->read(b, data.data(), data.size()); !st) return st;
+      if (Status st = file.write(data.data(), data.size()); !st) return st;
+    }
+    const std::uint64_t checksum = file.hash();
+    if (Status st = file.write(&checksum, sizeof checksum, false); !st) return st;
+    return file.sync_and_close();
+  }();
+  if (s && std::rename(tmp.c_str(), path.c_str()) != 0) {
+    s = Status::error(
+        fmt::format("cannot rename checkpoint '{}' to '{}': {}", tmp, path, std::strerror(errno)));
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    return Status::error(fmt::format("{}: cannot rename from {}", path, tmp));
+  if (!s) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    return s;
   }
-  return Status::ok();
+  return sync_directory_of(path);
 }
 
 Status Simulation::load_state(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::error(fmt::format("{}: cannot open checkpoint", path));
-  Header h{};
-  if (!in.read(reinterpret_cast<char*>(&h), sizeof h) || h.magic != kMagic) {
-    return Status::error(fmt::format("{}: not a motes checkpoint", path));
-  }
-  if (h.version != kVersion) {
-    return Status::error(
-        fmt::format("{}: checkpoint version {} (this motes reads {})", path, h.version, kVersion));
-  }
-  if (h.particles != sizes_.particles || h.bodies != bodies_.size()) {
+  Result<std::vector<unsigned char>> read = read_whole_file(path);
+  if (!read) return read.status();
+  const std::vector<unsigned char>& bytes = read.value();
+  Result<Parsed> parsed = parse(path, bytes);
+  if (!parsed) return parsed.status();
+  if (parsed->info.version == 1) return load_state_v1(path, bytes);
+  const Header& h = parsed->header;
+  if (h.particles != sizes_.particles || h.bodies != bodies_.size() ||
+      h.rigid_bodies != sizes_.bodies || h.rigid_particles != sizes_.rigid_particles ||
+      h.table != sizes_.table || h.neighbour_capacity != sizes_.neighbour_capacity ||
+      h.clusters != sizes_.clusters) {
     return Status::error(fmt::format(
-        "{}: checkpoint of {} particles and {} bodies does not fit this scene ({} and {})", path,
-        h.particles, h.bodies, sizes_.particles, bodies_.size()));
+        "{}: checkpoint of another scene: {} particles, {} bodies ({} rigid, {} rigid particles), "
+        "{} clusters, {} list entries per particle; this simulation has {}, {} ({}, {}), {}, {}",
+        path, h.particles, h.bodies, h.rigid_bodies, h.rigid_particles, h.clusters,
+        h.neighbour_capacity, sizes_.particles, bodies_.size(), sizes_.bodies,
+        sizes_.rigid_particles, sizes_.clusters, sizes_.neighbour_capacity));
+  }
+  if (h.setup_hash != setup_hash_) {
+    return Status::error(fmt::format(
+        "{}: checkpoint of another scene: its setup fingerprint {:016x} is not this "
+        "simulation's {:016x} (same sizes, but shapes, materials, planes, constraints, clusters "
+        "or settings differ)",
+        path, h.setup_hash, setup_hash_));
+  }
+  const std::vector<Section>& sections = parsed->sections;
+  const auto corrupt = [&](const std::string& what) {
+    return Status::error(fmt::format("{}: corrupt checkpoint ({})", path, what));
+  };
+  if (sections.size() != kStateBuffers.size()) return corrupt("section count");
+  for (std::size_t k = 0; k < sections.size(); ++k) {
+    const BufferLayout layout = buffer_layout(kStateBuffers[k], sizes_);
+    if (sections[k].buffer != static_cast<std::uint32_t>(kStateBuffers[k]) ||
+        sections[k].element_bytes != layout.element_bytes || sections[k].bytes != layout.bytes()) {
+      return corrupt(fmt::format("section {} is not {} of {} bytes", k,
+                                 buffer_name(kStateBuffers[k]), layout.bytes()));
+    }
+  }
+  // Values a step uses as indices must be in range, whatever a file made to pass the checksum
+  // holds; radii and masses must be the scene's.
+  const auto words = [&](std::size_t k) {
+    std::vector<std::uint32_t> v(sections[k].bytes / 4);
+    if (!v.empty()) std::memcpy(v.data(), bytes.data() + sections[k].offset, sections[k].bytes);
+    return v;
+  };
+  const auto vec4s = [&](std::size_t k) {
+    std::vector<shared::vec4> v(sections[k].bytes / 16);
+    if (!v.empty()) std::memcpy(v.data(), bytes.data() + sections[k].offset, sections[k].bytes);
+    return v;
+  };
+  const std::size_t n = sizes_.particles;
+  {
+    const std::vector<shared::vec4> pos = vec4s(kPosSection);
+    const std::vector<shared::vec4> vel = vec4s(kVelSection);
+    std::uint64_t w = fnv1a64(nullptr, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      const float pair[2] = {pos[i].w, vel[i].w};
+      w = fnv1a64(pair, sizeof pair, w);
+    }
+    if (w != particle_w_hash_) {
+      return Status::error(fmt::format(
+          "{}: checkpoint of another scene: its particles' radii or masses are not this "
+          "simulation's",
+          path));
+    }
+  }
+  {
+    const std::vector<std::uint32_t> list = words(kListSection);
+    const std::vector<std::uint32_t> count = words(kCountSection);
+    const std::vector<std::uint32_t> order = words(kOrderSection);
+    const std::vector<std::uint32_t> start = words(kStartSection);
+    const std::size_t capacity = sizes_.neighbour_capacity;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t listed = std::min<std::size_t>(count[i], capacity);
+      for (std::size_t k = 0; k < listed; ++k) {
+        if (list[k * n + i] >= n) return corrupt("a neighbour list entry out of range");
+      }
+      if (order[i] >= n) return corrupt("a grid entry out of range");
+    }
+    for (std::size_t b = 0; b < start.size(); ++b) {
+      if (start[b] > n || (b > 0 && start[b] < start[b - 1])) {
+        return corrupt("the grid's bucket starts");
+      }
+    }
+  }
+  Device& d = *device_;
+  for (std::size_t k = 0; k < sections.size(); ++k) {
+    if (sections[k].bytes == 0) continue;
+    if (Status s = d.write(kStateBuffers[k], bytes.data() + sections[k].offset, sections[k].bytes);
+        !s) {
+      return s;
+    }
+  }
+  if (Status s = d.synchronize(); !s) return s;
+  steps_ = h.step;
+  time_ = h.time;
+  return Status::ok();
+}
+
+Status Simulation::load_state_v1(const std::string& path, const std::vector<unsigned char>& bytes) {
+  HeaderV1 h{};
+  std::memcpy(&h, bytes.data(), sizeof h);
+  if (h.particles != sizes_.particles || h.bodies != bodies_.size()) {
+    return Status::error(
+        fmt::format("{}: checkpoint of another scene: {} particles and {} bodies; this simulation "
+                    "has {} and {}",
+                    path, h.particles, h.bodies, sizes_.particles, bodies_.size()));
   }
   const std::size_t b_bytes = bodies_.size() * 16;
   const std::size_t p_bytes = std::size_t{sizes_.particles} * 16;
   if (h.payload_bytes != 5 * b_bytes + 2 * p_bytes) {
     return Status::error(fmt::format("{}: corrupt checkpoint (payload size)", path));
   }
-  std::vector<unsigned char> payload(h.payload_bytes);
-  std::uint64_t hash = 0;
-  if (!in.read(reinterpret_cast<char*>(payload.data()),
-               static_cast<std::streamsize>(payload.size())) ||
-      !in.read(reinterpret_cast<char*>(&hash), sizeof hash)) {
-    return Status::error(fmt::format("{}: truncated checkpoint", path));
-  }
-  if (hash != hash_bytes(payload)) {
-    return Status::error(fmt::format("{}: corrupt checkpoint (hash mismatch)", path));
-  }
   Snapshot state;
-  std::size_t at = 0;
-  for (std::vector<shared::vec4>* v : payload_arrays(state)) {
-    const std::size_t bytes =
-        v == &state.particle_pos || v == &state.particle_vel ? p_bytes : b_bytes;
-    v->resize(bytes / 16);
-    std::memcpy(v->data(), payload.data() + at, bytes);
-    at += bytes;
+  std::size_t at = kV1HeaderBytes;
+  for (std::vector<shared::vec4>* v : payload_arrays_v1(state)) {
+    const std::size_t n = v == &state.particle_pos || v == &state.particle_vel ? p_bytes : b_bytes;
+    v->resize(n / 16);
+    std::memcpy(v->data(), bytes.data() + at, n);
+    at += n;
   }
   if (Status s = restore(state); !s) return s;
   steps_ = h.step;

@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "contact_laws.h"
+#include "motes/checkpoint.h"
 #include "motes/cloth.h"
 #include "motes/soft.h"
 #include "shared/body_math.h"
@@ -397,6 +398,39 @@ Status Simulation::upload(const Scene& scene) {
   sizes_.clusters = static_cast<std::uint32_t>(soft.clusters.size());
   sizes_.cluster_members = static_cast<std::uint32_t>(soft.members.size());
   if (Status st = check_memory(); !st) return st;
+
+  // The setup's fingerprint: every fixed input of a step (checkpoints load only where it is
+  // equal). Computed from the host's copies, so it is the same on every backend.
+  std::uint64_t h = fnv1a64(&sizes_, sizeof sizes_);
+  h = fnv1a64(&params_, sizeof params_, h);
+  const std::int64_t counts[2] = {settings_.substeps, settings_.constraint_iterations};
+  h = fnv1a64(counts, sizeof counts, h);
+  h = fnv1a64(&settings_.dt, sizeof settings_.dt, h);
+  const auto add = [&h](const auto& v) { h = fnv1a64(v.data(), v.size() * sizeof(v[0]), h); };
+  add(plocal);
+  add(pbody);
+  add(pmat);
+  add(binertia);
+  add(rigid_first_);
+  add(laws);
+  add(planes);
+  add(colouring.constraints);
+  add(colour_first_);
+  add(soft.clusters);
+  add(soft.members);
+  add(gather);
+  for (const auto& [body, q] : sphere_turns_) {
+    h = fnv1a64(&body, sizeof body, h);
+    h = fnv1a64(&q, sizeof q, h);
+  }
+  std::uint64_t w = fnv1a64(nullptr, 0);
+  for (std::size_t i = 0; i < ppos.size(); ++i) {
+    const float pair[2] = {ppos[i].w, pvel[i].w};
+    w = fnv1a64(pair, sizeof pair, w);
+  }
+  particle_w_hash_ = w;
+  setup_hash_ = fnv1a64(&w, sizeof w, h);
+
   const std::uint32_t neighbour_state[4] = {1u, 0u, 0u, 0u};  // build at the first step
   Status s = d.allocate(sizes_);
   if (s) s = write_vector(d, Buffer::ParticlePos, ppos);

@@ -1,10 +1,12 @@
 // Fuzz target: checkpoint bytes -> motes::Simulation::load_state (docs/fuzzing.md).
 //
-// One Simulation of a small fixed scene (a repeated box, a static box, a free sphere, a rope and a
-// cloth: every kind of body a checkpoint restores) on the OpenMP backend with one thread. Each
-// input is loaded as it is, and again with its last 8 bytes replaced by the FNV-1a hash of the
-// bytes between the 48-byte header and them, so that mutations get past the hash check and reach
-// the payload. A state that loads is stepped once and checked (check_finite, snapshot, save_state).
+// One Simulation of a small fixed scene (a repeated box, a static box, a free sphere, a rope, a
+// cloth and a soft box: every kind of body a checkpoint restores) on the OpenMP backend with one
+// thread. Each input is loaded as it is, and again with its checksum made right, so that mutations
+// get past it and reach the payload: for version 2 the header's file size is set to the input's
+// size and the last 8 bytes to the FNV-1a 64 of every byte before them; for version 1 the last 8
+// bytes to the FNV-1a 64 of the bytes between the 48-byte header and them. A state that loads is
+// stepped once and checked (check_finite, snapshot, save_state).
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -37,13 +39,17 @@ constexpr const char* kScene = R"({
      "rope": {"from": [0, 0.2, 0], "to": [0.04, 0.2, 0], "particles": 5, "pin": [0]}},
     {"name": "cloth", "kind": "cloth",
      "cloth": {"corner": [0, 0.3, 0], "edge_u": [0.02, 0, 0], "edge_v": [0, 0, 0.02],
-               "particles": [3, 3], "pin": [[0, 0]]}}
+               "particles": [3, 3], "pin": [[0, 0]]}},
+    {"name": "jelly", "kind": "soft", "shape": {"type": "box", "particles": [2, 2, 3]},
+     "position": [0.1, 0.1, 0], "soft": {"mode": "quadratic", "beta": 0.5, "clusters": [1, 1, 2]}}
   ]
 })";
 
-/// Size of checkpoint.cpp's header: magic, version, particles, bodies, reserved, step, time,
-/// payload bytes.
-constexpr std::size_t kHeaderBytes = 48;
+/// Size of a version 1 header: magic, version, particles, bodies, reserved, step, time, payload
+/// bytes.
+constexpr std::size_t kV1HeaderBytes = 48;
+/// Version 2: the header's file size field.
+constexpr std::size_t kFileBytesOffset = 16;
 
 [[noreturn]] void broken(const char* what, const std::string& message = {}) {
   std::fprintf(stderr, "motes fuzz checkpoint: %s %s\n", what, message.c_str());
@@ -99,9 +105,19 @@ int checkpoint(const std::uint8_t* data, std::size_t size) {
   const std::filesystem::path path = work_dir() / "state.ck";
   write_file(path, data, size);
   load(sim, path);
-  if (size >= kHeaderBytes + 8) {
+  std::uint32_t version = 0;
+  if (size >= 12) std::memcpy(&version, data + 8, sizeof version);
+  if (version == 1 && size >= kV1HeaderBytes + 8) {
     std::vector<std::uint8_t> fixed(data, data + size);
-    const std::uint64_t hash = fnv1a(fixed.data() + kHeaderBytes, size - kHeaderBytes - 8);
+    const std::uint64_t hash = fnv1a(fixed.data() + kV1HeaderBytes, size - kV1HeaderBytes - 8);
+    std::memcpy(fixed.data() + size - 8, &hash, sizeof hash);
+    write_file(path, fixed.data(), fixed.size());
+    load(sim, path);
+  } else if (version != 1 && size >= kFileBytesOffset + 16) {
+    std::vector<std::uint8_t> fixed(data, data + size);
+    const std::uint64_t bytes = size;
+    std::memcpy(fixed.data() + kFileBytesOffset, &bytes, sizeof bytes);
+    const std::uint64_t hash = fnv1a(fixed.data(), size - 8);
     std::memcpy(fixed.data() + size - 8, &hash, sizeof hash);
     write_file(path, fixed.data(), fixed.size());
     load(sim, path);
@@ -117,6 +133,33 @@ void write_checkpoint_seeds(const std::filesystem::path& dir) {
     if (const Status s = sim.save_state(path); !s) broken("cannot write a seed:", s.message());
     if (const Status s = sim.step(100); !s) broken("cannot step:", s.message());
   }
+  // A version 1 file (the format motes bench's caches may still hold): the snapshot's body and
+  // particle arrays after a 48-byte header, then the FNV-1a 64 of those arrays.
+  const Result<Snapshot> snap = sim.snapshot();
+  if (!snap) broken("snapshot for a seed:", snap.message());
+  std::vector<std::uint8_t> payload;
+  for (const std::vector<shared::vec4>* v :
+       {&snap->body_pos, &snap->body_quat, &snap->body_vel, &snap->body_angmom, &snap->body_angvel,
+        &snap->particle_pos, &snap->particle_vel}) {
+    const auto* p = reinterpret_cast<const std::uint8_t*>(v->data());
+    payload.insert(payload.end(), p, p + v->size() * sizeof(shared::vec4));
+  }
+  std::vector<std::uint8_t> file(kV1HeaderBytes, 0);
+  const char magic[8] = {'M', 'O', 'T', 'E', 'S', 'C', 'K', '1'};
+  const std::uint32_t words[4] = {1, sim.particle_count(), sim.body_count(), 0};
+  const std::uint64_t step = sim.steps();
+  const double time = sim.time();
+  const std::uint64_t payload_bytes = payload.size();
+  std::memcpy(file.data(), magic, 8);
+  std::memcpy(file.data() + 8, words, 16);
+  std::memcpy(file.data() + 24, &step, 8);
+  std::memcpy(file.data() + 32, &time, 8);
+  std::memcpy(file.data() + 40, &payload_bytes, 8);
+  file.insert(file.end(), payload.begin(), payload.end());
+  const std::uint64_t hash = fnv1a(payload.data(), payload.size());
+  const auto* h = reinterpret_cast<const std::uint8_t*>(&hash);
+  file.insert(file.end(), h, h + 8);
+  write_file(dir / "state_v1.ck", file.data(), file.size());
 }
 
 }  // namespace motes::fuzz

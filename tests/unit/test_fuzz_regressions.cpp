@@ -70,7 +70,7 @@ TEST(FuzzRegressions, GeneratedSeeds) {
   const fs::path dir = motes::fuzz::work_dir() / "seeds";
   motes::fuzz::write_checkpoint_seeds(dir / "checkpoint");
   motes::fuzz::write_frame_seeds(dir / "frames");
-  EXPECT_EQ(replay(dir / "checkpoint", motes::fuzz::checkpoint), 3u);
+  EXPECT_EQ(replay(dir / "checkpoint", motes::fuzz::checkpoint), 4u);
   EXPECT_EQ(replay(dir / "frames", motes::fuzz::frames), 5u);
 }
 

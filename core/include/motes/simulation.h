@@ -61,6 +61,8 @@ struct NeighbourStats {
   std::uint32_t max_count = 0;      ///< the largest neighbour count at the last build
 };
 
+struct CheckpointRun;  // motes/checkpoint.h
+
 class Simulation {
  public:
   /// Builds the particles and bodies of a scene and uploads them to the device.
@@ -86,12 +88,26 @@ class Simulation {
   Status set_body_velocities(const std::vector<Eigen::Vector3d>& velocity,
                              const std::vector<Eigen::Vector3d>& angular = {});
 
-  /// Writes the dynamic state (bodies, particles, step, time) to a checkpoint file.
+  /// Writes a checkpoint (motes/checkpoint.h, docs/reliability.md): the step, the time, and every
+  /// device buffer that a later step reads before writing it, as raw bits (particles, bodies,
+  /// the soft bodies' last fits, the neighbour lists with the grid of their build), with the
+  /// setup's fingerprint and `run` (the caller's description of the run). Atomic: the file is
+  /// written beside `path` as `path`.tmp, flushed to the disk (fsync), renamed over `path`, and
+  /// the directory is flushed; a crash at any moment leaves the old `path` or the new one.
   Status save_state(const std::string& path);
-  /// Restores a checkpoint written by save_state for the same scene (same particle and body
-  /// counts). A missing, truncated or corrupt file, or one of another scene, is refused and the
-  /// running state is left untouched. The neighbour lists are rebuilt at the next step.
+  Status save_state(const std::string& path, const CheckpointRun& run);
+  /// Restores a checkpoint written by save_state for the same scene (same sizes and setup
+  /// fingerprint), on any backend: stepping on from it on the backend that wrote it gives
+  /// bitwise the state the uninterrupted run has at the same step. A missing, truncated, corrupt
+  /// (checksum) or foreign file, another format version, or a checkpoint of another scene is
+  /// refused with a message naming the file and the reason, and the running state is left
+  /// untouched. Version 1 files (bodies and particles only) are still read; the neighbour lists
+  /// are then rebuilt at the next step.
   Status load_state(const std::string& path);
+  /// Fingerprint (FNV-1a 64) of everything fixed when the simulation was created: sizes, step
+  /// parameters, materials, planes, body frames, constraints, clusters, particle radii and
+  /// masses. Equal on every backend; a checkpoint loads only where it is equal.
+  [[nodiscard]] std::uint64_t setup_hash() const { return setup_hash_; }
 
   [[nodiscard]] double time() const { return time_; }
   [[nodiscard]] std::uint64_t steps() const { return steps_; }
@@ -120,6 +136,8 @@ class Simulation {
   /// Writes a scene-ordered state (a snapshot or a checkpoint's) to the device and asks for a
   /// neighbour-list rebuild.
   Status restore(const Snapshot& state);
+  /// load_state for a version 1 file (bytes: the whole file).
+  Status load_state_v1(const std::string& path, const std::vector<unsigned char>& bytes);
 
   std::unique_ptr<Device> device_;
   Settings settings_;
@@ -139,6 +157,10 @@ class Simulation {
   /// (scene body, orientation) of the free spheres that are not at the identity orientation; a
   /// free sphere never turns.
   std::vector<std::pair<std::uint32_t, shared::vec4>> sphere_turns_;
+  /// setup_hash(), and the FNV-1a 64 of the particles' radii and inverse masses (the w of
+  /// ParticlePos and ParticleVel, device order), which a checkpoint's particles must match.
+  std::uint64_t setup_hash_ = 0;
+  std::uint64_t particle_w_hash_ = 0;
   double time_ = 0.0;
   std::uint64_t steps_ = 0;
 };
