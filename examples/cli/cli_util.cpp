@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <system_error>
 
 namespace motes::cli {
 
@@ -14,6 +16,27 @@ void fail(const std::string& message) {
   fmt::print(stderr, "motes: error: {}\n", message);
   // CLI::App::exit() returns a RuntimeError's code without printing anything more.
   throw CLI::RuntimeError(kErrorExit);
+}
+
+std::uint64_t steps_of_duration(double duration, double dt) {
+  const double n = std::round(duration / dt);
+  if (!(n <= kMaxSteps)) {
+    fail(fmt::format("a duration of {} s at dt = {} s is {:.3g} steps: too many", duration, dt, n));
+  }
+  return static_cast<std::uint64_t>(n);
+}
+
+std::uint64_t checked_steps(std::uint64_t steps, const char* option) {
+  if (static_cast<double>(steps) > kMaxSteps) {
+    fail(fmt::format("{} {} is more than {:.0e} steps", option, steps, kMaxSteps));
+  }
+  return steps;
+}
+
+std::string absolute_path(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path p = std::filesystem::absolute(path, ec);
+  return ec ? path : p.lexically_normal().string();
 }
 
 std::string format_seconds(double seconds) {

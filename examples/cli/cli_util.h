@@ -13,6 +13,17 @@ constexpr int kErrorExit = 2;
 /// Prints "motes: error: MESSAGE" on stderr and ends the command with exit code 2.
 [[noreturn]] void fail(const std::string& message);
 
+/// More steps than this in one run is a mistake in the arguments or the scene (dt too small).
+constexpr double kMaxSteps = 1e13;
+
+/// round(duration / dt) steps; fail() when that is more than kMaxSteps.
+std::uint64_t steps_of_duration(double duration, double dt);
+/// `steps`, or fail() when it is more than kMaxSteps (`option` names it in the message).
+std::uint64_t checked_steps(std::uint64_t steps, const char* option);
+
+/// `path` made absolute (from the current directory) and normalized.
+std::string absolute_path(const std::string& path);
+
 /// A duration for people: "850 ms", "12.3 s", "4 min 05 s", "2 h 03 min".
 std::string format_seconds(double seconds);
 

@@ -4,20 +4,21 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <set>
 #include <string>
 
 #include "cli_util.h"
 #include "commands.h"
+#include "motes/checkpoint.h"
 #include "motes/devices.h"
 #include "motes/output.h"
 #include "motes/scene.h"
 #include "motes/simulation.h"
-#include "progress.h"
 #include "render_args.h"
+#include "run_session.h"
 
 namespace motes::cli {
 
@@ -36,45 +37,21 @@ struct RunArgs {
   std::uint64_t every = 0;
   std::string format = "vtu";
   std::string render_dir;
+  std::uint64_t checkpoint_every = 0;
+  std::string checkpoint_dir;
   RenderArgs render;
   CLI::Option* steps_option = nullptr;
   CLI::Option* duration_option = nullptr;
   CLI::Option* every_option = nullptr;
 };
 
-// More steps than this in one run is a mistake in the arguments or the scene (dt too small).
-constexpr double kMaxSteps = 1e13;
-// Steps go to the device in chunks sized to take about this long, so that progress, Ctrl-C
-// and device errors are seen promptly without a call per step.
-constexpr double kChunkSeconds = 0.1;
-constexpr std::uint64_t kMaxChunk = std::uint64_t{1} << 20;
-
-volatile std::sig_atomic_t g_interrupted = 0;
-
-extern "C" void on_interrupt(int /*signal*/) {
-  g_interrupted = 1;
-  // A second Ctrl-C ends the process at once.
-  std::signal(SIGINT, SIG_DFL);
-}
-
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
 std::uint64_t total_steps(const RunArgs& a, const Settings& s) {
-  if (a.steps_option->count() > 0) {
-    if (static_cast<double>(a.steps) > kMaxSteps) {
-      fail(fmt::format("--steps {} is more than {:.0e} steps", a.steps, kMaxSteps));
-    }
-    return a.steps;
-  }
-  const double duration = a.duration_option->count() > 0 ? a.duration : s.duration;
-  const double n = std::round(duration / s.dt);
-  if (!(n <= kMaxSteps)) {
-    fail(fmt::format("a duration of {} s at dt = {} s is {:.3g} steps: too many", duration, s.dt,
-                     n));
-  }
-  return static_cast<std::uint64_t>(n);
+  if (a.steps_option->count() > 0) return checked_steps(a.steps, "--steps");
+  return steps_of_duration(a.duration_option->count() > 0 ? a.duration : s.duration, s.dt);
 }
 
 std::uint64_t output_every(const RunArgs& a, const Settings& s) {
@@ -84,202 +61,97 @@ std::uint64_t output_every(const RunArgs& a, const Settings& s) {
   return k > kMaxSteps ? static_cast<std::uint64_t>(kMaxSteps) : static_cast<std::uint64_t>(k);
 }
 
-/// The whole run, after the arguments are parsed: exits through fail() on any error.
-class Runner {
- public:
-  explicit Runner(const RunArgs& args) : args_(args) {}
+/// The run after the arguments are parsed: loads the scene, opens the device and the outputs,
+/// then hands over to run_session(). Exits through fail() on any error.
+void run(const RunArgs& args) {
+  const Clock::time_point start = Clock::now();
+  Result<Scene> scene = args.scene.empty() ? builtin_default_scene() : load_scene_file(args.scene);
+  if (!scene) fail(scene.message());
+  // Mesh shapes filled by their winding number (open or non-manifold meshes) carry a warning;
+  // bodies that share a mesh share it, so each is printed once.
+  std::set<std::string> warned;
+  for (const BodySpec& body : scene->bodies) {
+    if (!body.shape) continue;
+    for (const std::string& warning : body.shape->warnings) {
+      if (warned.insert(warning).second) fmt::print(stderr, "motes: warning: {}\n", warning);
+    }
+  }
+  SessionPlan plan;
+  plan.scene_name =
+      args.scene.empty() ? "built-in default scene (examples/scenes/dominoes.json)" : args.scene;
+  Result<OutputFormat> format = parse_output_format(args.format);
+  if (!format) fail(format.message());
 
-  void run() {
-    const Clock::time_point start = Clock::now();
-    setup();
-    setup_seconds_ = seconds_since(start);
-    loop();
-    summary();
-    if (interrupted_) throw CLI::RuntimeError(130);  // as a shell reports SIGINT
+  plan.total = total_steps(args, scene->settings);
+  plan.every = output_every(args, scene->settings);
+  plan.checkpoint_every = args.checkpoint_every;
+
+  // What each checkpoint records, so that `motes resume` can go on with the same series.
+  CheckpointRun& record = plan.record;
+  if (!args.scene.empty()) {
+    record.scene_path = args.scene;
+    record.scene_file = absolute_path(args.scene);
+    Result<std::uint64_t> hash = scene_file_hash(args.scene);
+    if (!hash) fail(hash.message());
+    record.scene_hash = hash.value();
+  }
+  record.output_dir = absolute_path(args.out);
+  record.output_format = output_format_name(format.value());
+  record.every = plan.every;
+  record.total_steps = plan.total;
+  record.checkpoint_every = args.checkpoint_every;
+  record.checkpoint_dir = absolute_path(
+      args.checkpoint_dir.empty() ? (std::filesystem::path(args.out) / "checkpoints").string()
+                                  : args.checkpoint_dir);
+
+  DeviceOptions options;
+  options.cpu_threads = args.threads;
+  Result<std::unique_ptr<Device>> device = open_device(args.backend, args.device, options);
+  if (!device) fail(device.message());
+  Result<std::unique_ptr<Simulation>> sim =
+      Simulation::create(scene.value(), std::move(device).value());
+  if (!sim) fail(sim.message());
+  plan.sim = std::move(sim).value();
+
+  if (format.value() != OutputFormat::None) {
+    std::vector<std::string> names;
+    names.reserve(plan.sim->bodies().size());
+    for (const BodyInfo& b : plan.sim->bodies()) names.push_back(b.name);
+    Result<std::unique_ptr<FrameWriter>> writer =
+        open_frame_writer(format.value(), args.out, std::move(names));
+    if (!writer) fail(writer.message());
+    plan.writer = std::move(writer).value();
   }
 
- private:
-  void setup() {
-    Result<Scene> scene =
-        args_.scene.empty() ? builtin_default_scene() : load_scene_file(args_.scene);
-    if (!scene) fail(scene.message());
-    // Mesh shapes filled by their winding number (open or non-manifold meshes) carry a warning;
-    // bodies that share a mesh share it, so each is printed once.
-    std::set<std::string> warned;
-    for (const BodySpec& body : scene->bodies) {
-      if (!body.shape) continue;
-      for (const std::string& warning : body.shape->warnings) {
-        if (warned.insert(warning).second) fmt::print(stderr, "motes: warning: {}\n", warning);
-      }
-    }
-    scene_name_ = args_.scene.empty() ? "built-in default scene (examples/scenes/dominoes.json)"
-                                      : args_.scene;
-    Result<OutputFormat> format = parse_output_format(args_.format);
-    if (!format) fail(format.message());
-
-    total_ = total_steps(args_, scene->settings);
-    every_ = output_every(args_, scene->settings);
-
-    DeviceOptions options;
-    options.cpu_threads = args_.threads;
-    Result<std::unique_ptr<Device>> device = open_device(args_.backend, args_.device, options);
-    if (!device) fail(device.message());
-    Result<std::unique_ptr<Simulation>> sim =
-        Simulation::create(scene.value(), std::move(device).value());
-    if (!sim) fail(sim.message());
-    sim_ = std::move(sim).value();
-
-    if (format.value() != OutputFormat::None) {
-      std::vector<std::string> names;
-      names.reserve(sim_->bodies().size());
-      for (const BodyInfo& b : sim_->bodies()) names.push_back(b.name);
-      Result<std::unique_ptr<FrameWriter>> writer =
-          open_frame_writer(format.value(), args_.out, std::move(names));
-      if (!writer) fail(writer.message());
-      writer_ = std::move(writer).value();
-    }
-
-    const Settings& s = sim_->settings();
-    const DeviceInfo& info = sim_->device().info();
-    fmt::print("motes: {}: {} particles in {} bod{}\n", scene_name_, sim_->particle_count(),
-               sim_->body_count(), sim_->body_count() == 1 ? "y" : "ies");
-    fmt::print("motes: device {} {}: {}{}\n", info.backend, info.index, info.name,
-               info.detail.empty() ? "" : fmt::format(" ({})", info.detail));
-    fmt::print(
-        "motes: {} steps of {} s{} = {:.6g} s simulated; a frame every {} steps{}\n", total_, s.dt,
-        s.substeps > 1 ? fmt::format(" ({} substeps)", s.substeps) : "",
-        static_cast<double>(total_) * s.dt, every_,
-        writer_ ? fmt::format(" to {}", writer_->main_path()) : " (not written: --format none)");
-    std::fflush(stdout);
-    if (!args_.render_dir.empty()) setup_render(scene.value());
+  const Settings& s = plan.sim->settings();
+  const DeviceInfo& info = plan.sim->device().info();
+  fmt::print("motes: {}: {} particles in {} bod{}\n", plan.scene_name, plan.sim->particle_count(),
+             plan.sim->body_count(), plan.sim->body_count() == 1 ? "y" : "ies");
+  fmt::print("motes: device {} {}: {}{}\n", info.backend, info.index, info.name,
+             info.detail.empty() ? "" : fmt::format(" ({})", info.detail));
+  fmt::print("motes: {} steps of {} s{} = {:.6g} s simulated; a frame every {} steps{}\n",
+             plan.total, s.dt, s.substeps > 1 ? fmt::format(" ({} substeps)", s.substeps) : "",
+             static_cast<double>(plan.total) * s.dt, plan.every,
+             plan.writer ? fmt::format(" to {}", plan.writer->main_path())
+                         : " (not written: --format none)");
+  if (plan.checkpoint_every > 0) {
+    fmt::print("motes: a checkpoint every {} steps in {} (the last two kept)\n",
+               plan.checkpoint_every, record.checkpoint_dir);
   }
-
-  /// Pictures of every frame: the scene's camera or one fitted to the initial particles.
-  void setup_render(const Scene& scene) {
-    Result<Snapshot> first = sim_->snapshot();
+  std::fflush(stdout);
+  if (!args.render_dir.empty()) {
+    // Pictures of every frame: the scene's camera or one fitted to the initial particles.
+    Result<Snapshot> first = plan.sim->snapshot();
     if (!first) fail(first.message());
-    render::RenderSettings settings = render_settings(args_.render, render::look_from_scene(scene),
-                                                      scene.camera, first->particle_pos);
-    const double interval = static_cast<double>(every_) * sim_->settings().dt;
-    render_ = open_render_output(args_.render, std::move(settings), args_.render_dir, interval,
-                                 scene.camera.has_value());
+    render::RenderSettings settings = render_settings(
+        args.render, render::look_from_scene(scene.value()), scene->camera, first->particle_pos);
+    const double interval = static_cast<double>(plan.every) * s.dt;
+    plan.render = open_render_output(args.render, std::move(settings), args.render_dir, interval,
+                                     scene->camera.has_value());
   }
-
-  /// Checks the state and writes it as the next frame.
-  void output_frame() {
-    const Clock::time_point start = Clock::now();
-    if (Status s = sim_->check_finite(); !s) fail(s.message());
-    if (writer_ || render_) {
-      Result<Snapshot> snapshot = sim_->snapshot();
-      if (!snapshot) fail(snapshot.message());
-      if (writer_) {
-        if (Status s = writer_->write_frame(snapshot.value()); !s) fail(s.message());
-      }
-      if (render_) {
-        if (Status s = render_->add_frame(snapshot.value()); !s) fail(s.message());
-      }
-    }
-    last_output_step_ = sim_->steps();
-    output_seconds_ += seconds_since(start);
-  }
-
-  void loop() {
-    g_interrupted = 0;
-    const auto previous = std::signal(SIGINT, on_interrupt);
-    const Clock::time_point start = Clock::now();
-    Progress progress(total_);
-
-    try {
-      run_steps(progress);
-    } catch (const CLI::RuntimeError&) {
-      progress.finish();  // so that the error starts on a line of its own
-      throw;
-    }
-    progress.finish();
-    std::signal(SIGINT, previous);
-    wall_seconds_ = seconds_since(start);
-    if (writer_) {
-      if (Status s = writer_->finish(); !s) fail(s.message());
-    }
-    if (render_) {
-      if (Status s = render_->finish(); !s) fail(s.message());
-    }
-  }
-
-  /// Frame 0, the steps with a frame every every_ steps, and the final state.
-  void run_steps(Progress& progress) {
-    output_frame();
-    std::uint64_t done = 0;
-    std::uint64_t next_frame = every_;
-    std::uint64_t chunk = 1;
-    while (done < total_) {
-      if (g_interrupted != 0) {
-        interrupted_ = true;
-        break;
-      }
-      const std::uint64_t n = std::min({chunk, total_ - done, next_frame - done});
-      const Clock::time_point t0 = Clock::now();
-      if (Status s = sim_->step(n); !s) fail(s.message());
-      if (Status s = sim_->device().synchronize(); !s) fail(s.message());
-      const double took = seconds_since(t0);
-      step_seconds_ += took;
-      done += n;
-      if (took < kChunkSeconds / 2 && chunk < kMaxChunk) chunk *= 2;
-      if (took > kChunkSeconds * 2 && chunk > 1) chunk /= 2;
-      if (done == next_frame) {
-        output_frame();
-        next_frame += every_;
-      }
-      progress.update(done, sim_->time());
-    }
-    // The final state is always a frame, also when the step count is not a multiple of --every.
-    if (!interrupted_ && last_output_step_ != sim_->steps()) output_frame();
-  }
-
-  void summary() const {
-    const DeviceInfo& info = sim_->device().info();
-    // The state's fingerprint: equal on every run of the same scene, steps and backend.
-    const Result<std::uint64_t> hash = sim_->state_hash();
-    const std::uint64_t steps = sim_->steps();
-    const double rate = step_seconds_ > 0.0 ? static_cast<double>(steps) / step_seconds_ : 0.0;
-    const double particle_rate = rate * sim_->particle_count();
-    fmt::print("motes: {}\n", interrupted_ ? "interrupted (Ctrl-C)" : "done");
-    fmt::print("  {:<16}{} {}: {}{}\n", "device", info.backend, info.index, info.name,
-               info.detail.empty() ? "" : fmt::format(" ({})", info.detail));
-    fmt::print("  {:<16}{}\n", "particles", sim_->particle_count());
-    fmt::print("  {:<16}{}\n", "bodies", sim_->body_count());
-    fmt::print("  {:<16}{} of {}\n", "steps", steps, total_);
-    fmt::print("  {:<16}{:.6g} s\n", "simulated time", sim_->time());
-    if (hash) fmt::print("  {:<16}{:016x}\n", "state hash", hash.value());
-    fmt::print("  {:<16}{} (scene, device and upload)\n", "setup", format_seconds(setup_seconds_));
-    fmt::print("  {:<16}{} (stepping {}, checks and output {})\n", "wall time",
-               format_seconds(wall_seconds_), format_seconds(step_seconds_),
-               format_seconds(output_seconds_));
-    fmt::print("  {:<16}{} steps/s, {} particle-steps/s (stepping only)\n", "speed",
-               format_si(rate), format_si(particle_rate));
-    if (writer_) {
-      fmt::print("  {:<16}{} written to {}\n", "frames", writer_->frames(), writer_->main_path());
-    } else {
-      fmt::print("  {:<16}none written (--format none)\n", "frames");
-    }
-    if (render_) fmt::print("  {:<16}{}\n", "pictures", render_summary(*render_));
-    std::fflush(stdout);
-  }
-
-  const RunArgs& args_;
-  std::string scene_name_;
-  std::unique_ptr<Simulation> sim_;
-  std::unique_ptr<FrameWriter> writer_;
-  std::unique_ptr<render::RenderOutput> render_;
-  std::uint64_t total_ = 0;
-  std::uint64_t every_ = 1;
-  std::uint64_t last_output_step_ = 0;
-  bool interrupted_ = false;
-  double setup_seconds_ = 0.0;
-  double wall_seconds_ = 0.0;
-  double step_seconds_ = 0.0;
-  double output_seconds_ = 0.0;
-};
+  plan.setup_seconds = seconds_since(start);
+  run_session(std::move(plan));
+}
 
 }  // namespace
 
@@ -315,7 +187,13 @@ void add_run_command(CLI::App& app) {
                   "also draw every frame as a PNG in this directory, and an MP4 when ffmpeg is "
                   "installed (docs/rendering.md)");
   add_render_options(sub, args->render);
-  sub->callback([args] { Runner(*args).run(); });
+  sub->add_option("--checkpoint-every", args->checkpoint_every,
+                  "write a checkpoint every K steps (the last two kept; motes resume goes on "
+                  "from one)")
+      ->check(whole_number(1));
+  sub->add_option("--checkpoint-dir", args->checkpoint_dir,
+                  "directory of the checkpoints (default: OUT/checkpoints)");
+  sub->callback([args] { run(*args); });
 }
 
 }  // namespace motes::cli

@@ -7,6 +7,8 @@ namespace motes::cli {
 
 /// `motes run [SCENE]`: runs a scene and writes frames (cmd_run.cpp).
 void add_run_command(CLI::App& app);
+/// `motes resume CHECKPOINT`: goes on with a run from a checkpoint (cmd_resume.cpp).
+void add_resume_command(CLI::App& app);
 /// `motes devices`: every backend, its devices or why it has none (cmd_devices.cpp).
 void add_devices_command(CLI::App& app);
 /// `motes voxelize MESH`: fills a mesh with particles (cmd_voxelize.cpp).

@@ -1,4 +1,4 @@
-// The motes command: `motes run`, `motes devices`, `motes voxelize`, `motes bench`,
+// The motes command: `motes run`, `motes resume`, `motes devices`, `motes voxelize`, `motes bench`,
 // `motes render`.
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("motes ") + MOTES_VERSION);
   app.require_subcommand(1);
   motes::cli::add_run_command(app);
+  motes::cli::add_resume_command(app);
   motes::cli::add_devices_command(app);
   motes::cli::add_voxelize_command(app);
   motes::cli::add_bench_command(app);

@@ -16,8 +16,9 @@ namespace {
 constexpr double kRedrawInterval = 0.25;
 }  // namespace
 
-Progress::Progress(std::uint64_t total_steps)
+Progress::Progress(std::uint64_t total_steps, std::uint64_t first_step)
     : total_(total_steps),
+      first_(first_step),
       terminal_(isatty(fileno(stderr)) != 0),
       start_(std::chrono::steady_clock::now()) {}
 
@@ -49,7 +50,7 @@ void Progress::update(std::uint64_t step, double time) {
 void Progress::print(std::uint64_t step, double time, bool rewrite) {
   const double wall = elapsed();
   const double fraction = static_cast<double>(step) / static_cast<double>(total_);
-  const double rate = wall > 0.0 ? static_cast<double>(step) / wall : 0.0;
+  const double rate = wall > 0.0 && step > first_ ? static_cast<double>(step - first_) / wall : 0.0;
   const std::string eta =
       rate > 0.0 ? format_seconds(static_cast<double>(total_ - step) / rate) : "?";
   const std::string line = fmt::format("step {}/{}  t = {:.4g} s  {:.0f}%  {} steps/s  ETA {}",

@@ -9,7 +9,8 @@ namespace motes::cli {
 
 class Progress {
  public:
-  explicit Progress(std::uint64_t total_steps);
+  /// A run from step `first_step` (a resumed run's) to `total_steps`.
+  explicit Progress(std::uint64_t total_steps, std::uint64_t first_step = 0);
 
   /// Reports that `step` steps are done, at simulated time `time`; prints when due.
   void update(std::uint64_t step, double time);
@@ -21,6 +22,7 @@ class Progress {
   void print(std::uint64_t step, double time, bool rewrite);
 
   std::uint64_t total_;
+  std::uint64_t first_;
   bool terminal_;
   bool drawn_ = false;
   int next_tenth_ = 1;

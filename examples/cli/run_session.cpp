@@ -1,0 +1,292 @@
+// The stepping loop of `motes run` and `motes resume`: frames every K steps, checkpoints every C
+// steps (the last two kept), progress, SIGINT/SIGTERM (a last checkpoint, then a non-zero exit),
+// and the summary.
+#include "run_session.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <limits>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include "cli_util.h"
+#include "progress.h"
+#include "render_args.h"
+
+namespace motes::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// Steps go to the device in chunks sized to take about this long, so that progress, signals and
+// device errors are seen promptly without a call per step.
+constexpr double kChunkSeconds = 0.1;
+constexpr std::uint64_t kMaxChunk = std::uint64_t{1} << 20;
+
+constexpr const char* kCheckpointPrefix = "checkpoint-";
+constexpr const char* kCheckpointSuffix = ".mck";
+
+volatile std::sig_atomic_t g_signal = 0;
+
+extern "C" void on_signal(int signal) {
+  g_signal = signal;
+  // A second Ctrl-C (or SIGTERM) ends the process at once.
+  std::signal(signal, SIG_DFL);
+}
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+const char* signal_name(int signal) {
+  return signal == SIGINT ? "SIGINT (Ctrl-C)" : signal == SIGTERM ? "SIGTERM" : "a signal";
+}
+
+/// The step of a checkpoint file's name, or nothing; `tmp`: the name of one being written.
+bool checkpoint_step(const std::string& name, std::uint64_t& step, bool& tmp) {
+  const std::string prefix = kCheckpointPrefix;
+  std::string rest;
+  if (name.rfind(prefix, 0) != 0) return false;
+  rest = name.substr(prefix.size());
+  const std::string suffix = kCheckpointSuffix;
+  tmp = rest.size() > 4 && rest.compare(rest.size() - 4, 4, ".tmp") == 0;
+  if (tmp) rest.resize(rest.size() - 4);
+  if (rest.size() <= suffix.size() ||
+      rest.compare(rest.size() - suffix.size(), suffix.size(), suffix) != 0) {
+    return false;
+  }
+  rest.resize(rest.size() - suffix.size());
+  if (rest.empty() || rest.size() > 19 ||
+      !std::all_of(rest.begin(), rest.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    return false;
+  }
+  step = std::stoull(rest);
+  return true;
+}
+
+/// After checkpoint `newest` is in place: keeps it and the newest older one, removes the other
+/// older ones and leftovers of writes that a kill interrupted (*.mck.tmp). Later checkpoints (of
+/// a run this one was resumed from an earlier point of) are left alone.
+void prune_checkpoints(const fs::path& dir, std::uint64_t newest) {
+  std::vector<std::pair<std::uint64_t, fs::path>> older;
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    std::uint64_t step = 0;
+    bool tmp = false;
+    if (!checkpoint_step(e.path().filename().string(), step, tmp)) continue;
+    if (tmp) {
+      fs::remove(e.path(), ec);
+    } else if (step < newest) {
+      older.emplace_back(step, e.path());
+    }
+  }
+  std::sort(older.begin(), older.end(), [](const auto& a, const auto& b) { return a > b; });
+  for (std::size_t k = 1; k < older.size(); ++k) fs::remove(older[k].second, ec);
+}
+
+class Session {
+ public:
+  explicit Session(SessionPlan plan)
+      : p_(std::move(plan)), frame_times_(p_.record.series.frame_times) {}
+
+  void run() {
+    loop();
+    summary();
+    if (signal_ != 0) throw CLI::RuntimeError(128 + signal_);
+  }
+
+ private:
+  /// Checks the state and writes it as the next frame.
+  void output_frame() {
+    const Clock::time_point start = Clock::now();
+    Simulation& sim = *p_.sim;
+    if (Status s = sim.check_finite(); !s) fail(s.message());
+    if (p_.writer || p_.render) {
+      Result<Snapshot> snapshot = sim.snapshot();
+      if (!snapshot) fail(snapshot.message());
+      if (p_.writer) {
+        if (Status s = p_.writer->write_frame(snapshot.value()); !s) fail(s.message());
+      }
+      if (p_.render) {
+        if (Status s = p_.render->add_frame(snapshot.value()); !s) fail(s.message());
+      }
+    }
+    frame_times_.push_back(sim.time());
+    last_frame_step_ = sim.steps();
+    output_seconds_ += seconds_since(start);
+  }
+
+  /// Writes checkpoint-<step>.mck (atomically) and removes all but the last two.
+  void save_checkpoint() {
+    const Clock::time_point start = Clock::now();
+    Simulation& sim = *p_.sim;
+    const fs::path dir = p_.record.checkpoint_dir;
+    if (Status s = create_output_directory(dir.string(), "checkpoint"); !s) fail(s.message());
+    CheckpointRun record = p_.record;
+    record.series.frame_times = frame_times_;
+    if (record.output_format == "csv") {
+      if (Status s = csv_series_sizes(record.output_dir, record.series); !s) fail(s.message());
+    }
+    const fs::path path = dir / checkpoint_file_name(sim.steps());
+    if (Status s = sim.save_state(path.string(), record); !s) fail(s.message());
+    prune_checkpoints(dir, sim.steps());
+    last_checkpoint_ = path.string();
+    ++checkpoints_;
+    output_seconds_ += seconds_since(start);
+  }
+
+  void loop() {
+    g_signal = 0;
+    const auto previous_int = std::signal(SIGINT, on_signal);
+    const auto previous_term = std::signal(SIGTERM, on_signal);
+    const Clock::time_point start = Clock::now();
+    Progress progress(p_.total, p_.sim->steps());
+    first_step_ = p_.sim->steps();
+    try {
+      run_steps(progress);
+    } catch (const CLI::RuntimeError&) {
+      progress.finish();  // so that the error starts on a line of its own
+      throw;
+    }
+    progress.finish();
+    if (p_.writer) {
+      if (Status s = p_.writer->finish(); !s) fail(s.message());
+    }
+    if (p_.render) {
+      if (Status s = p_.render->finish(); !s) fail(s.message());
+    }
+    if (signal_ == 0 && g_signal != 0) signal_ = g_signal;  // came during the last chunk
+    if (signal_ != 0 || p_.checkpoint_every > 0) save_checkpoint();
+    wall_seconds_ = seconds_since(start);
+    std::signal(SIGINT, previous_int);
+    std::signal(SIGTERM, previous_term);
+    if (signal_ != 0) {
+      Simulation& sim = *p_.sim;
+      fmt::print(stderr,
+                 "motes: interrupted by {} at step {} of {} (t = {:.6g} s); {} frame{} written{}; "
+                 "checkpoint {}\n"
+                 "motes: continue with: motes resume {}\n",
+                 signal_name(signal_), sim.steps(), p_.total, sim.time(), frame_times_.size(),
+                 frame_times_.size() == 1 ? "" : "s",
+                 p_.writer ? fmt::format(" ({})", p_.writer->main_path()) : "", last_checkpoint_,
+                 last_checkpoint_);
+    }
+  }
+
+  /// Frame 0 (not for a resumed run), the steps with a frame every `every` steps and a checkpoint
+  /// every `checkpoint_every`, and the final state.
+  void run_steps(Progress& progress) {
+    Simulation& sim = *p_.sim;
+    const std::uint64_t first = sim.steps();
+    const std::uint64_t every = p_.every;
+    const std::uint64_t ck = p_.checkpoint_every;
+    if (!p_.resumed) {
+      output_frame();
+    } else if (!frame_times_.empty() && frame_times_.back() == sim.time()) {
+      last_frame_step_ = first;  // the checkpoint's step already has its frame
+    }
+    std::uint64_t next_frame = (first / every + 1) * every;
+    std::uint64_t next_checkpoint =
+        ck > 0 ? (first / ck + 1) * ck : std::numeric_limits<std::uint64_t>::max();
+    std::uint64_t chunk = 1;
+    while (sim.steps() < p_.total) {
+      if (g_signal != 0) {
+        signal_ = g_signal;
+        break;
+      }
+      const std::uint64_t done = sim.steps();
+      const std::uint64_t n =
+          std::min({chunk, p_.total - done, next_frame - done, next_checkpoint - done});
+      const Clock::time_point t0 = Clock::now();
+      if (Status s = sim.step(n); !s) fail(s.message());
+      if (Status s = sim.device().synchronize(); !s) fail(s.message());
+      const double took = seconds_since(t0);
+      step_seconds_ += took;
+      if (took < kChunkSeconds / 2 && chunk < kMaxChunk) chunk *= 2;
+      if (took > kChunkSeconds * 2 && chunk > 1) chunk /= 2;
+      if (sim.steps() == next_frame) {
+        output_frame();
+        next_frame += every;
+      }
+      if (sim.steps() == next_checkpoint) {
+        // The one at the end comes after the final frame (loop()).
+        if (sim.steps() < p_.total) save_checkpoint();
+        next_checkpoint += ck;
+      }
+      progress.update(sim.steps(), sim.time());
+    }
+    // The final state is always a frame, also when the step count is not a multiple of --every.
+    if (sim.steps() >= p_.total && last_frame_step_ != sim.steps()) output_frame();
+  }
+
+  void summary() const {
+    Simulation& sim = *p_.sim;
+    const DeviceInfo& info = sim.device().info();
+    // The state's fingerprint: equal on every run of the same scene, steps and backend.
+    const Result<std::uint64_t> hash = sim.state_hash();
+    const std::uint64_t steps = sim.steps() - first_step_;
+    const double rate = step_seconds_ > 0.0 ? static_cast<double>(steps) / step_seconds_ : 0.0;
+    const double particle_rate = rate * sim.particle_count();
+    fmt::print("motes: {}\n",
+               signal_ != 0 ? fmt::format("interrupted ({})", signal_name(signal_)) : "done");
+    fmt::print("  {:<16}{} {}: {}{}\n", "device", info.backend, info.index, info.name,
+               info.detail.empty() ? "" : fmt::format(" ({})", info.detail));
+    fmt::print("  {:<16}{}\n", "particles", sim.particle_count());
+    fmt::print("  {:<16}{}\n", "bodies", sim.body_count());
+    if (p_.resumed) {
+      fmt::print("  {:<16}{} of {} (resumed at step {})\n", "steps", sim.steps(), p_.total,
+                 first_step_);
+    } else {
+      fmt::print("  {:<16}{} of {}\n", "steps", sim.steps(), p_.total);
+    }
+    fmt::print("  {:<16}{:.6g} s\n", "simulated time", sim.time());
+    if (hash) fmt::print("  {:<16}{:016x}\n", "state hash", hash.value());
+    fmt::print("  {:<16}{} (scene, device and upload)\n", "setup",
+               format_seconds(p_.setup_seconds));
+    fmt::print("  {:<16}{} (stepping {}, checks and output {})\n", "wall time",
+               format_seconds(wall_seconds_), format_seconds(step_seconds_),
+               format_seconds(output_seconds_));
+    fmt::print("  {:<16}{} steps/s, {} particle-steps/s (stepping only)\n", "speed",
+               format_si(rate), format_si(particle_rate));
+    if (p_.writer) {
+      fmt::print("  {:<16}{} written to {}\n", "frames", p_.writer->frames(),
+                 p_.writer->main_path());
+    } else {
+      fmt::print("  {:<16}none written (--format none)\n", "frames");
+    }
+    if (p_.render) fmt::print("  {:<16}{}\n", "pictures", render_summary(*p_.render));
+    if (checkpoints_ > 0) {
+      fmt::print("  {:<16}{} written, the last {}\n", "checkpoints", checkpoints_,
+                 last_checkpoint_);
+    }
+    std::fflush(stdout);
+  }
+
+  SessionPlan p_;
+  std::vector<double> frame_times_;
+  std::uint64_t first_step_ = 0;
+  std::uint64_t last_frame_step_ = std::numeric_limits<std::uint64_t>::max();
+  std::uint64_t checkpoints_ = 0;
+  std::string last_checkpoint_;
+  int signal_ = 0;
+  double wall_seconds_ = 0.0;
+  double step_seconds_ = 0.0;
+  double output_seconds_ = 0.0;
+};
+
+}  // namespace
+
+std::string checkpoint_file_name(std::uint64_t step) {
+  return fmt::format("{}{:012}{}", kCheckpointPrefix, step, kCheckpointSuffix);
+}
+
+void run_session(SessionPlan plan) { Session(std::move(plan)).run(); }
+
+}  // namespace motes::cli

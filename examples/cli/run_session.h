@@ -1,0 +1,41 @@
+// The stepping loop that `motes run` and `motes resume` share: frames, periodic checkpoints,
+// progress, SIGINT/SIGTERM, the summary (docs/cli.md, docs/reliability.md).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "motes/checkpoint.h"
+#include "motes/output.h"
+#include "motes/render_output.h"
+#include "motes/scene.h"
+#include "motes/simulation.h"
+
+namespace motes::cli {
+
+/// Everything a session needs, prepared by cmd_run.cpp or cmd_resume.cpp.
+struct SessionPlan {
+  std::string scene_name;                        ///< for messages
+  std::unique_ptr<Simulation> sim;               ///< at its first step (0, or the checkpoint's)
+  std::unique_ptr<FrameWriter> writer;           ///< none with --format none
+  std::unique_ptr<render::RenderOutput> render;  ///< motes run --render only
+  std::uint64_t total = 0;                       ///< the step to stop at
+  std::uint64_t every = 1;             ///< a frame at every multiple of it (and at the end)
+  std::uint64_t checkpoint_every = 0;  ///< 0: only the last checkpoint of an interrupted run
+  /// What every checkpoint records about the run (its series is filled in at each save).
+  CheckpointRun record;
+  /// A resumed run: the series so far (frames are not written again) and the checkpoint it came
+  /// from; frame 0 is not written.
+  bool resumed = false;
+  double setup_seconds = 0.0;
+};
+
+/// Checkpoint files in a directory: checkpoint-<step, 12 digits>.mck, the last two kept.
+std::string checkpoint_file_name(std::uint64_t step);
+
+/// Runs the plan to its end or to SIGINT/SIGTERM and prints the summary; exits through
+/// CLI::RuntimeError with 128 + the signal's number after a signal, through fail() on errors.
+void run_session(SessionPlan plan);
+
+}  // namespace motes::cli
