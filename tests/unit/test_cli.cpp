@@ -141,6 +141,8 @@ TEST(Cli, HugeNonNumericAndOutOfRangeValuesAreUsageErrors) {
       {{"run", kSmallScene, "--duration", "1e400"}, "must be a finite number >= 0"},
       {{"run", kSmallScene, "--fps", "1e300"}, "must be a finite number from 0.01 to 1000"},
       {{"run", kSmallScene, "--fps", "1e-300"}, "must be a finite number from 0.01 to 1000"},
+      {{"run", kSmallScene, "--size", "99999999999x5"},
+       "invalid size '99999999999x5': width and height must be 16 to 16384 pixels"},
       {{"voxelize", kBunny, "--count", beyond_64_bits}, "is too large: at most 100000000"},
       {{"bench", "--threads", huge}, "at most 1024"},
       {{"bench", "--dominoes", huge}, "is too large: at most 6666666"},
