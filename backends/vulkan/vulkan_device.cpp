@@ -135,10 +135,27 @@ Status VulkanDevice::init(std::shared_ptr<Instance> instance, int physical) {
   queue.queueFamilyIndex = physical_.compute_family;
   queue.queueCount = 1;
   queue.pQueuePriorities = &priority;
+  // VK_EXT_memory_budget, where the device has it: what this process may still allocate on each
+  // heap (available_bytes), rather than the heap's whole size.
+  std::uint32_t extension_count = 0;
+  vkEnumerateDeviceExtensionProperties(physical_.handle, nullptr, &extension_count, nullptr);
+  std::vector<VkExtensionProperties> extensions(extension_count);
+  vkEnumerateDeviceExtensionProperties(physical_.handle, nullptr, &extension_count,
+                                       extensions.data());
+  for (const VkExtensionProperties& e : extensions) {
+    if (std::strcmp(e.extensionName, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME) == 0) {
+      memory_budget_ = true;
+    }
+  }
+  const char* budget_extension = VK_EXT_MEMORY_BUDGET_EXTENSION_NAME;
   VkDeviceCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue;
+  if (memory_budget_) {
+    info.enabledExtensionCount = 1;
+    info.ppEnabledExtensionNames = &budget_extension;
+  }
   if (Status s =
           check(vkCreateDevice(physical_.handle, &info, nullptr, &device_), "vkCreateDevice");
       !s) {
@@ -353,6 +370,7 @@ Status VulkanDevice::create_buffer(GpuBuffer& out, VkDeviceSize data_bytes, bool
         static_cast<double>(req.size) / 1048576.0, name, result_name(r),
         r == VK_ERROR_OUT_OF_DEVICE_MEMORY ? " (out of GPU memory: use fewer particles)" : ""));
   }
+  out.memory_bytes = req.size;
   if (Status s =
           check(vkBindBufferMemory(device_, out.buffer, out.memory, 0), "vkBindBufferMemory");
       !s) {
@@ -440,12 +458,14 @@ Status VulkanDevice::allocate(const Sizes& sizes) {
     } else {
       bytes = VkDeviceSize{sizes.particles} * 4;
     }
-    if (padded(bytes) > physical_.max_storage_range) {
+    // The core refuses these sizes before it allocates (check_device_fits, buffer_limit); this
+    // guards a direct caller of allocate().
+    if (padded(bytes) > buffer_limit().bytes) {
       release_buffers();
       return Status::error(fmt::format(
-          "vulkan ({}): buffer {} needs {} bytes, more than this device's storage-buffer range "
-          "({} bytes, maxStorageBufferRange); use fewer particles",
-          info_.name, binding_name(i), bytes, physical_.max_storage_range));
+          "vulkan ({}): buffer {} needs {} bytes, more than one buffer may hold on this device "
+          "({} bytes, {}); use fewer particles",
+          info_.name, binding_name(i), padded(bytes), buffer_limit().bytes, buffer_limit().what));
     }
     if (Status s = create_buffer(buffers_[i], bytes, false, binding_name(i)); !s) {
       release_buffers();
@@ -499,14 +519,67 @@ std::uint64_t VulkanDevice::required_bytes(const Sizes& sizes) const {
 }
 
 std::uint64_t VulkanDevice::available_bytes() const {
-  // The largest device-local heap (the driver may keep a little of it for itself).
-  std::uint64_t largest = 0;
+  // What allocate() gives back before it allocates again.
+  std::uint64_t held = 0;
+  for (const GpuBuffer& b : buffers_) held += b.memory_bytes;
+  std::uint64_t best = 0;
+  if (memory_budget_) {
+    // VK_EXT_memory_budget: the heap's budget for this process less what it uses, on the
+    // device-local heap with the most room.
+    VkPhysicalDeviceMemoryBudgetPropertiesEXT budget{};
+    budget.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT;
+    VkPhysicalDeviceMemoryProperties2 props{};
+    props.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2;
+    props.pNext = &budget;
+    vkGetPhysicalDeviceMemoryProperties2(physical_.handle, &props);
+    for (std::uint32_t h = 0; h < props.memoryProperties.memoryHeapCount; ++h) {
+      if ((props.memoryProperties.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) == 0) {
+        continue;
+      }
+      const std::uint64_t used = budget.heapUsage[h];
+      const std::uint64_t room = budget.heapBudget[h] > used ? budget.heapBudget[h] - used : 0;
+      best = std::max(best, room + held);
+    }
+    if (best > 0) return best;
+  }
+  // Otherwise the largest device-local heap (the driver may keep a little of it for itself).
   for (std::uint32_t h = 0; h < memory_.memoryHeapCount; ++h) {
     if ((memory_.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) != 0) {
-      largest = std::max<std::uint64_t>(largest, memory_.memoryHeaps[h].size);
+      best = std::max<std::uint64_t>(best, memory_.memoryHeaps[h].size);
     }
   }
-  return largest == 0 ? UINT64_MAX : largest;
+  return best == 0 ? UINT64_MAX : best;
+}
+
+BufferSize VulkanDevice::largest_buffer(const Sizes& sizes) const {
+  // The motes buffers and the grid build's scratch (GridArrival and GridUnsorted: N words; the
+  // scan's block sums: fewer than T / (SCAN_BLOCK - 1) + 64 words), each padded as allocate()
+  // pads it. The rebuild's indirect arguments are a few hundred bytes.
+  BufferSize largest;
+  for (std::uint32_t i = 0; i < kBindingCount; ++i) {
+    std::uint64_t bytes = 0;
+    if (i < kBufferCount) {
+      bytes = buffer_layout(static_cast<Buffer>(i), sizes).bytes();
+    } else if (i == B_SCAN_SCRATCH) {
+      bytes = ((std::uint64_t{sizes.table} + 1) / (SCAN_BLOCK - 1) + 64) * 4;
+    } else if (i == B_INDIRECT_ARGS) {
+      continue;
+    } else {
+      bytes = std::uint64_t{sizes.particles} * 4;
+    }
+    bytes = padded(bytes);
+    if (bytes > largest.bytes || largest.name.empty()) largest = {binding_name(i), bytes};
+  }
+  return largest;
+}
+
+BufferLimit VulkanDevice::buffer_limit() const {
+  // A buffer is bound whole as one storage buffer, and is one allocation with its guard words.
+  BufferLimit limit{physical_.max_storage_range, "maxStorageBufferRange"};
+  if (physical_.max_allocation != 0 && physical_.max_allocation - kGuardBytes < limit.bytes) {
+    limit = {physical_.max_allocation - kGuardBytes, "maxMemoryAllocationSize less guard words"};
+  }
+  return limit;
 }
 
 Status VulkanDevice::write(Buffer b, const void* src, std::size_t bytes) {

@@ -65,6 +65,8 @@ class VulkanDevice final : public Device {
   [[nodiscard]] const DeviceInfo& info() const override { return info_; }
   [[nodiscard]] std::uint64_t required_bytes(const Sizes& sizes) const override;
   [[nodiscard]] std::uint64_t available_bytes() const override;
+  [[nodiscard]] BufferSize largest_buffer(const Sizes& sizes) const override;
+  [[nodiscard]] BufferLimit buffer_limit() const override;
   Status allocate(const Sizes& sizes) override;
   Status write(Buffer b, const void* src, std::size_t bytes) override;
   Status read(Buffer b, void* dst, std::size_t bytes) override;
@@ -95,8 +97,9 @@ class VulkanDevice final : public Device {
   struct GpuBuffer {
     VkBuffer buffer = VK_NULL_HANDLE;
     VkDeviceMemory memory = VK_NULL_HANDLE;
-    VkDeviceSize data_bytes = 0;  ///< what the kernels may touch; the guard words follow
-    void* mapped = nullptr;       ///< host-visible buffers only (staging)
+    VkDeviceSize data_bytes = 0;    ///< what the kernels may touch; the guard words follow
+    VkDeviceSize memory_bytes = 0;  ///< the allocation's size (vkGetBufferMemoryRequirements)
+    void* mapped = nullptr;         ///< host-visible buffers only (staging)
   };
   /// One dispatch: a pipeline, its workgroups and the pass's own arguments.
   struct Pass {
@@ -195,6 +198,8 @@ class VulkanDevice final : public Device {
   VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
   std::array<VkPipeline, kPipelineCount> pipelines_{};
   VkPhysicalDeviceMemoryProperties memory_{};
+  /// VK_EXT_memory_budget is enabled: available_bytes() reads the heaps' budgets and usage.
+  bool memory_budget_ = false;
 
   Sizes sizes_;
   bool allocated_ = false;

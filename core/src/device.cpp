@@ -1,7 +1,13 @@
 // Names and layouts of the backend interface's buffers and kernels.
 #include "motes/backend/device.h"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <bit>
+#include <cmath>
+#include <limits>
+#include <vector>
 
 #include "shared/links.h"
 #include "shared/shape_matching.h"
@@ -177,6 +183,106 @@ std::uint32_t grid_table_size(std::uint32_t particles) {
   std::uint64_t t = std::bit_ceil(want < 64 ? std::uint64_t{64} : want);
   if (t > (std::uint64_t{1} << 31)) t = std::uint64_t{1} << 31;
   return static_cast<std::uint32_t>(t);
+}
+
+Sizes scale_sizes(const Sizes& sizes, std::uint32_t particles) {
+  const std::uint64_t from = sizes.particles;
+  const auto scale = [&](std::uint32_t count) -> std::uint32_t {
+    if (from == 0) return 0;
+    // count <= 2^32 and particles < 2^32: the product fits in 64 bits.
+    return static_cast<std::uint32_t>(std::uint64_t{count} * particles / from);
+  };
+  Sizes s = sizes;
+  s.particles = particles;
+  s.rigid_particles = scale(sizes.rigid_particles);
+  s.bodies = scale(sizes.bodies);
+  s.soft_particles = scale(sizes.soft_particles);
+  s.constraints = scale(sizes.constraints);
+  s.clusters = scale(sizes.clusters);
+  s.cluster_members = scale(sizes.cluster_members);
+  s.table = grid_table_size(particles);
+  return s;
+}
+
+BufferSize Device::largest_buffer(const Sizes& sizes) const {
+  BufferSize largest;
+  for (std::size_t i = 0; i < kBufferCount; ++i) {
+    const std::uint64_t bytes = buffer_layout(static_cast<Buffer>(i), sizes).bytes();
+    if (bytes > largest.bytes || largest.name.empty()) {
+      largest = {buffer_name(static_cast<Buffer>(i)), bytes};
+    }
+  }
+  return largest;
+}
+
+DeviceFit device_fit(const Device& device, const Sizes& sizes, std::uint64_t have) {
+  DeviceFit f;
+  f.need = device.required_bytes(sizes);
+  f.have = have;
+  f.largest = device.largest_buffer(sizes);
+  f.limit = device.buffer_limit();
+  return f;
+}
+
+std::uint32_t largest_fitting_particles(const Device& device, const Sizes& sizes,
+                                        std::uint64_t have) {
+  // Needs grow with N (the table in powers of two): bisect on [0, N] for the last that fits.
+  const auto fits = [&](std::uint32_t n) {
+    return device_fit(device, scale_sizes(sizes, n), have).fits();
+  };
+  if (fits(sizes.particles)) return sizes.particles;
+  std::uint32_t lo = 0;                // fits (or nothing does)
+  std::uint32_t hi = sizes.particles;  // does not fit
+  while (hi - lo > 1) {
+    const std::uint32_t mid = lo + (hi - lo) / 2;
+    (fits(mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+namespace {
+
+/// "2.00 GiB (2147483648 bytes)", or in MiB below 1 GiB.
+std::string gib(std::uint64_t bytes) {
+  const auto b = static_cast<double>(bytes);
+  if (bytes < (std::uint64_t{1} << 30)) {
+    return fmt::format("{:.2f} MiB ({} bytes)", b / 1048576.0, bytes);
+  }
+  return fmt::format("{:.2f} GiB ({} bytes)", b / 1073741824.0, bytes);
+}
+
+}  // namespace
+
+Status check_device_fits(const Device& device, const Sizes& sizes) {
+  const std::uint64_t have = device.available_bytes();
+  const DeviceFit f = device_fit(device, sizes, have);
+  if (f.fits()) return Status::ok();
+  const DeviceInfo& info = device.info();
+  std::vector<std::string> reasons;
+  if (!f.buffers_fit()) {
+    reasons.push_back(fmt::format(
+        "buffer {} would need {} bytes, more than the {} bytes one buffer may hold there ({})",
+        f.largest.name, f.largest.bytes, f.limit.bytes, f.limit.what));
+  }
+  if (!f.memory_fits()) {
+    reasons.push_back(
+        fmt::format("they would need {} of device memory, and the device has {} available",
+                    gib(f.need), gib(f.have)));
+  }
+  const std::uint32_t largest = largest_fitting_particles(device, sizes, have);
+  std::string advice =
+      largest == 0
+          ? std::string("not even one particle fits")
+          : fmt::format(
+                "at most {} particles fit ({:.1f}% of this scene, in its proportions)", largest,
+                std::floor(1000.0 * largest / std::max<double>(sizes.particles, 1.0)) / 10.0);
+  if (f.largest.name == "NeighbourList" && !f.buffers_fit() && sizes.neighbour_capacity > 1) {
+    advice +=
+        fmt::format(", or lower settings.neighbour_capacity (now {})", sizes.neighbour_capacity);
+  }
+  return Status::error(fmt::format("{} particles do not fit on {} device {} ({}): {}; {}",
+                                   sizes.particles, info.backend, info.index, info.name,
+                                   fmt::join(reasons, "; and "), advice));
 }
 
 }  // namespace motes

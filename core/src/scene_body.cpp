@@ -2,6 +2,7 @@
 // (cloth and ropes are read in scene_linked.cpp).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <limits>
 #include <map>
 
@@ -173,6 +174,10 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
     const Node body = bodies.at(i);
     if (is_linked(body)) {
       LinkedSpec spec = read_linked(body, i, cache, scene);
+      check_initial_speed(
+          body,
+          fmt::format("{} \"{}\"", spec.kind == LinkedKind::Cloth ? "cloth" : "rope", spec.name),
+          spec.velocity, Eigen::Vector3d::Zero(), 0.0, spec.diameter, scene.settings);
       count(body, spec.points.size());
       add_name(body, spec.name, body.path());
       scene.linked.push_back(std::move(spec));
@@ -217,6 +222,21 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
 
     const std::uint64_t copies = static_cast<std::uint64_t>(repeat.copies());
     count(body, copies * spec.shape->points.size());
+    if (spec.kind == BodyKind::Dynamic) {
+      // Its fastest particle at the start: |v| + |w| x the farthest particle centre from the
+      // centre of mass (the particles are equal: the centroid).
+      double reach = 0.0;
+      if (!spec.angular_velocity.isZero(0.0)) {
+        Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+        for (const Eigen::Vector3f& p : spec.shape->points) centre += p.cast<double>();
+        centre /= static_cast<double>(spec.shape->points.size());
+        for (const Eigen::Vector3f& p : spec.shape->points) {
+          reach = std::max(reach, (p.cast<double>() - centre).norm());
+        }
+      }
+      check_initial_speed(body, fmt::format("body \"{}\"", spec.name), spec.velocity,
+                          spec.angular_velocity, reach, spec.shape->diameter, scene.settings);
+    }
 
     entries.push_back(BodyEntry{scene.bodies.size(), copies, body.path()});
     Eigen::Quaterniond step_rotation = Eigen::Quaterniond::Identity();

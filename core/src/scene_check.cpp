@@ -47,6 +47,33 @@ double stable_step(const shared::ContactLaw& law, double m_eff) {
 
 }  // namespace
 
+void check_initial_speed(const Node& entry, const std::string& what, const Eigen::Vector3d& v,
+                         const Eigen::Vector3d& w, double reach, double diameter,
+                         const Settings& settings) {
+  const double speed = v.norm() + w.norm() * reach;
+  const double h = settings.dt / settings.substeps;
+  const double allowed = kMaxStartTravel * 0.5 * diameter;  // metres per substep
+  if (speed * h <= allowed) return;
+  const char* key = w.norm() * reach > v.norm() ? "angular_velocity" : "velocity";
+  const Node where = entry.has(key) ? entry.at(key) : entry;
+  const double safe_speed = allowed / h;
+  const double safe_dt = allowed / speed * settings.substeps;
+  const double substeps = std::ceil(speed * settings.dt / allowed);
+  where.fail(fmt::format(
+      "{} starts too fast for this dt: {:.4g} m/s at its fastest particle (|v| = {:.4g} m/s{}) "
+      "would move {:.4g} m in the first substep of {:.4g} s (dt {:.4g} s / substeps {}), more "
+      "than half its particle radius ({:.4g} m), so its contacts would be missed; the largest "
+      "safe speed at this dt is {:.4g} m/s, the largest safe dt at this speed {:.4g} s at "
+      "substeps {}{}",
+      what, speed, v.norm(),
+      w.isZero(0.0) ? std::string()
+                    : fmt::format(", |w| = {:.4g} rad/s at {:.4g} m from its centre of mass",
+                                  w.norm(), reach),
+      speed * h, h, settings.dt, settings.substeps, allowed, safe_speed, safe_dt, settings.substeps,
+      substeps <= 1e9 ? fmt::format(" (or keep dt and use substeps >= {:.0f})", substeps)
+                      : std::string()));
+}
+
 void check_stability(const Scene& scene, const std::vector<BodyEntry>& entries) {
   std::map<std::pair<int, double>, BodyClass> dynamic;
   // Material of static bodies, planes and pinned cloth or rope particles -> first user.

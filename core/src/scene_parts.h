@@ -61,6 +61,19 @@ bool is_linked(const Node& entry);
 LinkedSpec read_linked(const Node& entry, std::size_t index, const ShapeCache& cache,
                        const Scene& scene);
 
+/// Largest distance a particle may travel in one substep at the start, as a fraction of its radius
+/// (docs/reliability.md, "Initial speeds").
+constexpr double kMaxStartTravel = 0.5;
+
+/// Fails at the "velocity" (or, when the spin gives most of the speed, "angular_velocity") of
+/// `entry`, a body, cloth or rope called `what` (e.g. body "ball"), when its fastest particle,
+/// |v| + |w| x `reach` (the farthest particle centre from the centre of mass), would travel more
+/// than kMaxStartTravel of its particle radius in the first substep of dt / substeps: its contacts
+/// would be missed or come too deep to be resolved.
+void check_initial_speed(const Node& entry, const std::string& what, const Eigen::Vector3d& v,
+                         const Eigen::Vector3d& w, double reach, double diameter,
+                         const Settings& settings);
+
 /// Fails at /settings/dt when dt / substeps is above the explicit stability limit of the stiffest,
 /// lightest contact the scene can make (docs/scene-format.md, "Stability").
 void check_stability(const Scene& scene, const std::vector<BodyEntry>& entries);

@@ -139,20 +139,12 @@ Status Simulation::upload(const Scene& scene) {
 
   sizes_.soft_particles = static_cast<std::uint32_t>(soft_particles);
   Device& d = *device_;
-  // Device memory: refuse before allocating anything, with both numbers (again once the clusters
-  // are known, before the device allocates).
+  // Device memory and buffer limits: refuse before allocating anything, with both numbers and the
+  // largest particle count that fits (again once the clusters are known, before the device
+  // allocates).
   const auto check_memory = [&]() -> Status {
-    const std::uint64_t need = d.required_bytes(sizes_);
-    const std::uint64_t have = d.available_bytes();
-    if (need > have) {
-      const double per_particle =
-          static_cast<double>(need) / static_cast<double>(std::max<std::uint64_t>(n, 1));
-      return Status::error(fmt::format(
-          "{}: {} particles need {:.2f} GiB on {} device {} ({}), which has {:.2f} GiB available; "
-          "at {:.0f} bytes per particle about {} particles fit",
-          scene.source, n, static_cast<double>(need) / 1073741824.0, d.info().backend,
-          d.info().index, d.info().name, static_cast<double>(have) / 1073741824.0, per_particle,
-          static_cast<std::uint64_t>(static_cast<double>(have) / per_particle)));
+    if (Status st = check_device_fits(d, sizes_); !st) {
+      return Status::error(fmt::format("{}: {}", scene.source, st.message()));
     }
     return Status::ok();
   };

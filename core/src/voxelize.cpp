@@ -59,6 +59,12 @@ constexpr double kFixedPointRange = 536870912.0;  // 2^29: orientation products 
 // column coordinates are arrays: limits well above any body the particle limit allows in 3D.
 constexpr double kMaxColumns = 2.0e7;
 constexpr double kMaxCellsPerAxis = 1.0e6;
+// Particle positions and diameters are 32-bit floats: vertices beyond the float range cannot be
+// placed, and a mesh smaller than this has particles (at most kMaxCellsPerAxis across) whose
+// diameters fall below the smallest normal float (1.2e-38).
+constexpr double kMaxCoordinate = 3.0e38;
+constexpr double kMinExtent = 1.0e-30;
+constexpr double kMaxDiameter = 3.0e38;
 
 struct FixedPoint {
   std::int64_t x = 0;
@@ -167,11 +173,23 @@ Result<PreparedMesh> prepare(const TriangleMesh& mesh, winding::InsideTest test)
       if (!p.allFinite()) {
         return Status::error(fmt::format("{}: vertex {} has a non-finite coordinate", name, v));
       }
+      if (p.cwiseAbs().maxCoeff() > kMaxCoordinate) {
+        return Status::error(fmt::format(
+            "{}: vertex {} has a coordinate of {:.3g} m, outside the range of particle positions "
+            "(32-bit floats: at most {:.3g} m; a scale too large?)",
+            name, v, p.cwiseAbs().maxCoeff(), kMaxCoordinate));
+      }
       out.lo = out.lo.cwiseMin(p);
       out.hi = out.hi.cwiseMax(p);
     }
   }
   const Eigen::Vector3d extent = out.hi - out.lo;
+  if (extent.maxCoeff() < kMinExtent) {
+    return Status::error(fmt::format(
+        "{}: the mesh is {:.3g} m across, too small for particles in 32-bit floats (at least "
+        "{:.3g} m; a scale too small?)",
+        name, extent.maxCoeff(), kMinExtent));
+  }
   const char* axis_names[3] = {"x", "y", "z"};
   for (int a = 0; a < 3; ++a) {
     if (!(extent[a] > 1e-12 * extent.maxCoeff())) {
@@ -325,13 +343,19 @@ Lattice make_lattice(const PreparedMesh& mesh, double d) {
   return lattice;
 }
 
+/// A cell count for messages: whole up to a billion, then in powers of ten (a diameter of 1e-300
+/// m must not print a 300-digit number).
+std::string cells(double n) {
+  return n < 1e9 ? fmt::format("{:.0f}", n) : fmt::format("{:.3g}", n);
+}
+
 Status check_lattice(const PreparedMesh& mesh, const Lattice& lattice) {
   const double columns = lattice.n.x() * lattice.n.y();
   if (columns > kMaxColumns || lattice.n.maxCoeff() > kMaxCellsPerAxis) {
     return Status::error(fmt::format(
-        "{}: particle diameter {} m gives a lattice of {:.0f} x {:.0f} x {:.0f} cells, more "
-        "than the voxelizer handles: use a larger particle diameter",
-        mesh.name, lattice.d, lattice.n.x(), lattice.n.y(), lattice.n.z()));
+        "{}: particle diameter {} m gives a lattice of {} x {} x {} cells, more than the "
+        "voxelizer handles: use a larger particle diameter",
+        mesh.name, lattice.d, cells(lattice.n.x()), cells(lattice.n.y()), cells(lattice.n.z())));
   }
   return check_count(mesh.name, mesh.volume / (lattice.d * lattice.d * lattice.d), lattice.d);
 }
@@ -659,6 +683,11 @@ Result<ParticleSet> voxelize_with(const TriangleMesh& mesh, const VoxelizeOption
   if (has_diameter) {
     if (auto s = check_positive(fmt::format("{}: particle diameter", name), options.diameter); !s) {
       return s;
+    }
+    if (options.diameter > kMaxDiameter) {
+      return Status::error(fmt::format(
+          "{}: particle diameter {:.3g} m is outside the range of 32-bit floats (at most {:.3g} m)",
+          name, options.diameter, kMaxDiameter));
     }
   } else if (static_cast<double>(options.target_count) > kMaxParticles) {
     return Status::error(

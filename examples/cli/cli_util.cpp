@@ -83,18 +83,49 @@ CLI::Validator finite_number(bool allow_zero) {
 CLI::Validator finite_non_negative() { return finite_number(true); }
 CLI::Validator finite_positive() { return finite_number(false); }
 
-CLI::Validator whole_number(std::uint64_t least) {
+CLI::Validator finite_between(double least, double most) {
   return CLI::Validator(
-      [least](std::string& text) -> std::string {
-        const bool digits =
-            !text.empty() && text.size() <= 19 &&
-            std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
-        if (!digits || std::stoull(text) < least) {
-          return fmt::format("'{}' is not a whole number >= {}", text, least);
+      [least, most](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0') return fmt::format("'{}' is not a number", text);
+        if (!std::isfinite(v) || v < least || v > most) {
+          return fmt::format("'{}' must be a finite number from {} to {}", text, least, most);
         }
         return {};
       },
-      fmt::format("INTEGER >= {}", least));
+      fmt::format("NUMBER in [{}, {}]", least, most));
+}
+
+CLI::Validator whole_number(std::uint64_t least, std::uint64_t most) {
+  const bool bounded = most != std::numeric_limits<std::uint64_t>::max();
+  return CLI::Validator(
+      [least, most, bounded](std::string& text) -> std::string {
+        const bool digits = !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
+          return c >= '0' && c <= '9';
+        });
+        const std::string wanted =
+            bounded ? fmt::format("from {} to {}", least, most) : fmt::format(">= {}", least);
+        if (!digits) return fmt::format("'{}' is not a whole number {}", text, wanted);
+        // Digits only: the value, or "too large" once it passes `most` (or 64 bits).
+        std::uint64_t value = 0;
+        bool too_large = false;
+        for (char c : text) {
+          const auto d = static_cast<std::uint64_t>(c - '0');
+          if (d > most || value > (most - d) / 10) {
+            too_large = true;
+            break;
+          }
+          value = value * 10 + d;
+        }
+        if (too_large) {
+          return fmt::format("'{}' is too large: at most {}", text, most);
+        }
+        if (value < least) return fmt::format("'{}' is not a whole number {}", text, wanted);
+        return {};
+      },
+      bounded ? fmt::format("INTEGER in [{}, {}]", least, most)
+              : fmt::format("INTEGER >= {}", least));
 }
 
 }  // namespace motes::cli

@@ -3,12 +3,16 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <limits>
 #include <string>
 
 namespace motes::cli {
 
 /// Exit code of scene, mesh, device and output errors.
 constexpr int kErrorExit = 2;
+
+/// Most OpenMP threads a command accepts (OpenMP would start every one of them).
+constexpr std::uint64_t kMaxThreads = 1024;
 
 /// Prints "motes: error: MESSAGE" on stderr and ends the command with exit code 2.
 [[noreturn]] void fail(const std::string& message);
@@ -34,9 +38,20 @@ std::string format_si(double value);
 CLI::Validator finite_non_negative();
 /// Validator for a finite number > 0.
 CLI::Validator finite_positive();
-/// Validator for a count: a whole number >= least, in digits only ("-5", "2.5" and "1e3" are
-/// refused with a plain message; CLI11 would wrap a negative count around or print its range up
-/// to the largest double).
-CLI::Validator whole_number(std::uint64_t least);
+/// Validator for a finite number from least to most.
+CLI::Validator finite_between(double least, double most);
+/// Validator for a count: a whole number from least to most, in digits only ("-5", "2.5" and "1e3"
+/// are refused with a plain message; CLI11 would wrap a negative count around or print its range
+/// up to the largest double, and say "Could not convert" for one beyond its type). `most` is the
+/// largest value of the option's type, or a smaller limit of the option.
+CLI::Validator whole_number(std::uint64_t least,
+                            std::uint64_t most = std::numeric_limits<std::uint64_t>::max());
+/// whole_number for an option of type T: at most T's largest value (or `most`, if smaller).
+template <typename T>
+CLI::Validator whole_number_of(std::uint64_t least,
+                               std::uint64_t most = std::numeric_limits<std::uint64_t>::max()) {
+  const auto largest = static_cast<std::uint64_t>(std::numeric_limits<T>::max());
+  return whole_number(least, most < largest ? most : largest);
+}
 
 }  // namespace motes::cli

@@ -22,6 +22,11 @@
 namespace motes::cli {
 namespace {
 
+// W2 dominoes of 15 particles up to the scenes' default settings.max_particles (100,000,000): the
+// workload is built on the host before the device check, so a larger count would only exhaust host
+// memory first.
+constexpr std::uint64_t kMaxDominoes = 100'000'000 / 15;
+
 struct BenchOptions {
   std::string workload = "all";
   std::vector<std::uint64_t> sizes = {16384, 65536, 262144, 1048576};
@@ -280,15 +285,11 @@ void run_bench(const BenchOptions& o) {
     fail(fmt::format("--workload must be settle, dominoes, cloth, soft or all, got '{}'",
                      o.workload));
   }
-  for (const int count : o.soft_counts) {
-    if (count < 1 || count > 100000) {
-      fail(fmt::format("--soft-counts: {} is not from 1 to 100000 cubes", count));
-    }
-  }
-  for (const int side : o.cloth_sides) {
-    if (side < 2 || side > 1024) {
-      fail(fmt::format("--cloth-sides: {} is not from 2 to 1024 particles", side));
-    }
+  if (o.domino_rows > o.dominoes) {  // a usage error, as CLI11's own checks report them
+    throw CLI::ValidationError(
+        "--domino-rows", fmt::format("{} rows for {} dominoes: at most one row per domino (see "
+                                     "--dominoes)",
+                                     o.domino_rows, o.dominoes));
   }
   if (o.phase != "both" && o.phase != "falling" && o.phase != "dense") {
     fail(fmt::format("--phase must be falling, dense or both, got '{}'", o.phase));
@@ -430,14 +431,14 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--cloth-sides", opts->cloth_sides,
                   "W3: cloth sides in particles (a side x side cloth each)")
       ->delimiter(',')
-      ->check(whole_number(2))
+      ->check(whole_number_of<int>(2, 1024))
       ->capture_default_str();
   cmd->add_option("--cloth-steps", opts->cloth_steps, "W3: steps timed")
       ->check(whole_number(1))
       ->capture_default_str();
   cmd->add_option("--soft-counts", opts->soft_counts, "W4: numbers of soft cubes (392 particles)")
       ->delimiter(',')
-      ->check(whole_number(1))
+      ->check(whole_number_of<int>(1, 100000))
       ->capture_default_str();
   cmd->add_option("--soft-steps", opts->soft_steps, "W4: steps timed")
       ->check(whole_number(1))
@@ -451,11 +452,11 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--backend", opts->backend, "auto, openmp, cuda or vulkan")
       ->capture_default_str();
   cmd->add_option("--device", opts->device, "device index within the backend")
-      ->check(whole_number(0));
+      ->check(whole_number_of<int>(0));
   cmd->add_option("--threads", opts->threads, "OpenMP threads (0: OpenMP's default)")
-      ->check(whole_number(0));
+      ->check(whole_number_of<int>(0, kMaxThreads));
   cmd->add_option("--repeats", opts->repeats, "timed repeats (the median is reported)")
-      ->check(CLI::Range(1, 1000))
+      ->check(whole_number_of<int>(1, 1000))
       ->capture_default_str();
   cmd->add_option("--falling-steps", opts->falling_steps, "steps of the W1 falling phase")
       ->check(whole_number(1))
@@ -467,11 +468,12 @@ void add_bench_command(CLI::App& app) {
                   "steps run once to make the W1 dense-phase start state")
       ->check(whole_number(1))
       ->capture_default_str();
-  cmd->add_option("--dominoes", opts->dominoes, "W2: number of dominoes")
-      ->check(whole_number(1))
+  cmd->add_option("--dominoes", opts->dominoes,
+                  "W2: number of dominoes (15 particles each; at most 100,000,000 particles)")
+      ->check(whole_number_of<int>(1, kMaxDominoes))
       ->capture_default_str();
-  cmd->add_option("--domino-rows", opts->domino_rows, "W2: parallel rows")
-      ->check(whole_number(1))
+  cmd->add_option("--domino-rows", opts->domino_rows, "W2: parallel rows (at most --dominoes)")
+      ->check(whole_number_of<int>(1, kMaxDominoes))
       ->capture_default_str();
   cmd->add_option("--domino-steps", opts->domino_steps, "W2: steps timed")
       ->check(whole_number(1))

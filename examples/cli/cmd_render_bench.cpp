@@ -81,10 +81,10 @@ void add_render_bench_command(CLI::App& app) {
   CLI::App* sub =
       app.add_subcommand("render-bench", "Time the CPU renderer on a block of N particles");
   sub->add_option("--particles", args->particles, "particles to draw")
-      ->check(whole_number(1) & CLI::Range(1u, 100'000'000u))
+      ->check(whole_number_of<std::uint32_t>(1, 100'000'000))
       ->capture_default_str();
   sub->add_option("--frames", args->frames, "frames to time")
-      ->check(whole_number(1) & CLI::Range(1, 1000))
+      ->check(whole_number_of<int>(1, 1000))
       ->capture_default_str();
   add_render_options(sub, args->render);
   sub->callback([args] { render_bench(*args); });

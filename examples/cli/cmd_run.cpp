@@ -164,7 +164,7 @@ void add_run_command(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "openmp", "cuda", "vulkan"}))
       ->capture_default_str();
   sub->add_option("--device", args->device, "device index within the backend (motes devices)")
-      ->check(whole_number(0));
+      ->check(whole_number_of<int>(0));
   args->steps_option =
       sub->add_option("--steps", args->steps, "number of steps to run")->check(whole_number(0));
   args->duration_option =
@@ -182,7 +182,7 @@ void add_run_command(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--threads", args->threads,
                   "OpenMP backend threads (default: OMP_NUM_THREADS or every core)")
-      ->check(whole_number(1));
+      ->check(whole_number_of<int>(1, kMaxThreads));
   sub->add_option("--render", args->render_dir,
                   "also draw every frame as a PNG in this directory, and an MP4 when ffmpeg is "
                   "installed (docs/rendering.md)");

@@ -112,7 +112,7 @@ void add_voxelize_command(CLI::App& app) {
   size->add_option("--diameter", args->diameter, "particle diameter (mesh units, metres)")
       ->check(finite_positive());
   size->add_option("--count", args->count, "target particle count (the diameter is chosen)")
-      ->check(whole_number(1));
+      ->check(whole_number_of<std::size_t>(1, 100'000'000));
   size->require_option(1);
   sub->add_option("--scale", args->scale, "multiply the mesh coordinates by this first")
       ->check(finite_positive());

@@ -41,9 +41,9 @@ void add_render_options(CLI::App* sub, RenderArgs& args) {
       ->check(color_by_check())
       ->capture_default_str();
   sub->add_option("--fps", args.fps,
-                  "video frames per second (default: frames per simulated second, clamped to "
-                  "1..60)")
-      ->check(finite_positive());
+                  "video frames per second, 0.01 to 1000 (default: frames per simulated second, "
+                  "clamped to 1..60)")
+      ->check(finite_between(0.01, 1000.0));
   sub->add_flag("--no-video", args.no_video, "PNG frames only, no MP4");
   sub->add_flag("--no-shadows", args.no_shadows, "no shadows (a little faster)");
 }

@@ -124,3 +124,21 @@ def test_the_readme_example_runs():
     out = subprocess.run([sys.executable, os.path.join(SOURCE, "python", "example.py")],
                          cwd=SOURCE, env=env, check=True, capture_output=True, text=True).stdout
     assert re.match(r"\w+: t = 0\.030 s, lowest particle at y = [0-9.]+ m, 40 bodies", out), out
+
+
+def test_a_scene_too_big_for_the_device_raises_what_the_command_line_prints():
+    # Device limits (docs/reliability.md): the module goes through the check of
+    # Simulation::create, as `motes run` does, and raises its message. Lavapipe's
+    # maxStorageBufferRange (128 MiB) is below this scene's neighbour list (163,840,000 bytes).
+    lavapipe = [d["index"] for r in motes.devices() if r["backend"] == "vulkan"
+                for d in r["devices"] if "llvmpipe" in d["name"]]
+    if not lavapipe:
+        pytest.skip("needs lavapipe, whose maxStorageBufferRange is 128 MiB")
+    scene = os.path.join(SOURCE, "tests", "data", "cli", "big_neighbour_list.json")
+    with pytest.raises(motes.Error) as raised:
+        motes.Simulation(motes.load_scene(scene), backend="vulkan", device=lavapipe[0])
+    cli = subprocess.run([CLI, "run", scene, "--backend", "vulkan", "--device", str(lavapipe[0]),
+                          "--steps", "1", "--format", "none"], capture_output=True, text=True)
+    assert cli.returncode == 2
+    assert cli.stderr.strip() == "motes: error: " + str(raised.value)
+    assert "at most 32768 particles fit" in str(raised.value)

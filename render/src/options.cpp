@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <charconv>
+#include <limits>
 #include <string_view>
 
 #include "motes/render.h"
@@ -13,11 +14,16 @@ namespace {
 constexpr int kMinSide = 16;
 constexpr int kMaxSide = 16384;
 
-/// A whole decimal number, all of `text`.
+/// A whole decimal number, all of `text`; one too large for an int reads as the largest int (out
+/// of the side range, so that the range is what the message says).
 bool parse_int(std::string_view text, int& value) {
   if (text.empty()) return false;
   const char* end = text.data() + text.size();
   const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (ec == std::errc::result_out_of_range && ptr == end) {
+    value = std::numeric_limits<int>::max();
+    return true;
+  }
   return ec == std::errc() && ptr == end;
 }
 

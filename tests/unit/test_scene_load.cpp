@@ -415,6 +415,93 @@ TEST(SceneStability, DtJustBelowTheLimitLoadsAndJustAboveFails) {
   }
 }
 
+// ---- initial speeds (docs/reliability.md) ----
+
+/// A ball of 1 cm (or a cloth of them) at `speed` m/s along x, or a 3 x 3 x 3 box spinning at
+/// `spin` rad/s about y, with dt and substeps.
+std::string moving(const std::string& body, double dt, int substeps) {
+  return fmt::format(
+      R"({{"settings": {{"dt": {}, "substeps": {}, "particle_diameter": 0.01,
+          "contact": {{"stiffness": 1000, "damping": 10}}}}, "bodies": [{}]}})",
+      dt, substeps, body);
+}
+
+TEST(SceneInitialSpeed, JustUnderTheLimitLoadsAndJustOverFails) {
+  // Half a particle radius (2.5 mm) per substep: 25 m/s at dt = 1e-4 s, 75 m/s at 3 substeps.
+  for (int substeps : {1, 3}) {
+    const double limit = 0.0025 * substeps / 1e-4;
+    const auto ball = [&](double v) {
+      return moving(fmt::format(R"({{"name": "ball", "shape": {{"type": "particle"}},
+                                     "velocity": [{}, 0, 0]}})",
+                                v),
+                    1e-4, substeps);
+    };
+    Result<Scene> ok = load_scene_text(ball(0.99 * limit), "s", "");
+    EXPECT_TRUE(ok) << ok.message();
+    Result<Scene> bad = load_scene_text(ball(1.01 * limit), "s", "");
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.message().find("s: /bodies/0/velocity: body \"ball\" starts too fast"),
+              std::string::npos)
+        << bad.message();
+    EXPECT_NE(bad.message().find(fmt::format("largest safe speed at this dt is {:.4g} m/s", limit)),
+              std::string::npos)
+        << bad.message();
+    // The largest safe dt at this speed loads (a hair under it: the message rounds).
+    const double safe_dt = 0.0025 * substeps / (1.01 * limit);
+    EXPECT_NE(bad.message().find(fmt::format("largest safe dt at this speed {:.4g} s", safe_dt)),
+              std::string::npos)
+        << bad.message();
+    const std::string at_safe_dt =
+        moving(fmt::format(R"({{"name": "ball", "shape": {{"type": "particle"}},
+                               "velocity": [{}, 0, 0]}})",
+                           1.01 * limit),
+               0.999 * safe_dt, substeps);
+    Result<Scene> slower = load_scene_text(at_safe_dt, "s", "");
+    EXPECT_TRUE(slower) << slower.message();
+  }
+  // A spinning box: its corner particles, sqrt(3) cm from the centre, go fastest.
+  const double reach = std::sqrt(3.0) * 0.01;
+  const double spin_limit = 25.0 / reach;
+  for (double f : {0.99, 1.01}) {
+    const std::string box =
+        moving(fmt::format(R"({{"name": "box", "shape": {{"type": "box", "particles": [3, 3, 3]}},
+                        "angular_velocity": [0, {}, 0]}})",
+                           f * spin_limit),
+               1e-4, 1);
+    Result<Scene> r = load_scene_text(box, "s", "");
+    EXPECT_EQ(static_cast<bool>(r), f < 1.0) << f << ": " << (r ? "" : r.message());
+    if (!r) {
+      EXPECT_NE(r.message().find("s: /bodies/0/angular_velocity: body \"box\""), std::string::npos)
+          << r.message();
+    }
+  }
+  // A cloth: its velocity, its particle diameter.
+  for (double f : {0.99, 1.01}) {
+    const std::string cloth =
+        moving(fmt::format(R"({{"name": "sheet", "kind": "cloth", "cloth": {{"corner": [0, 1, 0],
+                        "edge_u": [0.1, 0, 0], "edge_v": [0, 0, 0.1], "particles": [11, 11]}},
+                        "velocity": [0, {}, 0]}})",
+                           -f * 25.0),
+               1e-4, 1);
+    Result<Scene> r = load_scene_text(cloth, "s", "");
+    EXPECT_EQ(static_cast<bool>(r), f < 1.0) << f << ": " << (r ? "" : r.message());
+    if (!r) {
+      EXPECT_NE(r.message().find("s: /bodies/0/velocity: cloth \"sheet\" starts too fast"),
+                std::string::npos)
+          << r.message();
+    }
+  }
+}
+
+// A static body has no speed to check, and a body at rest none either: every example scene loads.
+TEST(SceneInitialSpeed, ExampleScenesLoad) {
+  for (const char* name : {"dominoes", "dice", "bunny", "cloth", "rope", "soft"}) {
+    Result<Scene> r =
+        load_scene_file(std::string(MOTES_SOURCE_DIR) + "/examples/scenes/" + name + ".json");
+    EXPECT_TRUE(r) << name << ": " << r.message();
+  }
+}
+
 // ---- malformed scenes: each gives its path and reason ----
 
 struct BadCase {
@@ -510,6 +597,16 @@ const BadCase kBadCases[] = {
     {"bad_color_text.json",
      {": /bodies/0/color: must be a colour: [r, g, b] with each from 0 to 1, or \"#rrggbb\", "
       "got \"red\""}},
+    {"initial_speed_1e30.json",
+     {": /bodies/1/velocity: body \"bullet\" starts too fast for this dt: 1e+30 m/s",
+      "would move 1e+26 m in the first substep of 0.0001 s",
+      "the largest safe speed at this dt is 25 m/s, the largest safe dt at this speed 2.5e-33 s"}},
+    {"initial_spin.json",
+     {": /bodies/0/angular_velocity: body \"spinner\" starts too fast for this dt: 173.7 m/s",
+      "|w| = 5000 rad/s at 0.03464 m from its centre of mass", "use substeps >= 7"}},
+    {"initial_speed_rope.json",
+     {": /bodies/0/velocity: rope \"lasso\" starts too fast for this dt: 30 m/s",
+      "largest safe speed at this dt is 25 m/s", "largest safe dt at this speed 8.333e-05 s"}},
 };
 
 INSTANTIATE_TEST_SUITE_P(Bad, SceneErrors, ::testing::ValuesIn(kBadCases),

@@ -114,6 +114,48 @@ std::uint64_t buffers_bytes(const Sizes& sizes);
 /// Hash-table size the core uses for n particles: the power of two >= 4n, at least 64.
 std::uint32_t grid_table_size(std::uint32_t particles);
 
+/// `sizes` for `particles` particles in the same proportions: rigid particles, bodies, soft
+/// particles, constraints, clusters and their members scaled with N (rounded down), materials,
+/// planes and the neighbour capacity kept, the table grid_table_size(particles). What "the largest
+/// particle count that fits" is counted in.
+Sizes scale_sizes(const Sizes& sizes, std::uint32_t particles);
+
+/// One buffer a device would allocate: its name and bytes.
+struct BufferSize {
+  std::string name;
+  std::uint64_t bytes = 0;
+};
+
+/// The most bytes one buffer may hold on a device, and the limit's name for messages
+/// ("maxStorageBufferRange"); UINT64_MAX and "" where only memory limits a buffer.
+struct BufferLimit {
+  std::uint64_t bytes = UINT64_MAX;
+  std::string what;
+};
+
+class Device;
+
+/// What a simulation of some sizes needs from a device, and what the device has.
+struct DeviceFit {
+  std::uint64_t need = 0;  ///< Device::required_bytes
+  std::uint64_t have = 0;  ///< Device::available_bytes (or the value given)
+  BufferSize largest;      ///< Device::largest_buffer
+  BufferLimit limit;       ///< Device::buffer_limit
+  [[nodiscard]] bool memory_fits() const { return need <= have; }
+  [[nodiscard]] bool buffers_fit() const { return largest.bytes <= limit.bytes; }
+  [[nodiscard]] bool fits() const { return memory_fits() && buffers_fit(); }
+};
+/// The device's numbers for these sizes, with `have` bytes available.
+DeviceFit device_fit(const Device& device, const Sizes& sizes, std::uint64_t have);
+/// The largest particle count n <= sizes.particles for which scale_sizes(sizes, n) fits in `have`
+/// bytes and under the device's buffer limit (bisection; 0 when not even one particle fits).
+std::uint32_t largest_fitting_particles(const Device& device, const Sizes& sizes,
+                                        std::uint64_t have);
+/// Ok when these sizes fit on the device (Device::available_bytes, read once); otherwise an error
+/// with what is needed, what the device has, and the largest particle count that fits
+/// (largest_fitting_particles). Simulation::create calls it before it allocates anything.
+Status check_device_fits(const Device& device, const Sizes& sizes);
+
 /// Time spent per kernel family since the last reset (seconds) and launch counts.
 struct KernelTimes {
   std::array<double, kKernelCount> seconds{};
@@ -143,6 +185,12 @@ class Device {
   [[nodiscard]] virtual std::uint64_t required_bytes(const Sizes& sizes) const = 0;
   /// Memory the device can still give (GPU free memory, or the host's available memory).
   [[nodiscard]] virtual std::uint64_t available_bytes() const = 0;
+  /// The largest single buffer this device would allocate for these sizes (each buffer is one
+  /// allocation, bound whole). Default: the largest buffer_layout().
+  [[nodiscard]] virtual BufferSize largest_buffer(const Sizes& sizes) const;
+  /// The most bytes one buffer may hold (Vulkan: maxStorageBufferRange and
+  /// maxMemoryAllocationSize). Default: no limit but memory.
+  [[nodiscard]] virtual BufferLimit buffer_limit() const { return {}; }
   /// (Re)allocates every buffer for these sizes; contents are undefined afterwards.
   virtual Status allocate(const Sizes& sizes) = 0;
   /// Copies host memory into the start of a buffer; bytes <= buffer_layout(b).bytes().
