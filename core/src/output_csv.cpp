@@ -127,17 +127,8 @@ Result<std::unique_ptr<FrameWriter>> output::continue_csv_writer(
   const std::string particles = (std::filesystem::path(dir) / "particles.csv").string();
   const std::string bodies = (std::filesystem::path(dir) / "bodies.csv").string();
   // Both sizes are checked before either file is cut.
-  for (const auto& [path, bytes] : {std::pair{particles, state.particles_csv_bytes},
-                                    std::pair{bodies, state.bodies_csv_bytes}}) {
-    std::error_code ec;
-    const std::uintmax_t size = std::filesystem::file_size(path, ec);
-    if (ec) return Status::error(fmt::format("cannot continue '{}': {}", path, ec.message()));
-    if (size < bytes) {
-      return Status::error(fmt::format(
-          "cannot continue '{}': it has {} bytes, fewer than the {} written before the checkpoint",
-          path, size, bytes));
-    }
-  }
+  if (Status s = output::check_continuable(particles, state.particles_csv_bytes); !s) return s;
+  if (Status s = output::check_continuable(bodies, state.bodies_csv_bytes); !s) return s;
   if (Status s = output::cut_file(particles, state.particles_csv_bytes); !s) return s;
   if (Status s = output::cut_file(bodies, state.bodies_csv_bytes); !s) return s;
   auto file = OutputFile::append(particles);

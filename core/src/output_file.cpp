@@ -126,7 +126,7 @@ Status replace_file(const std::string& from, const std::string& to) {
   return Status::ok();
 }
 
-Status cut_file(const std::string& path, std::uint64_t bytes) {
+Status check_continuable(const std::string& path, std::uint64_t bytes) {
   std::error_code ec;
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
   if (ec) return Status::error(fmt::format("cannot continue '{}': {}", path, ec.message()));
@@ -135,7 +135,13 @@ Status cut_file(const std::string& path, std::uint64_t bytes) {
         "cannot continue '{}': it has {} bytes, fewer than the {} written before the checkpoint",
         path, size, bytes));
   }
-  if (size == bytes) return Status::ok();
+  return Status::ok();
+}
+
+Status cut_file(const std::string& path, std::uint64_t bytes) {
+  if (Status s = check_continuable(path, bytes); !s) return s;
+  std::error_code ec;
+  if (std::filesystem::file_size(path, ec) == bytes && !ec) return Status::ok();
   std::filesystem::resize_file(path, bytes, ec);
   if (ec)
     return Status::error(fmt::format("cannot cut '{}' to {} bytes: {}", path, bytes, ec.message()));

@@ -50,8 +50,11 @@ class OutputFile {
 /// Renames `from` to `to`, replacing `to` atomically.
 Status replace_file(const std::string& from, const std::string& to);
 
-/// Cuts `path` to `bytes` (it must hold at least that many): the rows of a CSV series written
-/// after a checkpoint go. A shorter file is an error naming it and both sizes.
+/// Ok when `path` exists and has at least `bytes` bytes (what a checkpoint's series wrote); else
+/// an error naming it and both sizes.
+Status check_continuable(const std::string& path, std::uint64_t bytes);
+/// Cuts `path` to `bytes` (check_continuable first): the rows of a CSV series written after a
+/// checkpoint go.
 Status cut_file(const std::string& path, std::uint64_t bytes);
 
 /// continue_frame_writer for each format (output_vtu.cpp, output_csv.cpp).
