@@ -26,8 +26,11 @@ using motes::shared::StepParams;
 /// The openmp device, reporting `available` bytes of memory and passing everything else on.
 class LimitedDevice final : public motes::Device {
  public:
-  LimitedDevice(std::unique_ptr<motes::Device> inner, std::uint64_t available)
-      : inner_(std::move(inner)), available_(available) {}
+  /// `allocations` (optional) counts the calls to allocate(); it is owned by the caller so that
+  /// it outlives a device that Simulation::create destroys when it refuses.
+  LimitedDevice(std::unique_ptr<motes::Device> inner, std::uint64_t available,
+                int* allocations = nullptr)
+      : inner_(std::move(inner)), available_(available), allocations_(allocations) {}
   [[nodiscard]] const motes::DeviceInfo& info() const override { return inner_->info(); }
   [[nodiscard]] std::uint64_t required_bytes(const Sizes& s) const override {
     return inner_->required_bytes(s);
@@ -38,7 +41,7 @@ class LimitedDevice final : public motes::Device {
   }
   [[nodiscard]] motes::BufferLimit buffer_limit() const override { return inner_->buffer_limit(); }
   Status allocate(const Sizes& s) override {
-    ++allocations;
+    if (allocations_ != nullptr) ++*allocations_;
     return inner_->allocate(s);
   }
   Status write(Buffer b, const void* src, std::size_t n) override {
@@ -62,19 +65,18 @@ class LimitedDevice final : public motes::Device {
   [[nodiscard]] motes::KernelTimes kernel_times() const override { return inner_->kernel_times(); }
   void reset_kernel_times() override { inner_->reset_kernel_times(); }
 
-  int allocations = 0;
-
  private:
   std::unique_ptr<motes::Device> inner_;
   std::uint64_t available_;
+  int* allocations_;
 };
 
 constexpr std::uint64_t kAvailable = 4u << 20;  // 4 MiB
 
-std::unique_ptr<LimitedDevice> limited_openmp() {
+std::unique_ptr<LimitedDevice> limited_openmp(int* allocations = nullptr) {
   auto opened = motes::open_device("openmp");
   EXPECT_TRUE(opened) << opened.message();
-  return std::make_unique<LimitedDevice>(std::move(opened).value(), kAvailable);
+  return std::make_unique<LimitedDevice>(std::move(opened).value(), kAvailable, allocations);
 }
 
 /// `boxes` boxes of 3 x 3 x 3 particles (rigid) and `spheres` free spheres of 1 cm.
@@ -136,13 +138,13 @@ TEST(DeviceLimits, ScaledSizesKeepTheSceneProportions) {
 // More than the device has: refused before any allocation, naming the scene, both numbers and
 // the largest count; a scene of that many free spheres is created on the same device.
 TEST(DeviceLimits, SimulationRefusesMoreThanTheDeviceHasBeforeAllocating) {
-  auto device = limited_openmp();
-  LimitedDevice* seen = device.get();
+  int allocations = 0;
+  auto device = limited_openmp(&allocations);
   const motes::Scene big = scene(0, 40000);
   auto refused = motes::Simulation::create(big, std::move(device));
   ASSERT_FALSE(refused);
   const std::string& msg = refused.message();
-  EXPECT_EQ(seen->allocations, 0) << "refused after allocating";
+  EXPECT_EQ(allocations, 0) << "refused after allocating";
   EXPECT_NE(msg.find("limits.json: 40000 particles do not fit on openmp device 0"),
             std::string::npos)
       << msg;
