@@ -44,6 +44,10 @@
 // step has no impulse stage (the impulses/* cases check the kernels against their oracle). Its
 // positions and velocities meet the rigid bounds above.
 //
+// Every kind at once (mixed.json: a rigid die and a soft cube landing in a cloth hammock, a rope
+// across it) right after the first touch: the soft, cloth and rope particles take the cloth's
+// velocity bound.
+//
 // Determinism: the dice window run twice on one device gives the same Simulation::state_hash().
 //
 // Chaos: dominoes for 1 s (33,333 steps, a wave in the middle of the chain; 6 s on openmp) is
@@ -105,6 +109,9 @@ const std::map<std::string, WindowRecipe>& recipes() {
       {"rope.json", {0.14, 0.04}},
       // The lowest soft cube reaches the floor after about 0.045 s.
       {"soft.json", {0.04, 0.01}},
+      // The die and the soft cube reach the hammock after about 0.17 s (the pinned cloth and
+      // rope start from rest when the warm-up starts).
+      {"mixed.json", {0.16, 0.04}},
   };
   return r;
 }
@@ -282,6 +289,7 @@ TEST_P(Scenes, SettleWindow) { run_window("settle_pressed"); }
 TEST_P(Scenes, ClothWindow) { run_window("cloth.json"); }
 TEST_P(Scenes, RopeWindow) { run_window("rope.json"); }
 TEST_P(Scenes, SoftWindow) { run_window("soft.json"); }
+TEST_P(Scenes, MixedWindow) { run_window("mixed.json"); }
 
 TEST_P(Scenes, SameHashRunToRun) { same_hash("dice.json", 400); }
 TEST_P(Scenes, ImpulseSameHashRunToRun) { same_hash("impulse_dominoes.json", 100); }
