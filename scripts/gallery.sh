@@ -4,7 +4,8 @@
 # and the full video (SCENE.mp4, 960x540 H.264). Needs a built motes and ffmpeg.
 # Usage: scripts/gallery.sh [MOTES_BINARY]   (default: build/bin/motes)
 # Environment: GALLERY_SIZE (render size, default 960x540), GALLERY_SCENES (names to render,
-# default all), GALLERY_WORK (scratch directory, default a temporary one).
+# default all), GALLERY_WORK (scratch directory, default a temporary one), GALLERY_BACKEND
+# (default auto; openmp is much faster than Vulkan on lavapipe on a machine without a GPU).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 motes=${1:-$root/build/bin/motes}
@@ -28,7 +29,8 @@ for scene in "$root"/examples/scenes/*.json; do
   echo "== $name"
   frames=$work/$name
   rm -rf "$frames"
-  "$motes" run "$scene" --format none --render "$frames" --size "$size" 2>/dev/null |
+  "$motes" run "$scene" --backend "${GALLERY_BACKEND:-auto}" --format none --render "$frames" \
+    --size "$size" 2>/dev/null |
     grep -E "^motes: (video|rendering)|pictures"
   count=$(ls "$frames"/frame_*.png | wc -l)
   # The still: the frame 40% of the way through (the motion under way), 640 px wide.

@@ -13,7 +13,7 @@ void main() {
   vec4 angmom = body_angmom[b];
   vec4 angvel;
   body_integrate(pos, quat, vel, angmom, angvel, body_inv_inertia[b], body_force[b],
-                 body_torque[b], p.gravity_dt);
+                 body_torque[b], p.gravity_dt, p.flags);
   body_pos[b] = pos;
   body_quat[b] = quat;
   body_vel[b] = vel;

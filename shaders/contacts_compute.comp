@@ -23,10 +23,12 @@ void main() {
   vec3 ui = xyz(vi);
   uint law_base = particle_material[i] * p.material_count;
   vec3 f = vec3(0.0f);
+  bool by_impulse = impulse_particle(p.flags, i, p.rigid_particle_count);
   uint c = neighbour_count[i];
   if (c <= p.neighbour_capacity) {
     for (uint k = 0u; k < c; ++k) {
       uint j = neighbour_list[k * p.particle_count + i];
+      if (by_impulse && j < p.rigid_particle_count) continue;
       vec4 pj = particle_pos[j];
       vec4 vj = particle_vel[j];
       f += particle_contact_force(xi, ui, pi.w, vi.w, xyz(pj), xyz(vj), pj.w, vj.w,
@@ -41,6 +43,7 @@ void main() {
       for (uint t = lo[r]; t < hi[r]; ++t) {
         if (contact_excluded(sorted_body[t], body_i)) continue;
         uint j = grid_order[t];
+        if (by_impulse && j < p.rigid_particle_count) continue;
         vec4 pj = particle_pos[j];
         vec4 vj = particle_vel[j];
         f += particle_contact_force(xi, ui, pi.w, vi.w, xyz(pj), xyz(vj), pj.w, vj.w,
@@ -48,7 +51,7 @@ void main() {
       }
     }
   }
-  for (uint k = 0u; k < p.plane_count; ++k) {
+  for (uint k = 0u; k < (by_impulse ? 0u : p.plane_count); ++k) {
     PlaneData pl = planes[k];
     f += plane_contact_force(xi, ui, pi.w, vi.w, pl.normal_offset,
                              contact_laws[law_base + pl.material], p.flags);

@@ -7,6 +7,7 @@
 #include "shared/links.h"
 #include "shared/params.h"
 #include "shared/shape_matching.h"
+#include "shared/impulse.h"
 #include "vulkan_bindings.h"
 
 layout(local_size_x = WORKGROUP_SIZE) in;
@@ -48,6 +49,11 @@ layout(std430, binding = B_CLUSTERS) readonly buffer ClustersBuf { Cluster clust
 layout(std430, binding = B_CLUSTER_MEMBERS) readonly buffer ClusterMembersBuf { ClusterMember cluster_members[]; };
 layout(std430, binding = B_CLUSTER_FRAMES) buffer ClusterFramesBuf { ClusterFrame cluster_frames[]; };
 layout(std430, binding = B_CLUSTER_GATHER) readonly buffer ClusterGatherBuf { uint cluster_gather[]; };
+layout(std430, binding = B_PARTICLE_MOMENT) buffer ParticleMomentBuf { vec4 particle_moment[]; };
+layout(std430, binding = B_BODY_VEL_START) buffer BodyVelStartBuf { vec4 body_vel_start[]; };
+layout(std430, binding = B_BODY_ANGVEL_START) buffer BodyAngVelStartBuf { vec4 body_angvel_start[]; };
+layout(std430, binding = B_CONTACT_IMPULSE) buffer ContactImpulseBuf { vec4 contact_impulse_acc[]; };
+layout(std430, binding = B_IMPULSE_STAMP) buffer ImpulseStampBuf { uint impulse_stamp[]; };
 layout(std430, binding = B_GRID_ARRIVAL) buffer GridArrivalBuf { uint grid_arrival[]; };
 layout(std430, binding = B_GRID_UNSORTED) buffer GridUnsortedBuf { uint grid_unsorted[]; };
 layout(std430, binding = B_SCAN_SCRATCH) buffer ScanScratchBuf { uint scan_scratch[]; };

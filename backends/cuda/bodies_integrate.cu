@@ -8,7 +8,7 @@ namespace {
 
 __global__ void bodies_integrate_kernel(shared::StepParams p, BodyBuffers d) {
   const std::uint64_t b = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
-  if (b < p.body_count) body_step(d, static_cast<shared::uint>(b), p.gravity_dt);
+  if (b < p.body_count) body_step(d, static_cast<shared::uint>(b), p.gravity_dt, p.flags);
 }
 
 }  // namespace

@@ -16,7 +16,7 @@ __global__ void bodies_step_kernel(shared::StepParams p, BodyBuffers d) {
   if (t < p.body_count) {
     const auto b = static_cast<shared::uint>(t);
     body_reduce(d, b);
-    body_step(d, b, p.gravity_dt);
+    body_step(d, b, p.gravity_dt, p.flags);
     const shared::uint end = d.first[b + 1];
     for (shared::uint i = d.first[b]; i < end; ++i) {
       moved = particle_update(d, i, b, p.neighbour_skin) || moved;

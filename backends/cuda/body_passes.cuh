@@ -30,14 +30,15 @@ __device__ inline void body_reduce(const BodyBuffers& d, shared::uint b) {
 }
 
 /// One semi-implicit Euler step of body b.
-__device__ inline void body_step(const BodyBuffers& d, shared::uint b, shared::vec4 gravity_dt) {
+__device__ inline void body_step(const BodyBuffers& d, shared::uint b, shared::vec4 gravity_dt,
+                                 shared::uint flags) {
   shared::vec4 pos = d.body_pos[b];
   shared::vec4 quat = d.quat[b];
   shared::vec4 vel = d.body_vel[b];
   shared::vec4 angmom = d.angmom[b];
   shared::vec4 angvel;
   shared::body_integrate(pos, quat, vel, angmom, angvel, d.inv_inertia[b], d.body_force[b],
-                         d.body_torque[b], gravity_dt);
+                         d.body_torque[b], gravity_dt, flags);
   d.body_pos[b] = pos;
   d.quat[b] = quat;
   d.body_vel[b] = vel;

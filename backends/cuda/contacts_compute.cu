@@ -47,7 +47,9 @@ __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
   const shared::ContactLaw* law_row = in.laws + std::size_t{in.material[i]} * p.material_count;
   vec3 f(0.0f);
   // The force of particle j on i (zero unless they overlap), added in order.
+  const bool by_impulse = shared::impulse_particle(p.flags, uint(i), p.rigid_particle_count);
   const auto add_contact = [&](uint j) {
+    if (by_impulse && j < p.rigid_particle_count) return;
     const vec4 pj = in.pos[j];
     const vec4 vj = in.vel[j];
     f += shared::particle_contact_force(xi, ui, pi.w, vi.w, shared::xyz(pj), shared::xyz(vj), pj.w,
@@ -65,7 +67,7 @@ __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
       }
     });
   }
-  for (uint k = 0; k < p.plane_count; ++k) {
+  for (uint k = 0; k < (by_impulse ? 0u : p.plane_count); ++k) {
     const shared::PlaneData pl = in.planes[k];
     f += shared::plane_contact_force(xi, ui, pi.w, vi.w, pl.normal_offset, law_row[pl.material],
                                      p.flags);

@@ -62,6 +62,10 @@ class CudaDevice final : public Device {
   }
   void clusters_fit(const shared::StepParams& p) override { enqueue(Kernel::ClustersFit, p); }
   void clusters_goal(const shared::StepParams& p) override { enqueue(Kernel::ClustersGoal, p); }
+  void impulses_compute(const shared::StepParams& p) override {
+    enqueue(Kernel::ImpulsesCompute, p);
+  }
+  void impulses_apply(const shared::StepParams& p) override { enqueue(Kernel::ImpulsesApply, p); }
 
   Status synchronize() override;
   Status check_guards() override;
@@ -114,6 +118,8 @@ class CudaDevice final : public Device {
   void launch_constraints_solve(const shared::StepParams& p);
   void launch_clusters_fit(const shared::StepParams& p);
   void launch_clusters_goal(const shared::StepParams& p);
+  void launch_impulses_compute(const shared::StepParams& p);
+  void launch_impulses_apply(const shared::StepParams& p);
   /// bodies_reduce, bodies_integrate and particles_update in one pass (bodies_step.cu), for scenes
   /// whose bodies are small; the same arithmetic as the three kernels.
   void launch_bodies_step(const shared::StepParams& p);

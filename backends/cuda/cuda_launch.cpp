@@ -55,6 +55,11 @@ void CudaDevice::enqueue(Kernel k, const shared::StepParams& p) {
         sizes_.clusters, sizes_.soft_particles));
     return;
   }
+  if ((k == Kernel::ImpulsesCompute || k == Kernel::ImpulsesApply) && sizes_.impulse == 0) {
+    error_ = Status::error(fmt::format(
+        "cuda: {} launched on buffers allocated without impulse contacts", kernel_name(k)));
+    return;
+  }
   pending_.push_back({k, p});
 }
 
@@ -100,6 +105,12 @@ std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t
       return 1;
     case Kernel::ConstraintsSolve:
       launch_constraints_solve(p);
+      return 1;
+    case Kernel::ImpulsesCompute:
+      launch_impulses_compute(p);
+      return 1;
+    case Kernel::ImpulsesApply:
+      launch_impulses_apply(p);
       return 1;
     case Kernel::Count:
       break;

@@ -24,7 +24,7 @@ void OpenMPDevice::bodies_integrate(const shared::StepParams& p) {
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(bodies))
   for (std::int64_t b = 0; b < bodies; ++b) {
     shared::body_integrate(pos[b], quat[b], vel[b], angmom[b], angvel[b], inv_inertia[b], force[b],
-                           torque[b], p.gravity_dt);
+                           torque[b], p.gravity_dt, p.flags);
   }
   record(Kernel::BodiesIntegrate, start);
 }

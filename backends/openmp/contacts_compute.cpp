@@ -49,7 +49,9 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
     const shared::ContactLaw* law_row = laws + std::size_t{material[i]} * materials;
     vec3 f(0.0f);
     // The force of particle j on i (zero unless they overlap), added in order.
+    const bool by_impulse = shared::impulse_particle(p.flags, uint(i), p.rigid_particle_count);
     auto add_contact = [&](uint j) {
+      if (by_impulse && j < p.rigid_particle_count) return;
       const vec4 pj = pos[j];
       const vec4 vj = vel[j];
       f += shared::particle_contact_force(xi, ui, pi.w, vi.w, shared::xyz(pj), shared::xyz(vj),
@@ -67,7 +69,7 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
         }
       }
     }
-    for (uint k = 0; k < p.plane_count; ++k) {
+    for (uint k = 0; k < (by_impulse ? 0u : p.plane_count); ++k) {
       const shared::PlaneData pl = planes[k];
       f += shared::plane_contact_force(xi, ui, pi.w, vi.w, pl.normal_offset, law_row[pl.material],
                                        p.flags);

@@ -61,6 +61,8 @@ class OpenMPDevice final : public Device {
   void constraints_solve(const shared::StepParams& p) override;
   void clusters_fit(const shared::StepParams& p) override;
   void clusters_goal(const shared::StepParams& p) override;
+  void impulses_compute(const shared::StepParams& p) override;
+  void impulses_apply(const shared::StepParams& p) override;
 
   Status synchronize() override { return Status::ok(); }
   Status check_guards() override;

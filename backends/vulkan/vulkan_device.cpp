@@ -31,6 +31,9 @@ static_assert(B_PLANES == static_cast<int>(Buffer::Planes));
 static_assert(B_CONSTRAINTS == static_cast<int>(Buffer::Constraints));
 static_assert(B_CLUSTERS == static_cast<int>(Buffer::Clusters));
 static_assert(B_CLUSTER_GATHER == static_cast<int>(Buffer::ClusterGather));
+static_assert(B_PARTICLE_MOMENT == static_cast<int>(Buffer::ParticleMoment));
+static_assert(B_BODY_ANGVEL_START == static_cast<int>(Buffer::BodyAngVelStart));
+static_assert(B_IMPULSE_STAMP == static_cast<int>(Buffer::ImpulseStamp));
 static_assert(B_GRID_ARRIVAL == static_cast<int>(Buffer::Count));
 
 namespace {
@@ -40,7 +43,7 @@ constexpr const char* kPipelineShaders[kPipelineCount] = {
     "grid_build_scan_add", "grid_build_scatter",  "grid_build_place", "neighbours_begin",
     "neighbours_build",    "contacts_compute",    "bodies_reduce",    "bodies_integrate",
     "particles_update",    "particles_integrate", "clusters_fit",     "clusters_goal",
-    "constraints_solve"};
+    "constraints_solve",   "impulses_compute",    "impulses_apply"};
 
 const char* binding_name(std::uint32_t binding) {
   if (binding < kBufferCount) return buffer_name(static_cast<Buffer>(binding));
@@ -689,6 +692,12 @@ void VulkanDevice::constraints_solve(const shared::StepParams& p) {
 }
 void VulkanDevice::clusters_fit(const shared::StepParams& p) { enqueue(Kernel::ClustersFit, p); }
 void VulkanDevice::clusters_goal(const shared::StepParams& p) { enqueue(Kernel::ClustersGoal, p); }
+void VulkanDevice::impulses_compute(const shared::StepParams& p) {
+  enqueue(Kernel::ImpulsesCompute, p);
+}
+void VulkanDevice::impulses_apply(const shared::StepParams& p) {
+  enqueue(Kernel::ImpulsesApply, p);
+}
 
 Listing list_devices() {
   Listing out;

@@ -40,6 +40,8 @@ enum class Pipeline : std::uint32_t {
   ClustersFit,
   ClustersGoal,
   ConstraintsSolve,
+  ImpulsesCompute,
+  ImpulsesApply,
   Count
 };
 constexpr std::size_t kPipelineCount = static_cast<std::size_t>(Pipeline::Count);
@@ -82,6 +84,8 @@ class VulkanDevice final : public Device {
   void constraints_solve(const shared::StepParams& p) override;
   void clusters_fit(const shared::StepParams& p) override;
   void clusters_goal(const shared::StepParams& p) override;
+  void impulses_compute(const shared::StepParams& p) override;
+  void impulses_apply(const shared::StepParams& p) override;
 
   Status synchronize() override;
   Status check_guards() override;
@@ -175,6 +179,8 @@ class VulkanDevice final : public Device {
   void record_constraints_solve(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_clusters_fit(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_clusters_goal(VkCommandBuffer cb, const shared::StepParams& p) const;
+  void record_impulses_compute(VkCommandBuffer cb, const shared::StepParams& p) const;
+  void record_impulses_apply(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_contacts_compute(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_bodies_reduce(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_bodies_integrate(VkCommandBuffer cb, const shared::StepParams& p) const;

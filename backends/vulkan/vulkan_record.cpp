@@ -182,6 +182,12 @@ Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool ti
       case Kernel::ConstraintsSolve:
         record_constraints_solve(cb, p);
         break;
+      case Kernel::ImpulsesCompute:
+        record_impulses_compute(cb, p);
+        break;
+      case Kernel::ImpulsesApply:
+        record_impulses_apply(cb, p);
+        break;
       case Kernel::NeighboursUpdate:
       case Kernel::Count:
         break;

@@ -46,12 +46,16 @@ constexpr std::size_t kV1HeaderBytes = 48;
 /// (docs/architecture.md, "The step"). Not here: the fixed inputs (covered by the setup hash),
 /// forces (written before they are read in every substep) and GridBucket and SortedPos (read only
 /// by the list build that rewrites them).
-constexpr std::array<Buffer, 15> kStateBuffers = {
+/// The impulse contacts' history (ContactImpulse, ImpulseStamp) came last: files written before
+/// it have kSectionsBeforeImpulses sections and are read when those buffers are empty.
+constexpr std::array<Buffer, 17> kStateBuffers = {
     Buffer::ParticlePos,     Buffer::ParticleVel,    Buffer::BodyPos,       Buffer::BodyQuat,
     Buffer::BodyVel,         Buffer::BodyAngMom,     Buffer::BodyAngVel,    Buffer::ClusterFrames,
     Buffer::NeighbourRefPos, Buffer::NeighbourState, Buffer::NeighbourList, Buffer::NeighbourCount,
-    Buffer::GridOrder,       Buffer::GridCellStart,  Buffer::SortedBody,
+    Buffer::GridOrder,       Buffer::GridCellStart,  Buffer::SortedBody,    Buffer::ContactImpulse,
+    Buffer::ImpulseStamp,
 };
+constexpr std::size_t kSectionsBeforeImpulses = 15;
 // load_state checks these sections by position.
 constexpr std::size_t kPosSection = 0;
 constexpr std::size_t kVelSection = 1;
@@ -536,7 +540,14 @@ Status Simulation::load_state(const std::string& path) {
   const auto corrupt = [&](const std::string& what) {
     return Status::error(fmt::format("{}: corrupt checkpoint ({})", path, what));
   };
-  if (sections.size() != kStateBuffers.size()) return corrupt("section count");
+  if (sections.size() != kStateBuffers.size() && sections.size() != kSectionsBeforeImpulses) {
+    return corrupt("section count");
+  }
+  for (std::size_t k = sections.size(); k < kStateBuffers.size(); ++k) {
+    if (buffer_layout(kStateBuffers[k], sizes_).bytes() != 0) {
+      return corrupt(fmt::format("no section for {}", buffer_name(kStateBuffers[k])));
+    }
+  }
   for (std::size_t k = 0; k < sections.size(); ++k) {
     const BufferLayout layout = buffer_layout(kStateBuffers[k], sizes_);
     if (sections[k].buffer != static_cast<std::uint32_t>(kStateBuffers[k]) ||

@@ -22,6 +22,7 @@ std::vector<shared::ContactLaw> contact_law_table(const std::vector<Material>& m
       law.damping = static_cast<float>(0.5 * (x.damping + y.damping));
       law.tangential = static_cast<float>(0.5 * (x.tangential + y.tangential));
       law.friction = static_cast<float>(mu);
+      law.restitution = static_cast<float>(0.5 * (x.restitution + y.restitution));
     }
   }
   return table;

@@ -78,6 +78,16 @@ const char* buffer_name(Buffer b) {
       return "ClusterFrames";
     case Buffer::ClusterGather:
       return "ClusterGather";
+    case Buffer::ParticleMoment:
+      return "ParticleMoment";
+    case Buffer::BodyVelStart:
+      return "BodyVelStart";
+    case Buffer::BodyAngVelStart:
+      return "BodyAngVelStart";
+    case Buffer::ContactImpulse:
+      return "ContactImpulse";
+    case Buffer::ImpulseStamp:
+      return "ImpulseStamp";
     case Buffer::Count:
       break;
   }
@@ -108,6 +118,10 @@ const char* kernel_name(Kernel k) {
       return "clusters_goal";
     case Kernel::ConstraintsSolve:
       return "constraints_solve";
+    case Kernel::ImpulsesCompute:
+      return "impulses_compute";
+    case Kernel::ImpulsesApply:
+      return "impulses_apply";
     case Kernel::Count:
       break;
   }
@@ -164,6 +178,17 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
       return {sizeof(shared::ClusterFrame), s.clusters};
     case Buffer::ClusterGather:
       return {kUint, s.clusters > 0 ? std::size_t{s.soft_particles} + 1 + s.cluster_members : 0};
+    case Buffer::ParticleMoment:
+      return {kVec4, s.impulse != 0 ? std::size_t{s.rigid_particles} : 0};
+    case Buffer::BodyVelStart:
+    case Buffer::BodyAngVelStart:
+      return {kVec4, s.impulse != 0 ? std::size_t{s.bodies} : 0};
+    case Buffer::ContactImpulse:
+      return {kVec4, s.impulse != 0 ? (std::size_t{s.neighbour_capacity} + s.planes) *
+                                          std::size_t{s.rigid_particles}
+                                    : 0};
+    case Buffer::ImpulseStamp:
+      return {kUint, s.impulse != 0 ? std::size_t{s.rigid_particles} : 0};
     case Buffer::Count:
       break;
   }

@@ -22,8 +22,9 @@ struct BodyClass {
   int material = 0;
   double particle_mass = 0.0;
   std::size_t copies = 0;
-  std::string name;   ///< first body of the class, for messages: body "NAME", cloth "NAME"...
-  bool self = false;  ///< a cloth or rope of the class can touch itself
+  std::string name;      ///< first body of the class, for messages: body "NAME", cloth "NAME"...
+  bool self = false;     ///< a cloth or rope of the class can touch itself
+  bool impulse = false;  ///< rigid bodies of an impulse scene: no force among themselves
 };
 
 /// The worst contact found so far.
@@ -78,17 +79,25 @@ void check_stability(const Scene& scene, const std::vector<BodyEntry>& entries) 
   std::map<std::pair<int, double>, BodyClass> dynamic;
   // Material of static bodies, planes and pinned cloth or rope particles -> first user.
   std::map<int, std::string> partners;
+  // With impulse contacts (docs/architecture.md, "Impulse contacts"), rigid bodies meet static
+  // bodies, planes and each other without the force law: those pairs have no stability limit.
+  const bool impulses = scene.settings.contact_model == ContactModel::Impulses;
+  std::map<int, std::string> rigid_partners;  // static bodies and planes
   for (const BodyEntry& e : entries) {
     const BodySpec& b = scene.bodies[e.first];
     const Material& mat = scene.materials[static_cast<std::size_t>(b.material)];
     if (b.kind == BodyKind::Static) {
-      partners.emplace(b.material, fmt::format("static body \"{}\"", b.name));
+      rigid_partners.emplace(b.material, fmt::format("static body \"{}\"", b.name));
       continue;
     }
     const double d = b.shape->diameter;
     const double m = mat.density * d * d * d;
-    BodyClass& c = dynamic[{b.material, m}];
-    if (c.copies == 0) c = BodyClass{b.material, m, 0, fmt::format("body \"{}\"", b.name)};
+    const bool impulse = impulses && !b.soft;
+    // Impulse bodies form their own classes (a negative mass key), apart from soft bodies.
+    BodyClass& c = dynamic[{b.material, impulse ? -m : m}];
+    if (c.copies == 0) {
+      c = BodyClass{b.material, m, 0, fmt::format("body \"{}\"", b.name), false, impulse};
+    }
     c.copies += e.copies;
   }
   // Cloth and rope particles are lone spheres; they touch their own object beyond two lattice
@@ -107,7 +116,7 @@ void check_stability(const Scene& scene, const std::vector<BodyEntry>& entries) 
     c.self = c.self || side > 3;
   }
   for (const PlaneSpec& p : scene.planes) {
-    partners.emplace(p.material, fmt::format("plane \"{}\"", p.name));
+    rigid_partners.emplace(p.material, fmt::format("plane \"{}\"", p.name));
   }
 
   const std::vector<shared::ContactLaw> laws = contact_law_table(scene.materials);
@@ -135,7 +144,13 @@ void check_stability(const Scene& scene, const std::vector<BodyEntry>& entries) 
   };
   for (const auto& [key_a, a] : dynamic) {
     for (const auto& [material, name] : partners) consider(a, material, a.particle_mass, name);
+    if (!a.impulse) {
+      for (const auto& [material, name] : rigid_partners) {
+        consider(a, material, a.particle_mass, name);
+      }
+    }
     for (const auto& [key_b, b] : dynamic) {
+      if (a.impulse && b.impulse) continue;
       // A body does not touch itself: a class meets itself only through a second copy, or a
       // cloth or rope through itself.
       if (key_a == key_b && a.copies < 2 && !a.self) continue;

@@ -3,6 +3,7 @@
 // stability check in scene_check.cpp.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -25,7 +26,7 @@ using scene_detail::Sign;
 
 /// Reads the fields of a material object over `base` (missing fields keep base's values).
 Material read_material_fields(const Node& node, Material base) {
-  node.expect_object({"density", "stiffness", "damping", "tangential", "friction"});
+  node.expect_object({"density", "stiffness", "damping", "tangential", "friction", "restitution"});
   if (auto v = node.find("density")) base.density = v->number(Sign::Positive);
   if (auto v = node.find("stiffness")) base.stiffness = v->number(Sign::Positive);
   if (auto v = node.find("damping")) base.damping = v->number(Sign::NonNegative);
@@ -34,13 +35,21 @@ Material read_material_fields(const Node& node, Material base) {
     // null: no Coulomb cap, even if settings.contact has one.
     base.friction = v->json().is_null() ? -1.0 : v->number(Sign::NonNegative);
   }
+  if (auto v = node.find("restitution")) {
+    base.restitution = v->number(Sign::NonNegative);
+    if (!(base.restitution <= 1.0)) {
+      v->fail(fmt::format("must be a coefficient of restitution between 0 and 1, got {}",
+                          base.restitution));
+    }
+  }
   return base;
 }
 
 void read_settings(const Node& node, Settings& s, std::int64_t& max_particles) {
   node.expect_object({"dt", "substeps", "gravity", "particle_diameter", "clamp_attraction",
                       "duration", "output_interval", "max_particles", "neighbour_skin",
-                      "neighbour_capacity", "constraint_iterations", "link_damping", "contact"});
+                      "neighbour_capacity", "constraint_iterations", "link_damping",
+                      "contact_model", "impulse_iterations", "contact"});
   if (auto v = node.find("dt")) s.dt = v->number(Sign::Positive);
   if (auto v = node.find("substeps")) s.substeps = static_cast<int>(v->integer(1, 1'000'000));
   if (auto v = node.find("gravity")) s.gravity = v->vec3();
@@ -56,6 +65,19 @@ void read_settings(const Node& node, Settings& s, std::int64_t& max_particles) {
     s.constraint_iterations = static_cast<int>(v->integer(1, 1000));
   }
   if (auto v = node.find("link_damping")) s.link_damping = v->number(Sign::NonNegative);
+  if (auto v = node.find("contact_model")) {
+    const std::string model = v->string();
+    if (model == "dem") {
+      s.contact_model = ContactModel::Forces;
+    } else if (model == "impulse") {
+      s.contact_model = ContactModel::Impulses;
+    } else {
+      v->fail(fmt::format("unknown contact model \"{}\" (allowed: dem, impulse)", model));
+    }
+  }
+  if (auto v = node.find("impulse_iterations")) {
+    s.impulse_iterations = static_cast<int>(v->integer(1, 1000));
+  }
   if (auto v = node.find("max_particles")) {
     max_particles = v->integer(1, scene_detail::kParticleLimit);
   }
@@ -174,10 +196,22 @@ CameraSpec read_camera(const Node& node) {
 /// Every material a body, cloth, rope or plane uses needs a stiffness (from itself or
 /// settings.contact).
 void check_stiffness(const Scene& scene, const std::vector<std::string>& paths) {
+  // With impulse contacts, rigid bodies and planes meet each other without the force law: only
+  // soft bodies, cloth and ropes need a stiffness, and whatever they touch (they meet everything
+  // through forces).
+  const bool deformables =
+      !scene.linked.empty() || std::any_of(scene.bodies.begin(), scene.bodies.end(),
+                                           [](const BodySpec& b) { return b.soft; });
+  const bool forces_only_where_deformable =
+      scene.settings.contact_model == ContactModel::Impulses && !deformables;
   std::vector<bool> used(scene.materials.size(), false);
-  for (const BodySpec& b : scene.bodies) used[static_cast<std::size_t>(b.material)] = true;
+  for (const BodySpec& b : scene.bodies) {
+    if (!forces_only_where_deformable || b.soft) used[static_cast<std::size_t>(b.material)] = true;
+  }
   for (const LinkedSpec& l : scene.linked) used[static_cast<std::size_t>(l.material)] = true;
-  for (const PlaneSpec& p : scene.planes) used[static_cast<std::size_t>(p.material)] = true;
+  for (const PlaneSpec& p : scene.planes) {
+    if (!forces_only_where_deformable) used[static_cast<std::size_t>(p.material)] = true;
+  }
   static const Json none;
   for (std::size_t i = 0; i < scene.materials.size(); ++i) {
     if (!used[i] || scene.materials[i].stiffness > 0.0) continue;

@@ -74,8 +74,15 @@ Status Simulation::upload(const Scene& scene) {
   std::uint64_t rigid_bodies = 0;
   std::uint64_t soft_particles = 0;
   double max_diameter = 0.0;
-  const auto is_free_sphere = [](const BodySpec& b) {
-    return b.kind == BodyKind::Dynamic && !b.soft && b.shape->points.size() == 1 &&
+  // With impulse contacts every rigid body, one-particle ones too, is integrated as a body (an
+  // impulse at the contact point makes any sphere spin).
+  const bool impulses = settings_.contact_model == ContactModel::Impulses;
+  if (impulses && settings_.impulse_iterations < 1) {
+    return Status::error(fmt::format("{}: impulse_iterations must be at least 1 (got {})",
+                                     scene.source, settings_.impulse_iterations));
+  }
+  const auto is_free_sphere = [impulses](const BodySpec& b) {
+    return !impulses && b.kind == BodyKind::Dynamic && !b.soft && b.shape->points.size() == 1 &&
            b.angular_velocity.isZero(0.0);
   };
   for (const BodySpec& b : scene.bodies) {
@@ -138,6 +145,7 @@ Status Simulation::upload(const Scene& scene) {
   }
 
   sizes_.soft_particles = static_cast<std::uint32_t>(soft_particles);
+  sizes_.impulse = impulses ? 1u : 0u;
   Device& d = *device_;
   // Device memory and buffer limits: refuse before allocating anything, with both numbers and the
   // largest particle count that fits (again once the clusters are known, before the device
@@ -377,7 +385,8 @@ Status Simulation::upload(const Scene& scene) {
   params_.cell_size = static_cast<float>(max_diameter + skin);
   params_.inv_cell_size = static_cast<float>(1.0 / (max_diameter + skin));
   params_.material_count = sizes_.materials;
-  params_.flags = settings_.clamp_attraction ? MOTES_FLAG_CLAMP_ATTRACTION : 0u;
+  params_.flags = (settings_.clamp_attraction ? MOTES_FLAG_CLAMP_ATTRACTION : 0u) |
+                  (impulses ? MOTES_FLAG_IMPULSE : 0u);
   params_.rigid_particle_count = sizes_.rigid_particles;
   params_.neighbour_capacity = sizes_.neighbour_capacity;
   params_.neighbour_skin = static_cast<float>(skin);
@@ -447,6 +456,7 @@ Status Simulation::upload(const Scene& scene) {
   if (s) s = write_vector(d, Buffer::ClusterMembers, soft.members);
   if (s) s = write_vector(d, Buffer::ClusterFrames, frames);
   if (s) s = write_vector(d, Buffer::ClusterGather, gather);
+  if (s) s = clear_contact_history();
   if (!s) return s;
   // Rigid particles take their pose from the bodies with the device's own arithmetic.
   if (sizes_.rigid_particles > 0) d.particles_update(params_);
@@ -461,7 +471,9 @@ Status Simulation::step(std::uint64_t count) {
     for (int sub = 0; sub < settings_.substeps; ++sub) {
       d.neighbours_update(params_);
       d.contacts_compute(params_);
-      if (rigid) {
+      if (rigid && sizes_.impulse != 0) {
+        step_impulses();
+      } else if (rigid) {
         d.bodies_reduce(params_);
         d.bodies_integrate(params_);
         d.particles_update(params_);
@@ -484,6 +496,39 @@ Status Simulation::step(std::uint64_t count) {
     time_ = static_cast<double>(steps_) * settings_.dt;
   }
   return d.synchronize();
+}
+
+void Simulation::step_impulses() {
+  // Forces (soft bodies, cloth, ropes, gravity) move the velocities; then the impulse stage:
+  // count each body's contacts and keep the start velocities, sweep every contact
+  // impulse_iterations times (shared/impulse.h); then the poses from the final velocities.
+  Device& d = *device_;
+  shared::StepParams velocity = params_;
+  velocity.flags |= MOTES_FLAG_BODY_VELOCITY;
+  shared::StepParams count = params_;
+  count.flags |= MOTES_FLAG_IMPULSE_COUNT;
+  shared::StepParams pose = params_;
+  pose.flags |= MOTES_FLAG_BODY_POSE;
+  d.bodies_reduce(params_);
+  d.bodies_integrate(velocity);
+  d.impulses_compute(count);
+  d.impulses_apply(count);
+  for (int it = 0; it < settings_.impulse_iterations; ++it) {
+    d.impulses_compute(params_);
+    d.impulses_apply(params_);
+  }
+  d.bodies_integrate(pose);
+  d.particles_update(params_);
+}
+
+Status Simulation::clear_contact_history() {
+  if (sizes_.impulse == 0) return Status::ok();
+  Device& d = *device_;
+  const std::vector<vec4> acc(buffer_layout(Buffer::ContactImpulse, sizes_).count, vec4(0.0f));
+  const std::vector<std::uint32_t> stamp(sizes_.rigid_particles, 0u);
+  Status s = write_vector(d, Buffer::ContactImpulse, acc);
+  if (s) s = write_vector(d, Buffer::ImpulseStamp, stamp);
+  return s;
 }
 
 Result<Snapshot> Simulation::snapshot() {
@@ -591,6 +636,7 @@ Status Simulation::restore(const Snapshot& state) {
   if (s) s = write_vector(d, Buffer::BodyAngMom, bangmom);
   if (s) s = write_vector(d, Buffer::BodyAngVel, bangvel);
   if (s) s = d.write(Buffer::NeighbourState, neighbour_state, sizeof neighbour_state);
+  if (s) s = clear_contact_history();
   if (s && state.cluster_rotation.size() == sizes_.clusters && sizes_.clusters > 0) {
     std::vector<shared::ClusterFrame> frames;
     s = read_vector(d, Buffer::ClusterFrames, frames, sizes_.clusters);

@@ -231,6 +231,17 @@ Scene dominoes_workload(int count, int rows) {
   return scene;
 }
 
+Scene impulse_dominoes_workload(int count, int rows) {
+  Scene scene = dominoes_workload(count, rows);
+  scene.source = fmt::format("<impulse dominoes {} in {} rows>", count, rows);
+  scene.settings.dt = 2e-4;
+  scene.settings.contact_model = ContactModel::Impulses;
+  scene.settings.impulse_iterations = 16;
+  for (Material& m : scene.materials) m.restitution = 0.3;
+  scene.settings.contact.restitution = 0.3;
+  return scene;
+}
+
 Scene cloth_workload(int side) {
   constexpr double d = 0.01;
   Scene scene;

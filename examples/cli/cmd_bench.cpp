@@ -56,6 +56,7 @@ struct Measurement {
   std::uint32_t rigid_particles = 0, rigid_bodies = 0;
   std::uint32_t table = 0;
   std::uint64_t constraint_sweeps = 0;  // constraints projected per step (C x iterations)
+  std::uint64_t impulse_sweeps = 0;     // impulse passes per step ((iterations + 1) x substeps)
   std::uint32_t soft_particles = 0, clusters = 0, cluster_members = 0;
   std::uint64_t steps = 0;         // per timed repeat
   std::vector<double> seconds;     // per repeat, kernel timing off
@@ -122,6 +123,10 @@ Measurement measure(const motes::Scene& scene, const BenchOptions& o, std::uint6
       m.constraint_sweeps = std::uint64_t{sim->sizes().constraints} *
                             static_cast<std::uint64_t>(sim->settings().constraint_iterations) *
                             static_cast<std::uint64_t>(sim->settings().substeps);
+      if (sim->sizes().impulse != 0) {
+        m.impulse_sweeps = static_cast<std::uint64_t>(sim->settings().impulse_iterations + 1) *
+                           static_cast<std::uint64_t>(sim->settings().substeps);
+      }
       m.backend = sim->device().info().backend;
       m.device = sim->device().info().name;
       m.detail = sim->device().info().detail;
@@ -177,6 +182,14 @@ double compulsory_bytes(motes::Kernel k, const Measurement& m) {
     case motes::Kernel::ConstraintsSolve:  // per projection: read the constraint, both
                                            // particles' pos, vel, ref; write their pos, vel
       return (16.0 + 96.0 + 64.0) * static_cast<double>(m.constraint_sweeps);
+    case motes::Kernel::ImpulsesCompute:  // per sweep: read own pos, vel, body, material, count,
+                                          // the body's 7 vec4 once; write impulse, moment (the
+                                          // entries, the neighbours gathered and the contacts'
+                                          // accumulated impulses are not counted)
+      return ((16.0 + 16.0 + 12.0 + 32.0) * nr + 112.0 * b) * static_cast<double>(m.impulse_sweeps);
+    case motes::Kernel::ImpulsesApply:  // per sweep: read first, com, quat, inertia, vel, angmom,
+                                        // impulses and moments; write vel, angmom, angvel
+      return (4.0 * (b + 1) + 128.0 * b + 32.0 * nr) * static_cast<double>(m.impulse_sweeps);
     case motes::Kernel::Count:
       break;
   }
@@ -281,9 +294,10 @@ void print_row(const Measurement& m) {
 
 void run_bench(const BenchOptions& o) {
   if (o.workload != "all" && o.workload != "settle" && o.workload != "dominoes" &&
-      o.workload != "cloth" && o.workload != "soft") {
-    fail(fmt::format("--workload must be settle, dominoes, cloth, soft or all, got '{}'",
-                     o.workload));
+      o.workload != "cloth" && o.workload != "soft" && o.workload != "impulse-dominoes") {
+    fail(fmt::format(
+        "--workload must be settle, dominoes, cloth, soft, impulse-dominoes or all, got '{}'",
+        o.workload));
   }
   if (o.domino_rows > o.dominoes) {  // a usage error, as CLI11's own checks report them
     throw CLI::ValidationError(
@@ -312,9 +326,9 @@ void run_bench(const BenchOptions& o) {
         o.repeats);
   }
   // Column labels of the kernel families, in motes::Kernel order (JSON has the full names).
-  constexpr std::array kLabels = {"nb_upd",   "grid",     "nb_build", "contacts",
-                                  "b_reduce", "b_integr", "p_update", "p_integr",
-                                  "cl_fit",   "cl_goal",  "constr"};
+  constexpr std::array kLabels = {"nb_upd",   "grid",     "nb_build", "contacts", "b_reduce",
+                                  "b_integr", "p_update", "p_integr", "cl_fit",   "cl_goal",
+                                  "constr",   "imp_comp", "imp_appl"};
   static_assert(kLabels.size() == motes::kKernelCount, "a label per kernel family");
   std::string ks;
   for (const char* label : kLabels) ks += fmt::format(" {:>8}", label);
@@ -384,6 +398,16 @@ void run_bench(const BenchOptions& o) {
       results.push_back(to_json(m));
     });
   }
+  if (o.workload == "impulse-dominoes") {
+    attempt([&] {
+      const motes::Scene scene = motes::impulse_dominoes_workload(o.dominoes, o.domino_rows);
+      Measurement m = measure(scene, o, o.domino_steps, [](motes::Simulation&) {});
+      m.workload = "imp-dom";
+      m.phase = "falling";
+      print_row(m);
+      results.push_back(to_json(m));
+    });
+  }
   if (o.workload == "cloth") {
     for (const int side : o.cloth_sides) {
       attempt([&] {
@@ -426,7 +450,8 @@ void add_bench_command(CLI::App& app) {
       "Run the fixed benchmark workloads (docs/benchmarks.md): W1 settle, W2 dominoes, W3 cloth, "
       "W4 soft");
   cmd->add_option("--workload", opts->workload,
-                  "settle, dominoes, all (settle and dominoes), cloth or soft")
+                  "settle, dominoes, all (settle and dominoes), cloth, soft or impulse-dominoes "
+                  "(W2's dominoes with impulse contacts)")
       ->capture_default_str();
   cmd->add_option("--cloth-sides", opts->cloth_sides,
                   "W3: cloth sides in particles (a side x side cloth each)")

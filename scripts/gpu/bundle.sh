@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds motes for the GPU machine and bundles what has to travel there (it has no network and
 # lacks assimp, the Vulkan loader and the glvnd libraries NVIDIA's Vulkan driver needs):
-#   gpu-bundle/bin/   motes, motes_conformance_tests (CUDA for sm_90, Vulkan, OpenMP),
+#   gpu-bundle/bin/   motes, motes_conformance_tests, motes_unit_tests (their CUDA cases: run
+#                     with --gtest_filter='*cuda*:*Cuda*') (CUDA for sm_90, Vulkan, OpenMP),
 #                     motes_gpu_floors (bench/gpu)
 #   gpu-bundle/lib/   their shared libraries, except those the GPU machine has (libc, libstdc++...)
 #   gpu-bundle/debs/  Debian packages of the Vulkan loader and glvnd (unpacked there by run.sh)
@@ -13,10 +14,12 @@ build=${1:-$root/build-gpu}
 bundle=$root/gpu-bundle
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DMOTES_WITH_VULKAN=ON \
   -DMOTES_WITH_CUDA=ON >/dev/null
-cmake --build "$build" -j "${JOBS:-$(nproc)}" --target motes_cli motes_conformance_tests
+cmake --build "$build" -j "${JOBS:-$(nproc)}" --target motes_cli motes_conformance_tests \
+  motes_unit_tests
 rm -rf "$bundle/bin" "$bundle/lib"
 mkdir -p "$bundle/bin" "$bundle/lib" "$bundle/debs"
-cp "$build/bin/motes" "$build/tests/motes_conformance_tests" "$bundle/bin/"
+cp "$build/bin/motes" "$build/tests/motes_conformance_tests" "$build/tests/motes_unit_tests" \
+  "$bundle/bin/"
 # The floors every GPU number is compared with (copy bandwidth, CUB sort), for sm_90 plus PTX.
 nvcc=${NVCC:-$(command -v nvcc || echo /usr/local/cuda/bin/nvcc)}
 if [ -x "$nvcc" ]; then

@@ -6,11 +6,13 @@
 # slow part cannot lose the others' results. Results go to ${OUT:-gpu-out}/ (at most 8 files come
 # back from the GPU machine): conformance.txt, conformance.md, sanitize.txt, bench.txt, bench.json,
 # bench.md (scripts/gpu/bench-tables.py).
-# Usage: scripts/gpu/run-suite.sh [conformance|sanitize|bench|all]...   (default all)
+# Usage: scripts/gpu/run-suite.sh [conformance|unit|sanitize|bench|all]...   (default all)
+#   unit: the unit tests' CUDA cases (checkpoint resume on CUDA, the CLI on CUDA), into unit.txt
 #   MOTES_BENCH_RUNS="cuda:falling cuda:dominoes cuda:dense vulkan:falling ..."   what is measured
 #     (also BACKEND:huge: W1 at 67 M and 134 M particles, one short repeat; BACKEND:dominoes-1m:
 #     W2 with 1,000,000 dominoes; BACKEND:cloth: W3 at 256 x 256 and 1024 x 1024;
-#     BACKEND:soft: W4 with 1,000 and 10,000 soft cubes;
+#     BACKEND:soft: W4 with 1,000 and 10,000 soft cubes; BACKEND:impulse-dominoes: W2's chain
+#     with impulse contacts, 100,000 dominoes;
 #     openmp:scaling: W1 at 1 M on 1, 2, 4, 8 and 16 threads)
 #   MOTES_GPU_SIZES, MOTES_GPU_DENSE_SIZES   W1 sizes of the falling and dense phases
 #   MOTES_SANITIZE_TOOLS="memcheck racecheck"   compute-sanitizer tools
@@ -51,6 +53,10 @@ if want conformance; then
       --backend "$backend" --out "${TMPDIR:-/tmp}/motes-dominoes-$backend" || status=1
   done
 fi
+if want unit; then
+  part "${LIMIT_UNIT:-120}" unit motes_unit_tests --gtest_brief=1 --gtest_filter='*cuda*:*Cuda*' ||
+    status=1
+fi
 if want sanitize; then
   sanitizer=$(command -v compute-sanitizer || echo /usr/local/cuda/bin/compute-sanitizer)
   # Every CUDA case under memcheck; racecheck (much slower) leaves out the one-second domino
@@ -85,6 +91,10 @@ if want bench; then
       cloth)
         part "${LIMIT_CLOTH:-120}" bench motes bench --backend "$backend" --workload cloth \
           --cloth-sides 256,1024 --json "$j" ;;
+      impulse-dominoes)
+        part "${LIMIT_DOMINOES:-60}" bench motes bench --backend "$backend" \
+          --workload impulse-dominoes --dominoes 100000 --domino-rows 100 --domino-steps 500 \
+          --json "$j" ;;
       soft)
         part "${LIMIT_SOFT:-120}" bench motes bench --backend "$backend" --workload soft \
           --soft-counts 1000,10000 --json "$j" ;;

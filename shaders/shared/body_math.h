@@ -4,6 +4,7 @@
 #define MOTES_SHARED_BODY_MATH_H
 
 #include "common.h"
+#include "params.h"
 #include "quaternion.h"
 
 MOTES_SHARED_BEGIN
@@ -17,20 +18,32 @@ MOTES_FN vec3 body_angular_velocity(vec4 q, vec4 inv_inertia, vec3 angular_momen
 /// One semi-implicit Euler step of a dynamic body (pos_invm.w > 0):
 ///   v += dt (F/m + g);  x += dt v;  L += dt tau;
 ///   q_half = exp(w(q, L) dt / 4) q;  q = exp(w(q_half, L) dt / 2) q;  w = w(q, L).
-/// Static bodies (pos_invm.w == 0) are left untouched.
+/// flags (StepParams.flags) may ask for one half: MOTES_FLAG_BODY_VELOCITY stops after v and L
+/// (w from the unchanged q), MOTES_FLAG_BODY_POSE starts from v and L as they are (the impulse
+/// stage runs between the two). Static bodies (pos_invm.w == 0) are left untouched.
 MOTES_FN void body_integrate(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
                              MOTES_INOUT(vec4) vel, MOTES_INOUT(vec4) angmom,
                              MOTES_OUT(vec4) angvel, vec4 inv_inertia, vec4 force, vec4 torque,
-                             vec4 gravity_dt) {
+                             vec4 gravity_dt, uint flags) {
   float inv_m = pos_invm.w;
   if (inv_m == 0.0f) {
     angvel = vec4(0.0f);
     return;
   }
   float dt = gravity_dt.w;
-  vec3 v = xyz(vel) + (xyz(force) * inv_m + xyz(gravity_dt)) * dt;
+  vec3 v = xyz(vel);
+  vec3 l = xyz(angmom);
+  if ((flags & MOTES_FLAG_BODY_POSE) == 0u) {
+    v = v + (xyz(force) * inv_m + xyz(gravity_dt)) * dt;
+    l = l + xyz(torque) * dt;
+  }
+  if ((flags & MOTES_FLAG_BODY_VELOCITY) != 0u) {
+    vel = vec4(v, 0.0f);
+    angmom = vec4(l, 0.0f);
+    angvel = vec4(body_angular_velocity(quat, inv_inertia, l), 0.0f);
+    return;
+  }
   vec3 x = xyz(pos_invm) + v * dt;
-  vec3 l = xyz(angmom) + xyz(torque) * dt;
   vec4 q = quat;
   vec3 w = vec3(0.0f);
   if (l.x != 0.0f || l.y != 0.0f || l.z != 0.0f) {  // a body at rest in rotation stays so

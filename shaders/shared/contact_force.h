@@ -9,6 +9,13 @@
 
 MOTES_SHARED_BEGIN
 
+/// True when particle i (< particle count) is a rigid body's and the scene resolves rigid contacts
+/// by impulses (MOTES_FLAG_IMPULSE): its contacts with rigid particles and planes then get no
+/// force here (impulses_compute has them).
+MOTES_FN bool impulse_particle(uint flags, uint i, uint rigid_count) {
+  return (flags & MOTES_FLAG_IMPULSE) != 0u && i < rigid_count;
+}
+
 /// Force on particle i from a contact with unit normal n (pointing from i towards the other
 /// body), overlap > 0, relative velocity vrel = v_other - v_i and effective mass meff.
 MOTES_FN vec3 contact_law_force(vec3 n, float overlap, vec3 vrel, float meff, ContactLaw law,

@@ -9,6 +9,17 @@ MOTES_SHARED_BEGIN
 
 /// StepParams.flags: the normal force may not become attractive (clamped dashpot).
 #define MOTES_FLAG_CLAMP_ATTRACTION 1u
+/// StepParams.flags: rigid bodies meet each other and the planes with impulses (shared/impulse.h),
+/// so contacts_compute leaves those contacts out (every other contact keeps the force law).
+#define MOTES_FLAG_IMPULSE 2u
+/// impulses_compute / impulses_apply: the counting pass. Count each body's contacts, keep its
+/// velocities as the stage's start (BodyVelStart, BodyAngVelStart) and apply the warm start
+/// (each contact's accumulated impulse of the last substep).
+#define MOTES_FLAG_IMPULSE_COUNT 4u
+/// bodies_integrate: only the velocities (v += dt (F/m + g), L += dt tau, w from L).
+#define MOTES_FLAG_BODY_VELOCITY 8u
+/// bodies_integrate: only the pose, from the velocities as they are (x += dt v, q from L).
+#define MOTES_FLAG_BODY_POSE 16u
 
 /// Launch parameters of every kernel family; travels with the launch (push constants).
 struct StepParams {
@@ -36,12 +47,17 @@ struct StepParams {
 };
 
 /// Contact law of one pair of materials (symmetric): F_n = k d - gamma_n m* v_n,
-/// F_t = gamma_t m* v_t, |F_t| <= mu |F_n| when friction >= 0.
+/// F_t = gamma_t m* v_t, |F_t| <= mu |F_n| when friction >= 0. Impulse contacts use the friction
+/// and the restitution (shared/impulse.h).
 struct ContactLaw {
-  float stiffness;   // k (N/m)
-  float damping;     // gamma_n (1/s), multiplied by the effective mass m*
-  float tangential;  // gamma_t (1/s), multiplied by m*
-  float friction;    // Coulomb cap mu; negative: no cap (Harada's purely viscous force)
+  float stiffness;    // k (N/m)
+  float damping;      // gamma_n (1/s), multiplied by the effective mass m*
+  float tangential;   // gamma_t (1/s), multiplied by m*
+  float friction;     // Coulomb cap mu; negative: no cap (Harada's purely viscous force)
+  float restitution;  // e of impulse contacts, in [0, 1]
+  float reserved0;    // 0
+  float reserved1;    // 0
+  float reserved2;    // 0
 };
 
 /// Static analytic half-space: solid where dot(normal, x) < offset.
@@ -67,7 +83,7 @@ static_assert(offsetof(motes::shared::StepParams, cluster_count) == 80, "StepPar
 static_assert(offsetof(motes::shared::StepParams, reserved2) + sizeof(motes::shared::uint) ==
                   sizeof(motes::shared::StepParams),
               "StepParams must have no padding");
-static_assert(sizeof(motes::shared::ContactLaw) == 16, "ContactLaw layout");
+static_assert(sizeof(motes::shared::ContactLaw) == 32, "ContactLaw layout");
 static_assert(sizeof(motes::shared::PlaneData) == 32, "PlaneData layout");
 #endif
 

@@ -36,18 +36,6 @@ using motes::Buffer;
 
 constexpr double kTolerance = 1.0e-7;
 
-/// The lists of `g` (built at w.particles.pos) as a NeighbourList buffer of capacity K.
-std::vector<uint> list_buffer(const motes_ref::Neighbours& nb, uint capacity) {
-  const std::size_t n = nb.count.size();
-  std::vector<uint> out(std::size_t{capacity} * n, 0xFFFFFFFFu);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t k = 0; k < std::min<std::size_t>(nb.lists[i].size(), capacity); ++k) {
-      out[k * n + i] = nb.lists[i][k];
-    }
-  }
-  return out;
-}
-
 class ContactsCompute : public DeviceTest {
  protected:
   /// ParticleForce on the device for lists of capacity K (the world's sizes otherwise).

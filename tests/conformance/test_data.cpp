@@ -28,15 +28,20 @@ vec4 random_vec(Rng& rng, float scale, float w = 0.0f) {
 
 /// Three materials. Deliberately asymmetric: the buffer's contract is laws[a * M + b] with a =
 /// the particle's own material, and a symmetric table would hide swapped indices. Caps: none
-/// (-1), zero (no tangential force at all) and finite. Dashpots strong enough that the normal
-/// force often turns attractive, so MOTES_FLAG_CLAMP_ATTRACTION matters.
+/// (-1), zero (no tangential force at all) and finite; restitutions (impulse contacts) 0 to 0.9.
+/// Dashpots strong enough that the normal force often turns attractive, so
+/// MOTES_FLAG_CLAMP_ATTRACTION matters.
 std::vector<ContactLaw> three_materials() {
   return {
-      {200.0f, 400.0f, 300.0f, -1.0f},  {300.0f, 800.0f, 1000.0f, 0.5f},
-      {150.0f, 1500.0f, 2000.0f, 0.0f}, {250.0f, 600.0f, 500.0f, 0.3f},
-      {400.0f, 200.0f, 100.0f, -1.0f},  {500.0f, 1000.0f, 3000.0f, 0.8f},
-      {120.0f, 2000.0f, 1500.0f, 0.2f}, {350.0f, 300.0f, 800.0f, -1.0f},
-      {600.0f, 1200.0f, 400.0f, 0.4f},
+      {200.0f, 400.0f, 300.0f, -1.0f, 0.0f, 0.0f, 0.0f, 0.0f},
+      {300.0f, 800.0f, 1000.0f, 0.5f, 0.5f, 0.0f, 0.0f, 0.0f},
+      {150.0f, 1500.0f, 2000.0f, 0.0f, 0.2f, 0.0f, 0.0f, 0.0f},
+      {250.0f, 600.0f, 500.0f, 0.3f, 0.9f, 0.0f, 0.0f, 0.0f},
+      {400.0f, 200.0f, 100.0f, -1.0f, 0.0f, 0.0f, 0.0f, 0.0f},
+      {500.0f, 1000.0f, 3000.0f, 0.8f, 0.3f, 0.0f, 0.0f, 0.0f},
+      {120.0f, 2000.0f, 1500.0f, 0.2f, 0.7f, 0.0f, 0.0f, 0.0f},
+      {350.0f, 300.0f, 800.0f, -1.0f, 0.1f, 0.0f, 0.0f, 0.0f},
+      {600.0f, 1200.0f, 400.0f, 0.4f, 0.4f, 0.0f, 0.0f, 0.0f},
   };
 }
 
@@ -257,6 +262,17 @@ World random_bodies(std::uint32_t seed, std::size_t bodies) {
   w.params.inv_cell_size = 1.0f;
   w.params.material_count = 3;
   return w;
+}
+
+std::vector<uint> list_buffer(const motes_ref::Neighbours& nb, uint capacity) {
+  const std::size_t n = nb.count.size();
+  std::vector<uint> out(std::size_t{capacity} * n, 0xFFFFFFFFu);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t k = 0; k < std::min<std::size_t>(nb.lists[i].size(), capacity); ++k) {
+      out[k * n + i] = nb.lists[i][k];
+    }
+  }
+  return out;
 }
 
 std::vector<vec4> random_forces(std::uint32_t seed, std::size_t n, float scale) {

@@ -88,6 +88,10 @@ World random_world(std::uint32_t seed, std::size_t n, std::uint32_t flags = 0, f
 /// 0.25 per substep.
 World with_linked(World w, std::uint32_t seed);
 
+/// The oracle's lists as a NeighbourList buffer of capacity K (entry k of particle i at k N + i;
+/// unused entries 0xFFFFFFFF).
+std::vector<uint> list_buffer(const motes_ref::Neighbours& nb, uint capacity);
+
 /// n forces with components uniform in [-scale, scale), w = 0.
 std::vector<vec4> random_forces(std::uint32_t seed, std::size_t n, float scale);
 

@@ -36,7 +36,7 @@ void main() {
   vec4 v = vel[i];
   vec4 l = vec4(1.0f, 0.0f, 0.0f, 0.0f);
   vec4 w;
-  body_integrate(body, q, v, l, w, vec4(1.0f), vec4(f, 0.0f), vec4(0.0f), p.gravity_dt);
+  body_integrate(body, q, v, l, w, vec4(1.0f), vec4(f, 0.0f), vec4(0.0f), p.gravity_dt, p.flags);
   vec3 x = particle_position(body, q, a) + particle_velocity(q, v, w, a);
   result[i] = vec4(x + particle_torque(a, body, vec4(f, 0.0f)), float(bucket));
 }

@@ -161,7 +161,7 @@ void bodies_integrate(Bodies& bodies, const StepParams& p) {
   for (std::size_t b = 0; b < bodies.size(); ++b) {
     motes::shared::body_integrate(bodies.pos[b], bodies.quat[b], bodies.vel[b], bodies.angmom[b],
                                   bodies.angvel[b], bodies.inv_inertia[b], bodies.force[b],
-                                  bodies.torque[b], p.gravity_dt);
+                                  bodies.torque[b], p.gravity_dt, p.flags);
   }
 }
 

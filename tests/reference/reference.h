@@ -142,6 +142,34 @@ bool clusters_goal(Particles& particles, const std::vector<ClusterMember>& membe
                    const std::vector<ClusterFrame>& frames, const StepParams& p,
                    const std::vector<vec4>& ref = {});
 
+/// The state of the impulse stage (MOTES_FLAG_IMPULSE) that impulses_compute and impulses_apply
+/// read or write besides the particles and bodies.
+struct ImpulseState {
+  std::vector<vec4> vel0;     ///< B: BodyVelStart (w: the body's counted contacts)
+  std::vector<vec4> angvel0;  ///< B: BodyAngVelStart
+  std::vector<vec4> acc;      ///< (K + P) x Nr: ContactImpulse, slot k of particle i at k Nr + i
+  std::vector<uint> stamp;    ///< Nr: ImpulseStamp
+  uint builds = 0;            ///< NeighbourState[MOTES_NEIGHBOUR_BUILDS]
+  std::vector<vec4> impulse;  ///< Nr: ParticleForce (xyz impulse, w counted contacts)
+  std::vector<vec4> moment;   ///< Nr: ParticleMoment
+};
+
+/// impulses_compute: for every dynamic rigid particle i (static ones get 0), the contacts with the
+/// rigid particles j of nb.lists[i] (every neighbour, in canonical order: what the device reads
+/// from its list, or walks in the grid beyond K), each with shared::pair_impulse (lower id first)
+/// and the accumulated impulse of i's slot k (shared::impulse_pair_slotted; an unslotted contact
+/// starts from 0 and keeps nothing), then the planes (slot K + k) with plane_contact_impulse; the
+/// counting pass reads slots only when stamp[i] == builds, and sets stamp[i]. Summed in float in
+/// that order (shared::impulse_add), as the contract says.
+void impulses_compute(const Particles& particles, const Bodies& bodies, const Neighbours& nb,
+                      const std::vector<ContactLaw>& laws, const std::vector<PlaneData>& planes,
+                      const StepParams& p, ImpulseState& s);
+
+/// impulses_apply: each dynamic body's particles' impulses, counts and moments summed in float in
+/// particle order; the counting pass first keeps vel0 = (vel, count) and angvel0 = angvel; then
+/// shared::body_apply_impulse (static bodies: angvel from angmom only).
+void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s);
+
 /// One whole step in the core's order (the grid and the lists are skipped: the brute-force
 /// contacts do not need them).
 void step(Particles& particles, Bodies& bodies, const std::vector<ContactLaw>& laws,

@@ -59,6 +59,8 @@ class LimitedDevice final : public motes::Device {
   void constraints_solve(const StepParams& p) override { inner_->constraints_solve(p); }
   void clusters_fit(const StepParams& p) override { inner_->clusters_fit(p); }
   void clusters_goal(const StepParams& p) override { inner_->clusters_goal(p); }
+  void impulses_compute(const StepParams& p) override { inner_->impulses_compute(p); }
+  void impulses_apply(const StepParams& p) override { inner_->impulses_apply(p); }
   Status synchronize() override { return inner_->synchronize(); }
   Status check_guards() override { return inner_->check_guards(); }
   void set_timing(bool on) override { inner_->set_timing(on); }

@@ -137,9 +137,9 @@ Particles one_cell(std::size_t n, float rmax, vec3 corner, unsigned seed) {
 
 std::vector<ContactLaw> contact_laws() {
   // Symmetric M x M table with distinct laws, one of them with a Coulomb cap.
-  const ContactLaw l00{100.0f, 5.0f, 2.0f, -1.0f};
-  const ContactLaw l01{200.0f, 3.0f, 1.0f, 0.4f};
-  const ContactLaw l11{150.0f, 4.0f, 3.0f, 0.2f};
+  const ContactLaw l00{100.0f, 5.0f, 2.0f, -1.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  const ContactLaw l01{200.0f, 3.0f, 1.0f, 0.4f, 0.0f, 0.0f, 0.0f, 0.0f};
+  const ContactLaw l11{150.0f, 4.0f, 3.0f, 0.2f, 0.0f, 0.0f, 0.0f, 0.0f};
   return {l00, l01, l01, l11};
 }
 

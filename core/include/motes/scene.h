@@ -26,6 +26,16 @@ struct Material {
   double damping = 0.0;     ///< gamma_n (1/s): normal dashpot force = gamma_n m* v_n
   double tangential = 0.0;  ///< gamma_t (1/s): tangential force = gamma_t m* v_t
   double friction = -1.0;   ///< Coulomb cap mu on the tangential force; < 0: no cap
+  /// Impulse contacts (Settings::contact_model): coefficient of restitution e in [0, 1] (a pair
+  /// takes the mean of its two materials').
+  double restitution = 0.0;
+};
+
+/// How rigid bodies meet each other and the planes (docs/architecture.md, "Impulse contacts").
+/// Soft bodies, cloth and ropes always meet everything through the force law.
+enum class ContactModel {
+  Forces,   ///< Harada's DEM: spring, dashpot and tangential force per particle contact
+  Impulses  ///< Guendelman et al. 2003: impulses with restitution and Coulomb friction
 };
 
 /// Global settings of a scene.
@@ -45,6 +55,10 @@ struct Settings {
   int constraint_iterations = 8;
   /// Cloth and ropes: their particles' velocities decay at this rate (1/s); 0 = none.
   double link_damping = 0.0;
+  /// Rigid-body contacts by forces (default) or by impulses ("contact_model": "impulse").
+  ContactModel contact_model = ContactModel::Forces;
+  /// Impulse contacts: Jacobi sweeps over every contact per substep.
+  int impulse_iterations = 16;
   Material contact;  ///< defaults for materials' missing fields
 };
 

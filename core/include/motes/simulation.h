@@ -133,6 +133,11 @@ class Simulation {
  private:
   Simulation() = default;
   Status upload(const Scene& scene);
+  /// The rigid bodies' part of a substep with impulse contacts (docs/architecture.md).
+  void step_impulses();
+  /// Impulse contacts: every contact's accumulated impulse to zero and its list slots void (a
+  /// new state has no contact history to warm-start from).
+  Status clear_contact_history();
   /// Writes a scene-ordered state (a snapshot or a checkpoint's) to the device and asks for a
   /// neighbour-list rebuild.
   Status restore(const Snapshot& state);

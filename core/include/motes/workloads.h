@@ -29,6 +29,11 @@ bool settle_dimensions(std::uint64_t particles, int& nx, int& ny, int& nz);
 /// on a floor, pitch 0.6 x domino height along a row; the first of each row is tipped.
 Scene dominoes_workload(int count, int rows);
 
+/// "impulse-dominoes": W2's dominoes with impulse contacts (settings.contact_model Impulses, 16
+/// iterations; restitution 0.3, friction 0.5) and dt = 2e-4 s, ten times W2's: impulses have no
+/// stiffness to resolve, only the travel per step to keep below the contact margin.
+Scene impulse_dominoes_workload(int count, int rows);
+
 /// W3 "cloth": a side x side cloth (d = 0.01 m particles, spacing d; structural, shear and bend
 /// links; 8 relaxation sweeps; self-collision on) held at the two corners of one edge, starting
 /// flat at y = 0.1 m + side d so that it swings down and folds without reaching the floor at

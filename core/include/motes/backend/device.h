@@ -60,6 +60,17 @@ enum class Buffer : std::uint32_t {
   /// uint (Ns + 1 + Sm): soft particle Ns + k is in the members ClusterGather[j] for j in
   /// [ClusterGather[k], ClusterGather[k + 1]) (the offsets count from the buffer's start).
   ClusterGather,
+  // Impulse contacts (StepParams.flags MOTES_FLAG_IMPULSE; empty otherwise): rigid bodies only.
+  ParticleMoment,   ///< vec4 (Nr): impulses_compute's moment about the body's centre of mass
+  BodyVelStart,     ///< vec4 (B): BodyVel at the start of the impulse stage, w = contacts
+  BodyAngVelStart,  ///< vec4 (B): BodyAngVel at the start of the impulse stage
+  /// vec4 ((K + P) x Nr): accumulated impulse of every contact of rigid particle i (xyz: on the
+  /// lower particle id's body, w: its normal part), its list slot k at k * Nr + i, plane k at
+  /// (K + k) * Nr + i. Kept across substeps while the lists stay (warm start).
+  ContactImpulse,
+  /// uint (Nr): NeighbourState[MOTES_NEIGHBOUR_BUILDS] when particle i's list slots of
+  /// ContactImpulse were last written; another value: the lists were rebuilt, the slots are void.
+  ImpulseStamp,
   Count
 };
 
@@ -77,6 +88,8 @@ enum class Kernel : std::uint32_t {
   ClustersFit,
   ClustersGoal,
   ConstraintsSolve,
+  ImpulsesCompute,
+  ImpulsesApply,
   Count
 };
 
@@ -99,6 +112,7 @@ struct Sizes {
   std::uint32_t soft_particles = 0;      ///< Ns: particles of soft bodies
   std::uint32_t clusters = 0;            ///< S: shape-matching clusters
   std::uint32_t cluster_members = 0;     ///< Sm: their members (a particle may be in several)
+  std::uint32_t impulse = 0;             ///< 1: rigid contacts by impulses (buffers for them)
 };
 
 /// Bytes of one element and number of elements of a buffer.
@@ -238,6 +252,20 @@ class Device {
   /// its members in ClusterGather order (its velocity by the same / dt); asks for a rebuild when
   /// one ends too far from its NeighbourRefPos.
   virtual void clusters_goal(const shared::StepParams& p) = 0;
+
+  /// Impulse contacts (shared/impulse.h), rigid particles [0, Nr) only: ParticleForce xyz = the
+  /// sum of particle_contact_impulse over its list's rigid particles in list order (each pair
+  /// evaluated lower id first, negated for the higher), then plane_contact_impulse over the
+  /// planes; w = the contacts counted; ParticleMoment = the sum of (c - x_com) x J. The bodies'
+  /// state: BodyPos, BodyQuat, BodyInvInertia, BodyVel, BodyAngVel now, BodyVelStart and
+  /// BodyAngVelStart. Static particles get 0. With MOTES_FLAG_IMPULSE_COUNT the same (only w is
+  /// used).
+  virtual void impulses_compute(const shared::StepParams& p) = 0;
+  /// Every dynamic body sums its particles' ParticleForce and ParticleMoment in particle order,
+  /// then shared/impulse.h: body_apply_impulse (BodyVel, BodyAngMom, BodyAngVel). With
+  /// MOTES_FLAG_IMPULSE_COUNT instead: BodyVelStart = (BodyVel xyz, the summed count),
+  /// BodyAngVelStart = BodyAngVel.
+  virtual void impulses_apply(const shared::StepParams& p) = 0;
 
   /// Waits for queued work; reports any error it raised.
   virtual Status synchronize() = 0;

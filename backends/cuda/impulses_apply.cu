@@ -1,0 +1,71 @@
+// impulses_apply: each dynamic body (one thread per body) sums its particles' impulses, counts and
+// moments in particle order and applies them (shared/impulse.h: body_apply_impulse); with
+// MOTES_FLAG_IMPULSE_COUNT it first keeps its velocities and contact count as the start of the
+// impulse stage. As backends/openmp/impulses_apply.cpp.
+#include "cuda_device.h"
+#include "shared/impulse.h"
+
+namespace motes::cuda {
+
+using shared::uint;
+using shared::vec3;
+using shared::vec4;
+
+namespace {
+
+struct ApplyBuffers {
+  const uint* __restrict__ first;
+  const vec4* __restrict__ com;
+  const vec4* __restrict__ quat;
+  const vec4* __restrict__ inv_inertia;
+  const vec4* __restrict__ impulse;
+  const vec4* __restrict__ moment;
+  vec4* __restrict__ vel;
+  vec4* __restrict__ angmom;
+  vec4* __restrict__ angvel;
+  vec4* __restrict__ vel0;
+  vec4* __restrict__ angvel0;
+};
+
+__global__ void impulses_apply_kernel(shared::StepParams p, ApplyBuffers d) {
+  const std::uint64_t t = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
+  if (t >= p.body_count) return;
+  const auto b = static_cast<uint>(t);
+  const vec4 com = d.com[b];
+  vec4 sum(0.0f);
+  vec3 m(0.0f);
+  if (com.w != 0.0f) {
+    const uint end = d.first[b + 1];
+    for (uint i = d.first[b]; i < end; ++i) {
+      sum = sum + d.impulse[i];
+      m += shared::xyz(d.moment[i]);
+    }
+  }
+  if ((p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
+    d.vel0[b] = vec4(shared::xyz(d.vel[b]), sum.w);
+    d.angvel0[b] = d.angvel[b];
+  }
+  vec4 vel = d.vel[b];
+  vec4 angmom = d.angmom[b];
+  vec4 angvel;
+  shared::body_apply_impulse(com, d.quat[b], d.inv_inertia[b], vel, angmom, angvel,
+                             shared::xyz(sum), m);
+  d.vel[b] = vel;
+  d.angmom[b] = angmom;
+  d.angvel[b] = angvel;
+}
+
+}  // namespace
+
+void CudaDevice::launch_impulses_apply(const shared::StepParams& p) {
+  if (p.body_count == 0) return;
+  const ApplyBuffers d{buf<uint>(Buffer::BodyFirst),      buf<vec4>(Buffer::BodyPos),
+                       buf<vec4>(Buffer::BodyQuat),       buf<vec4>(Buffer::BodyInvInertia),
+                       buf<vec4>(Buffer::ParticleForce),  buf<vec4>(Buffer::ParticleMoment),
+                       buf<vec4>(Buffer::BodyVel),        buf<vec4>(Buffer::BodyAngMom),
+                       buf<vec4>(Buffer::BodyAngVel),     buf<vec4>(Buffer::BodyVelStart),
+                       buf<vec4>(Buffer::BodyAngVelStart)};
+  impulses_apply_kernel<<<blocks_for(p.body_count), kBlock, 0, stream_>>>(p, d);
+}
+
+}  // namespace motes::cuda

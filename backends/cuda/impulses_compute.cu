@@ -1,0 +1,153 @@
+// impulses_compute: every dynamic rigid particle (one thread per particle id) sums the impulses of
+// its contacts with the rigid particles of its list, in list order (a particle with more
+// neighbours than its list holds walks the grid of the last build instead: the same pairs in the
+// same order), then the planes, and writes only its own impulse, count and moment
+// (shared/impulse.h). Each pair is evaluated lower id first, so the two particles of a contact get
+// bitwise opposite impulses; each keeps the contact's accumulated impulse in its own slot of
+// ContactImpulse (valid while ImpulseStamp matches the lists' build). As
+// backends/openmp/impulses_compute.cpp and shaders/impulses_compute.comp.
+#include "cuda_device.h"
+#include "grid_walk.cuh"
+#include "shared/impulse.h"
+#include "shared/links.h"
+#include "shared/neighbours.h"
+
+namespace motes::cuda {
+
+using shared::uint;
+using shared::vec3;
+using shared::vec4;
+
+namespace {
+
+struct ImpulseInputs {
+  const vec4* __restrict__ pos;
+  const vec4* __restrict__ vel;
+  const uint* __restrict__ body;
+  const uint* __restrict__ material;
+  const uint* __restrict__ list;
+  const uint* __restrict__ count;
+  const vec4* __restrict__ ref;
+  const uint* __restrict__ order;
+  const uint* __restrict__ cell_start;
+  const uint* __restrict__ sbody;
+  const shared::ContactLaw* __restrict__ laws;
+  const shared::PlaneData* __restrict__ planes;
+  const vec4* __restrict__ com;
+  const vec4* __restrict__ quat;
+  const vec4* __restrict__ inv_inertia;
+  const vec4* __restrict__ body_vel;
+  const vec4* __restrict__ body_angvel;
+  const vec4* __restrict__ vel0;
+  const vec4* __restrict__ angvel0;
+  const uint* __restrict__ state;
+};
+
+/// The state of body b that its contacts read.
+__device__ shared::ImpulseBody impulse_body(const ImpulseInputs& in, uint b, uint flags) {
+  shared::ImpulseBody s;
+  s.com = in.com[b];
+  s.quat = in.quat[b];
+  s.inv_inertia = in.inv_inertia[b];
+  s.vel = in.body_vel[b];
+  s.angvel = in.body_angvel[b];
+  s.vel0 = in.vel0[b];
+  s.angvel0 = in.angvel0[b];
+  return shared::impulse_body_for(s, flags);
+}
+
+__global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
+                                        vec4* __restrict__ impulse, vec4* __restrict__ moment,
+                                        vec4* __restrict__ acc, uint* __restrict__ stamp) {
+  const std::uint64_t t = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
+  if (t >= p.rigid_particle_count) return;
+  const auto i = static_cast<uint>(t);
+  const vec4 xi = in.pos[i];
+  if (in.vel[i].w == 0.0f) {  // static particle: its impulse is never used
+    impulse[i] = vec4(0.0f);
+    moment[i] = vec4(0.0f);
+    return;
+  }
+  const float margin = shared::impulse_margin(p.neighbour_skin);
+  const uint bi = in.body[i];
+  const shared::ImpulseBody own = impulse_body(in, bi, p.flags);
+  const shared::ContactLaw* law_row = in.laws + std::size_t{in.material[i]} * p.material_count;
+  const uint builds = in.state[MOTES_NEIGHBOUR_BUILDS];
+  const bool counting = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
+  const bool slots_valid = !counting || stamp[i] == builds;
+  const std::size_t nr = p.rigid_particle_count;
+  vec4 sum(0.0f);
+  vec3 moment_sum(0.0f);
+  // The impulse of the contact with particle j (rigid particles only), added in order; its
+  // accumulated impulse in slot `slot` (nullptr: none).
+  const auto add_contact = [&](uint j, vec4* slot) {
+    if (j >= p.rigid_particle_count) return;
+    const vec4 xj = in.pos[j];
+    const shared::ImpulseBody other = impulse_body(in, in.body[j], p.flags);
+    vec4 a = slot != nullptr && slots_valid ? *slot : vec4(0.0f);
+    const vec4 r = shared::pair_impulse(
+        own, xi, other, xj, i < j, margin,
+        in.laws[shared::pair_law_index(i, in.material[i], j, in.material[j], p.material_count)],
+        p.gravity_dt, p.flags, a);
+    if (slot != nullptr) *slot = a;
+    shared::impulse_add(sum, moment_sum, r, shared::pair_contact_point(xi, xj), own.com);
+  };
+  const uint c = in.count[i];
+  if (c <= p.neighbour_capacity) {
+    const std::size_t stride = p.particle_count;
+    for (uint k = 0; k < c; ++k) {
+      const uint j = in.list[std::size_t{k} * stride + i];
+      const bool slotted = j < p.rigid_particle_count &&
+                           shared::impulse_pair_slotted(c, in.count[j], p.neighbour_capacity);
+      add_contact(j, slotted ? acc + std::size_t{k} * nr + i : nullptr);
+    }
+  } else {
+    grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
+      for (uint s = lo; s < hi; ++s) {
+        if (!shared::contact_excluded(in.sbody[s], bi)) add_contact(in.order[s], nullptr);
+      }
+    });
+  }
+  for (uint k = 0; k < p.plane_count; ++k) {
+    const shared::PlaneData pl = in.planes[k];
+    vec4& a = acc[(std::size_t{p.neighbour_capacity} + k) * nr + i];
+    const vec4 r = shared::plane_contact_impulse(own, xi, pl.normal_offset, margin,
+                                                 law_row[pl.material], p.gravity_dt, p.flags, a);
+    shared::impulse_add(sum, moment_sum, r, shared::plane_contact_point(xi, pl.normal_offset),
+                        own.com);
+  }
+  if (counting) stamp[i] = builds;
+  impulse[i] = sum;
+  moment[i] = vec4(moment_sum, 0.0f);
+}
+
+}  // namespace
+
+void CudaDevice::launch_impulses_compute(const shared::StepParams& p) {
+  if (p.rigid_particle_count == 0) return;
+  const ImpulseInputs in{buf<vec4>(Buffer::ParticlePos),
+                         buf<vec4>(Buffer::ParticleVel),
+                         buf<uint>(Buffer::ParticleBody),
+                         buf<uint>(Buffer::ParticleMaterial),
+                         buf<uint>(Buffer::NeighbourList),
+                         buf<uint>(Buffer::NeighbourCount),
+                         buf<vec4>(Buffer::NeighbourRefPos),
+                         buf<uint>(Buffer::GridOrder),
+                         buf<uint>(Buffer::GridCellStart),
+                         buf<uint>(Buffer::SortedBody),
+                         buf<shared::ContactLaw>(Buffer::ContactLaws),
+                         buf<shared::PlaneData>(Buffer::Planes),
+                         buf<vec4>(Buffer::BodyPos),
+                         buf<vec4>(Buffer::BodyQuat),
+                         buf<vec4>(Buffer::BodyInvInertia),
+                         buf<vec4>(Buffer::BodyVel),
+                         buf<vec4>(Buffer::BodyAngVel),
+                         buf<vec4>(Buffer::BodyVelStart),
+                         buf<vec4>(Buffer::BodyAngVelStart),
+                         buf<uint>(Buffer::NeighbourState)};
+  impulses_compute_kernel<<<blocks_for(p.rigid_particle_count), kBlock, 0, stream_>>>(
+      p, in, buf<vec4>(Buffer::ParticleForce), buf<vec4>(Buffer::ParticleMoment),
+      buf<vec4>(Buffer::ContactImpulse), buf<uint>(Buffer::ImpulseStamp));
+}
+
+}  // namespace motes::cuda

@@ -1,0 +1,52 @@
+// impulses_apply: each dynamic body sums its particles' impulses, counts and moments in particle
+// order and applies them (shared/impulse.h: body_apply_impulse); with MOTES_FLAG_IMPULSE_COUNT it
+// first keeps its velocities and contact count as the start of the impulse stage.
+#include <chrono>
+#include <cstdint>
+
+#include "openmp_device.h"
+#include "shared/impulse.h"
+
+namespace motes::openmp {
+
+using shared::uint;
+using shared::vec3;
+using shared::vec4;
+
+void OpenMPDevice::impulses_apply(const shared::StepParams& p) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto bodies = static_cast<std::int64_t>(p.body_count);
+  const bool count_only = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
+  const uint* first = buf<uint>(Buffer::BodyFirst);
+  const vec4* com = buf<vec4>(Buffer::BodyPos);
+  const vec4* quat = buf<vec4>(Buffer::BodyQuat);
+  const vec4* inv_inertia = buf<vec4>(Buffer::BodyInvInertia);
+  const vec4* impulse = buf<vec4>(Buffer::ParticleForce);
+  const vec4* moment = buf<vec4>(Buffer::ParticleMoment);
+  vec4* vel = buf<vec4>(Buffer::BodyVel);
+  vec4* angmom = buf<vec4>(Buffer::BodyAngMom);
+  vec4* angvel = buf<vec4>(Buffer::BodyAngVel);
+  vec4* vel0 = buf<vec4>(Buffer::BodyVelStart);
+  vec4* angvel0 = buf<vec4>(Buffer::BodyAngVelStart);
+
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(bodies))
+  for (std::int64_t b = 0; b < bodies; ++b) {
+    vec4 sum(0.0f);
+    vec3 m(0.0f);
+    if (com[b].w != 0.0f) {
+      for (uint i = first[b]; i < first[b + 1]; ++i) {
+        sum = sum + impulse[i];
+        m += shared::xyz(moment[i]);
+      }
+    }
+    if (count_only) {  // the stage's start, then the warm start
+      vel0[b] = vec4(shared::xyz(vel[b]), sum.w);
+      angvel0[b] = angvel[b];
+    }
+    shared::body_apply_impulse(com[b], quat[b], inv_inertia[b], vel[b], angmom[b], angvel[b],
+                               shared::xyz(sum), m);
+  }
+  record(Kernel::ImpulsesApply, start);
+}
+
+}  // namespace motes::openmp

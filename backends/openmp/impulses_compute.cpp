@@ -1,0 +1,138 @@
+// impulses_compute: every dynamic rigid particle sums the impulses of its contacts with the rigid
+// particles of its list, in list order (a particle with more neighbours than its list holds walks
+// the grid of the last build instead: the same pairs in the same order), then the planes, and
+// writes only its own impulse, count and moment (shared/impulse.h). Each pair is evaluated with
+// the lower particle id first, so the two particles of a contact get bitwise opposite impulses;
+// each keeps the contact's accumulated impulse in its own slot of ContactImpulse (the same bits
+// on both sides). The counting pass reads the slots only while the lists are those that wrote them
+// (ImpulseStamp), and stamps them.
+#include <chrono>
+#include <cstdint>
+
+#include "grid_walk.h"
+#include "openmp_device.h"
+#include "shared/impulse.h"
+#include "shared/links.h"
+#include "shared/neighbours.h"
+
+namespace motes::openmp {
+
+using shared::uint;
+using shared::vec3;
+using shared::vec4;
+
+namespace {
+
+/// The state of body b that its contacts read.
+shared::ImpulseBody impulse_body(const vec4* com, const vec4* quat, const vec4* inv_inertia,
+                                 const vec4* vel, const vec4* angvel, const vec4* vel0,
+                                 const vec4* angvel0, uint b, uint flags) {
+  shared::ImpulseBody s;
+  s.com = com[b];
+  s.quat = quat[b];
+  s.inv_inertia = inv_inertia[b];
+  s.vel = vel[b];
+  s.angvel = angvel[b];
+  s.vel0 = vel0[b];
+  s.angvel0 = angvel0[b];
+  return shared::impulse_body_for(s, flags);
+}
+
+}  // namespace
+
+void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto n = static_cast<std::int64_t>(p.rigid_particle_count);
+  const std::size_t stride = p.particle_count;
+  const uint capacity = p.neighbour_capacity;
+  const uint materials = p.material_count;
+  const float margin = shared::impulse_margin(p.neighbour_skin);
+  const vec4* pos = buf<vec4>(Buffer::ParticlePos);
+  const vec4* vel = buf<vec4>(Buffer::ParticleVel);
+  const uint* body = buf<uint>(Buffer::ParticleBody);
+  const uint* material = buf<uint>(Buffer::ParticleMaterial);
+  const uint* list = buf<uint>(Buffer::NeighbourList);
+  const uint* count = buf<uint>(Buffer::NeighbourCount);
+  const vec4* ref = buf<vec4>(Buffer::NeighbourRefPos);
+  const uint* order = buf<uint>(Buffer::GridOrder);
+  const uint* cell_start = buf<uint>(Buffer::GridCellStart);
+  const uint* sbody = buf<uint>(Buffer::SortedBody);
+  const auto* laws = buf<shared::ContactLaw>(Buffer::ContactLaws);
+  const auto* planes = buf<shared::PlaneData>(Buffer::Planes);
+  const vec4* com = buf<vec4>(Buffer::BodyPos);
+  const vec4* quat = buf<vec4>(Buffer::BodyQuat);
+  const vec4* inv_inertia = buf<vec4>(Buffer::BodyInvInertia);
+  const vec4* body_vel = buf<vec4>(Buffer::BodyVel);
+  const vec4* body_angvel = buf<vec4>(Buffer::BodyAngVel);
+  const vec4* vel0 = buf<vec4>(Buffer::BodyVelStart);
+  const vec4* angvel0 = buf<vec4>(Buffer::BodyAngVelStart);
+  vec4* impulse = buf<vec4>(Buffer::ParticleForce);
+  vec4* moment = buf<vec4>(Buffer::ParticleMoment);
+  vec4* acc = buf<vec4>(Buffer::ContactImpulse);
+  uint* stamp = buf<uint>(Buffer::ImpulseStamp);
+  const uint builds = buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_BUILDS];
+  const bool counting = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
+  const std::size_t nr = p.rigid_particle_count;
+
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
+  for (std::int64_t i = 0; i < n; ++i) {
+    const vec4 xi = pos[i];
+    if (vel[i].w == 0.0f) {  // static particle: its impulse is never used
+      impulse[i] = vec4(0.0f);
+      moment[i] = vec4(0.0f);
+      continue;
+    }
+    const uint bi = body[i];
+    const shared::ImpulseBody own =
+        impulse_body(com, quat, inv_inertia, body_vel, body_angvel, vel0, angvel0, bi, p.flags);
+    const shared::ContactLaw* law_row = laws + std::size_t{material[i]} * materials;
+    const bool slots_valid = !counting || stamp[i] == builds;
+    vec4 sum(0.0f);
+    vec3 moment_sum(0.0f);
+    // The impulse of the contact with particle j (rigid particles only), added in order; its
+    // accumulated impulse in slot `slot` (nullptr: none).
+    auto add_contact = [&](uint j, vec4* slot) {
+      if (j >= p.rigid_particle_count) return;
+      const vec4 xj = pos[j];
+      const shared::ImpulseBody other = impulse_body(com, quat, inv_inertia, body_vel, body_angvel,
+                                                     vel0, angvel0, body[j], p.flags);
+      vec4 a = slot != nullptr && slots_valid ? *slot : vec4(0.0f);
+      const vec4 r = shared::pair_impulse(
+          own, xi, other, xj, static_cast<uint>(i) < j, margin,
+          laws[shared::pair_law_index(uint(i), material[i], j, material[j], materials)],
+          p.gravity_dt, p.flags, a);
+      if (slot != nullptr) *slot = a;
+      shared::impulse_add(sum, moment_sum, r, shared::pair_contact_point(xi, xj), own.com);
+    };
+    const uint c = count[i];
+    if (c <= capacity) {
+      for (uint k = 0; k < c; ++k) {
+        const uint j = list[std::size_t{k} * stride + std::size_t(i)];
+        const bool slotted =
+            j < p.rigid_particle_count && shared::impulse_pair_slotted(c, count[j], capacity);
+        add_contact(j, slotted ? acc + std::size_t{k} * nr + std::size_t(i) : nullptr);
+      }
+    } else {
+      const GridRanges ranges = grid_walk(p, ref[i], cell_start);
+      for (int r = 0; r < ranges.count; ++r) {
+        for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
+          if (!shared::contact_excluded(sbody[t], bi)) add_contact(order[t], nullptr);
+        }
+      }
+    }
+    for (uint k = 0; k < p.plane_count; ++k) {
+      const shared::PlaneData pl = planes[k];
+      vec4& a = acc[(std::size_t{capacity} + k) * nr + std::size_t(i)];
+      const vec4 r = shared::plane_contact_impulse(own, xi, pl.normal_offset, margin,
+                                                   law_row[pl.material], p.gravity_dt, p.flags, a);
+      shared::impulse_add(sum, moment_sum, r, shared::plane_contact_point(xi, pl.normal_offset),
+                          own.com);
+    }
+    if (counting) stamp[i] = builds;
+    impulse[i] = sum;
+    moment[i] = vec4(moment_sum, 0.0f);
+  }
+  record(Kernel::ImpulsesCompute, start);
+}
+
+}  // namespace motes::openmp

@@ -1,0 +1,33 @@
+#version 450
+// impulses_apply: each dynamic body (one thread per body) sums its particles' impulses, counts and
+// moments in particle order and applies them (shared/impulse.h: body_apply_impulse); with
+// MOTES_FLAG_IMPULSE_COUNT it first keeps its velocities and contact count as the start of the
+// impulse stage. As backends/openmp/impulses_apply.cpp.
+#extension GL_GOOGLE_include_directive : require
+#include "kernel_common.glsl"
+
+void main() {
+  uint b = thread_index();
+  if (b >= p.body_count) return;
+  vec4 com = body_pos[b];
+  vec4 sum = vec4(0.0f);
+  vec3 m = vec3(0.0f);
+  if (com.w != 0.0f) {
+    uint end = body_first[b + 1u];
+    for (uint i = body_first[b]; i < end; ++i) {
+      sum = sum + particle_force[i];
+      m += xyz(particle_moment[i]);
+    }
+  }
+  if ((p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
+    body_vel_start[b] = vec4(xyz(body_vel[b]), sum.w);
+    body_angvel_start[b] = body_angvel[b];
+  }
+  vec4 vel = body_vel[b];
+  vec4 angmom = body_angmom[b];
+  vec4 angvel;
+  body_apply_impulse(com, body_quat[b], body_inv_inertia[b], vel, angmom, angvel, xyz(sum), m);
+  body_vel[b] = vel;
+  body_angmom[b] = angmom;
+  body_angvel[b] = angvel;
+}

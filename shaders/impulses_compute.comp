@@ -1,0 +1,96 @@
+#version 450
+// impulses_compute: every dynamic rigid particle (one thread per particle id) sums the impulses of
+// its contacts with the rigid particles of its list, in list order (a particle with more
+// neighbours than its list holds walks the grid of the last build instead: the same pairs in the
+// same order), then the planes, and writes only its own impulse, count and moment
+// (shared/impulse.h). Each pair is evaluated lower id first, so the two particles of a contact get
+// bitwise opposite impulses; each keeps the contact's accumulated impulse in its own slot of
+// ContactImpulse (valid while ImpulseStamp matches the lists' build). As
+// backends/openmp/impulses_compute.cpp.
+#extension GL_GOOGLE_include_directive : require
+#include "kernel_common.glsl"
+#include "shared/grid_hash.h"
+#include "shared/neighbours.h"
+#include "grid_walk.glsl"
+
+ImpulseBody impulse_body(uint b) {
+  ImpulseBody s;
+  s.com = body_pos[b];
+  s.quat = body_quat[b];
+  s.inv_inertia = body_inv_inertia[b];
+  s.vel = body_vel[b];
+  s.angvel = body_angvel[b];
+  s.vel0 = body_vel_start[b];
+  s.angvel0 = body_angvel_start[b];
+  return impulse_body_for(s, p.flags);
+}
+
+void main() {
+  uint i = thread_index();
+  if (i >= p.rigid_particle_count) return;
+  vec4 xi = particle_pos[i];
+  if (particle_vel[i].w == 0.0f) {  // static particle: its impulse is never used
+    particle_force[i] = vec4(0.0f);
+    particle_moment[i] = vec4(0.0f);
+    return;
+  }
+  float margin = impulse_margin(p.neighbour_skin);
+  uint bi = particle_body[i];
+  ImpulseBody own = impulse_body(bi);
+  uint law_base = particle_material[i] * p.material_count;
+  uint builds = neighbour_state[MOTES_NEIGHBOUR_BUILDS];
+  bool counting = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
+  bool slots_valid = !counting || impulse_stamp[i] == builds;
+  uint nr = p.rigid_particle_count;
+  vec4 sum = vec4(0.0f);
+  vec3 moment_sum = vec3(0.0f);
+  uint c = neighbour_count[i];
+  if (c <= p.neighbour_capacity) {
+    for (uint k = 0u; k < c; ++k) {
+      uint j = neighbour_list[k * p.particle_count + i];
+      if (j >= p.rigid_particle_count) continue;
+      bool slotted = impulse_pair_slotted(c, neighbour_count[j], p.neighbour_capacity);
+      uint slot = k * nr + i;
+      vec4 a = slotted && slots_valid ? contact_impulse_acc[slot] : vec4(0.0f);
+      vec4 xj = particle_pos[j];
+      vec4 r = pair_impulse(own, xi, impulse_body(particle_body[j]), xj, i < j, margin,
+                            contact_laws[pair_law_index(i, particle_material[i], j,
+                                                         particle_material[j],
+                                                         p.material_count)],
+                            p.gravity_dt, p.flags, a);
+      if (slotted) contact_impulse_acc[slot] = a;
+      impulse_add(sum, moment_sum, r, pair_contact_point(xi, xj), own.com);
+    }
+  } else {
+    uint lo[27];
+    uint hi[27];
+    int ranges = grid_walk(neighbour_ref_pos[i], lo, hi);
+    for (int r = 0; r < ranges; ++r) {
+      for (uint t = lo[r]; t < hi[r]; ++t) {
+        if (contact_excluded(sorted_body[t], bi)) continue;
+        uint j = grid_order[t];
+        if (j >= p.rigid_particle_count) continue;
+        vec4 xj = particle_pos[j];
+        vec4 none = vec4(0.0f);  // no slot beyond the list's capacity
+        vec4 q = pair_impulse(own, xi, impulse_body(particle_body[j]), xj, i < j, margin,
+                              contact_laws[pair_law_index(i, particle_material[i], j,
+                                                          particle_material[j],
+                                                          p.material_count)],
+                              p.gravity_dt, p.flags, none);
+        impulse_add(sum, moment_sum, q, pair_contact_point(xi, xj), own.com);
+      }
+    }
+  }
+  for (uint k = 0u; k < p.plane_count; ++k) {
+    PlaneData pl = planes[k];
+    uint slot = (p.neighbour_capacity + k) * nr + i;
+    vec4 a = contact_impulse_acc[slot];
+    vec4 r = plane_contact_impulse(own, xi, pl.normal_offset, margin,
+                                   contact_laws[law_base + pl.material], p.gravity_dt, p.flags, a);
+    contact_impulse_acc[slot] = a;
+    impulse_add(sum, moment_sum, r, plane_contact_point(xi, pl.normal_offset), own.com);
+  }
+  if (counting) impulse_stamp[i] = builds;
+  particle_force[i] = sum;
+  particle_moment[i] = vec4(moment_sum, 0.0f);
+}

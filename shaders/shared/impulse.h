@@ -1,0 +1,266 @@
+// Impulse-based rigid contact (Guendelman, Bridson, Fedkiw 2003, as Ponce Atencio & Esperanca use
+// it for bodies made of particles): at the contact point c of two touching particles (their
+// midpoint; for a plane, the particle's lowest point), an impulse J acts on the two bodies,
+//   v' = v + J / m,   L' = L + (c - x_com) x J,
+// with restitution e and Coulomb friction mu. The many particle contacts of one body pair act
+// together through mass splitting (Tonge, Benevolenski, Voroshilov 2012): every contact of a body
+// that has n contacts sees the body with n times its inverse mass and inverse inertia, all
+// contacts are solved at once (Jacobi) and a body's impulses are summed in a fixed order, so the
+// body's velocity is the average of what each contact asks for. Each contact keeps its
+// accumulated impulse (clamped as a total, never per iteration) and starts every substep from the
+// last one's (warm start; Catto's accumulated impulses), so a resting stack carries its weight
+// from the first iteration. Iterated a fixed number of times per substep, this converges to the
+// simultaneous solution; it needs no atomics and no order that depends on thread timing.
+// docs/architecture.md, "Impulse contacts", has the whole stage.
+#ifndef MOTES_SHARED_IMPULSE_H
+#define MOTES_SHARED_IMPULSE_H
+
+#include "body_math.h"
+#include "common.h"
+#include "params.h"
+
+MOTES_SHARED_BEGIN
+
+/// Fraction of an overlap (beyond the slop) removed per substep by a separating velocity.
+#define MOTES_IMPULSE_BIAS 0.2f
+/// Overlap left alone, as a fraction of r_a + r_b: resting contacts keep it without jitter.
+#define MOTES_IMPULSE_SLOP 0.002f
+/// A contact closing faster than this many substeps' worth of gravity bounces (restitution);
+/// slower ones (resting contacts, which close at |g| dt every substep) do not.
+#define MOTES_IMPULSE_BOUNCE_SUBSTEPS 4.0f
+
+/// Contacts reach this far apart (speculative contacts), as a fraction of the neighbour skin:
+/// every pair this close is in the lists since their last build (two particles close at most
+/// 2 x 0.45 skin before a rebuild), so the contact set does not depend on when lists were built.
+MOTES_FN float impulse_margin(float skin) { return 0.1f * skin; }
+
+/// What a contact needs to know of one of its bodies. A plane or a static body has com.w == 0 and
+/// inv_inertia == 0, and so takes no part in the contact's effective mass.
+struct ImpulseBody {
+  vec4 com;          // xyz: centre of mass, w: inverse mass
+  vec4 quat;         // orientation, body (principal) frame to world
+  vec4 inv_inertia;  // inverse principal moments (body frame)
+  vec4 vel;          // linear velocity now (this iteration)
+  vec4 angvel;       // angular velocity now
+  vec4 vel0;         // xyz: linear velocity at the start of the impulse stage, w: its contacts
+  vec4 angvel0;      // angular velocity at the start of the impulse stage
+};
+
+/// A body as the contacts of an impulse iteration see it: in the counting pass
+/// (MOTES_FLAG_IMPULSE_COUNT) the stage starts now, so its start is its present state.
+MOTES_FN ImpulseBody impulse_body_for(ImpulseBody b, uint flags) {
+  if ((flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
+    b.vel0 = vec4(xyz(b.vel), 1.0f);
+    b.angvel0 = b.angvel;
+  }
+  return b;
+}
+
+/// A body that takes no part: a plane.
+MOTES_FN ImpulseBody impulse_wall() {
+  ImpulseBody w;
+  w.com = vec4(0.0f);
+  w.quat = vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  w.inv_inertia = vec4(0.0f);
+  w.vel = vec4(0.0f);
+  w.angvel = vec4(0.0f);
+  w.vel0 = vec4(0.0f);
+  w.angvel0 = vec4(0.0f);
+  return w;
+}
+
+/// 1/m + (r x d) . I^-1 (r x d): the inverse mass a unit impulse along d at arm r meets, times
+/// the body's contact count (mass splitting). 0 for a wall or a static body.
+MOTES_FN float impulse_inverse_mass(ImpulseBody b, vec3 r, vec3 d) {
+  vec3 rd = cross(r, d);
+  float k = b.com.w + dot(rd, body_angular_velocity(b.quat, b.inv_inertia, rd));
+  return max(b.vel0.w, 1.0f) * k;
+}
+
+/// Velocity of a body's material point at arm r: v + w x r.
+MOTES_FN vec3 impulse_point_velocity(vec4 vel, vec4 angvel, vec3 r) {
+  return xyz(vel) + cross(xyz(angvel), r);
+}
+
+/// The normal velocity (separating > 0) a contact must reach in this substep, from its
+/// separation sep (< 0: overlap) and its normal velocity vn0 at the start of the stage:
+/// - apart (sep > 0): approach by at most the gap (speculative contact: touch, don't pass);
+/// - overlapping: separate at MOTES_IMPULSE_BIAS of the overlap beyond the slop per substep;
+/// - closing faster than resting contacts do, with e > 0: bounce at -e vn0 (Newton's law).
+MOTES_FN float impulse_target(float sep, float rsum, float vn0, float restitution,
+                              vec4 gravity_dt) {
+  float dt = gravity_dt.w;
+  float target = sep > 0.0f ? -sep / dt
+                            : MOTES_IMPULSE_BIAS * max(-sep - MOTES_IMPULSE_SLOP * rsum, 0.0f) / dt;
+  float bounce_speed = MOTES_IMPULSE_BOUNCE_SUBSTEPS * length(xyz(gravity_dt)) * dt;
+  if (restitution > 0.0f && vn0 < -bounce_speed && vn0 * dt < -sep) {
+    target = max(target, -restitution * vn0);
+  }
+  return target;
+}
+
+/// Where the impulse of two particles acts: their midpoint.
+MOTES_FN vec3 pair_contact_point(vec4 xa, vec4 xb) { return (xyz(xa) + xyz(xb)) * 0.5f; }
+
+/// Where the impulse of a particle and a plane acts: the particle's point nearest the plane.
+MOTES_FN vec3 plane_contact_point(vec4 xa, vec4 normal_offset) {
+  return xyz(xa) - xyz(normal_offset) * xa.w;
+}
+
+/// The impulse on body a of a contact between bodies a and b at point c, normal n (unit, from b
+/// towards a), separation sep, r_a + r_b = rsum (on b: its negation), as a change of the contact's
+/// accumulated impulse acc (xyz: the total impulse on a in this substep; w: its normal part, >= 0).
+/// Returns (the change, counted): counted is 1 when the contact counts for mass splitting (it
+/// touches, or needs an impulse at the start of the stage), else 0.
+/// - Counting pass (MOTES_FLAG_IMPULSE_COUNT): warm start. A counted contact starts from the
+///   total of the last substep (acc), its tangential part capped at mu times its normal part;
+///   one not counted starts from zero.
+/// - Iterations: the normal total grows by what brings the normal velocity to impulse_target and
+///   is clamped at zero (a contact pushes, never pulls, but may take back what it pushed too
+///   much); the tangential total grows by what stops the sliding at c and is capped at mu times
+///   the normal total (law.friction < 0: no cap; 0: none). Only totals are clamped, so the
+///   iterations converge to the simultaneous solution (projected Gauss-Seidel's rule, applied
+///   Jacobi-style).
+/// With acc = 0 on entry every time (a contact without a slot), this is the plain impulse.
+MOTES_FN vec4 contact_impulse(ImpulseBody a, ImpulseBody b, vec3 c, vec3 n, float sep, float rsum,
+                              ContactLaw law, vec4 gravity_dt, uint flags, MOTES_INOUT(vec4) acc) {
+  vec3 ra = c - xyz(a.com);
+  vec3 rb = c - xyz(b.com);
+  vec3 u0 =
+      impulse_point_velocity(a.vel0, a.angvel0, ra) - impulse_point_velocity(b.vel0, b.angvel0, rb);
+  float vn0 = dot(u0, n);
+  float target = impulse_target(sep, rsum, vn0, law.restitution, gravity_dt);
+  float counts = sep <= 0.0f || target > vn0 ? 1.0f : 0.0f;
+  vec3 old_total = xyz(acc);
+  float jn = acc.w;
+  vec3 jt = old_total - n * dot(old_total, n);
+  if ((flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
+    if (counts == 0.0f) {
+      jn = 0.0f;
+    }
+  } else {
+    vec3 u =
+        impulse_point_velocity(a.vel, a.angvel, ra) - impulse_point_velocity(b.vel, b.angvel, rb);
+    float vn = dot(u, n);
+    float kn = impulse_inverse_mass(a, ra, n) + impulse_inverse_mass(b, rb, n);
+    if (!(kn > 0.0f)) {
+      return vec4(0.0f, 0.0f, 0.0f, counts);
+    }
+    jn = max(jn + (target - vn) / kn, 0.0f);
+    vec3 vt = u - n * vn;
+    float vt2 = dot(vt, vt);
+    if (vt2 > 0.0f && law.friction != 0.0f) {
+      float vt_len = sqrt(vt2);
+      vec3 t = vt / vt_len;
+      float kt = impulse_inverse_mass(a, ra, t) + impulse_inverse_mass(b, rb, t);
+      jt -= t * (vt_len / kt);
+    }
+  }
+  if (law.friction == 0.0f || jn == 0.0f) {
+    jt = vec3(0.0f);
+  } else if (law.friction > 0.0f) {
+    float cap = law.friction * jn;
+    float jt2 = dot(jt, jt);
+    if (jt2 > cap * cap) {
+      jt = jt * (cap / sqrt(jt2));
+    }
+  }
+  vec3 total = n * jn + jt;
+  acc = vec4(total, jn);
+  // The counting pass applies the whole warm start: nothing of this substep is applied yet.
+  vec3 applied = (flags & MOTES_FLAG_IMPULSE_COUNT) != 0u ? vec3(0.0f) : old_total;
+  return vec4(total - applied, counts);
+}
+
+/// The impulse on body a of particle a (centre xa, radius ra) touching particle b, as a change of
+/// the contact's accumulated impulse acc (contact_impulse). The pair is always evaluated in the
+/// order (lower particle id first), so that the two particles of a contact compute bitwise
+/// opposite impulses and bitwise equal totals: call with a = the lower id and negate for b.
+/// Zero (not counted, acc zeroed) when their gap is margin (impulse_margin) or more, or their
+/// centres coincide.
+MOTES_FN vec4 particle_contact_impulse(ImpulseBody a, vec4 xa, ImpulseBody b, vec4 xb, float margin,
+                                       ContactLaw law, vec4 gravity_dt, uint flags,
+                                       MOTES_INOUT(vec4) acc) {
+  vec3 d = xyz(xa) - xyz(xb);
+  float dist2 = dot(d, d);
+  float rsum = xa.w + xb.w;
+  float reach = rsum + margin;
+  if (dist2 >= reach * reach || dist2 == 0.0f) {
+    acc = vec4(0.0f);  // zero already in the iterations: positions do not change within them
+    return vec4(0.0f);
+  }
+  float dist = sqrt(dist2);
+  return contact_impulse(a, b, pair_contact_point(xa, xb), d / dist, dist - rsum, rsum, law,
+                         gravity_dt, flags, acc);
+}
+
+/// Index in the contact-law table of the pair of particles i and j (materials mi, mj) as
+/// pair_impulse evaluates it: the lower id's material first, so both particles use one law.
+MOTES_FN uint pair_law_index(uint i, uint mi, uint j, uint mj, uint materials) {
+  return i < j ? mi * materials + mj : mj * materials + mi;
+}
+
+/// The impulse on body `own` (w: counted) of its particle xi and particle xj of body `other`;
+/// own_first: xi has the lower particle id (see particle_contact_impulse). acc: the contact's
+/// accumulated impulse, as the lower id sees it (the same bits in both particles' slots).
+MOTES_FN vec4 pair_impulse(ImpulseBody own, vec4 xi, ImpulseBody other, vec4 xj, bool own_first,
+                           float margin, ContactLaw law, vec4 gravity_dt, uint flags,
+                           MOTES_INOUT(vec4) acc) {
+  if (own_first) {
+    return particle_contact_impulse(own, xi, other, xj, margin, law, gravity_dt, flags, acc);
+  }
+  vec4 r = particle_contact_impulse(other, xj, own, xi, margin, law, gravity_dt, flags, acc);
+  return vec4(-r.x, -r.y, -r.z, r.w);
+}
+
+/// The impulse on body a of its particle xa and a static half-space plane (solid where
+/// dot(normal, x) < offset), at the particle's point nearest the plane, as a change of the
+/// contact's accumulated impulse acc (contact_impulse).
+MOTES_FN vec4 plane_contact_impulse(ImpulseBody a, vec4 xa, vec4 normal_offset, float margin,
+                                    ContactLaw law, vec4 gravity_dt, uint flags,
+                                    MOTES_INOUT(vec4) acc) {
+  vec3 np = xyz(normal_offset);
+  float sep = dot(np, xyz(xa)) - normal_offset.w - xa.w;
+  if (sep >= margin) {
+    acc = vec4(0.0f);  // zero already in the iterations: positions do not change within them
+    return vec4(0.0f);
+  }
+  return contact_impulse(a, impulse_wall(), plane_contact_point(xa, normal_offset), np, sep, xa.w,
+                         law, gravity_dt, flags, acc);
+}
+
+/// True when the contact of particles i and j (neighbour counts ci and cj) keeps its accumulated
+/// impulse in both particles' list slots: both lists hold all their neighbours (capacity K). A
+/// particle beyond K walks the grid and has no slots, so both sides solve that contact without
+/// memory (acc = 0 each time), and stay bitwise opposite.
+MOTES_FN bool impulse_pair_slotted(uint ci, uint cj, uint capacity) {
+  return ci <= capacity && cj <= capacity;
+}
+
+/// Adds a contact's impulse r (w: counted) at point c to a particle's sums: the impulse and count
+/// (sum), the moment about the body's centre com (moment).
+MOTES_FN void impulse_add(MOTES_INOUT(vec4) sum, MOTES_INOUT(vec3) moment, vec4 r, vec3 c,
+                          vec4 com) {
+  sum = sum + r;
+  moment += cross(c - xyz(com), xyz(r));
+}
+
+/// Body state at the end of an impulse iteration: v += J / m, L += tau, w = I^-1(q) L.
+/// Static bodies (com.w == 0) are left untouched.
+MOTES_FN void body_apply_impulse(vec4 com, vec4 quat, vec4 inv_inertia, MOTES_INOUT(vec4) vel,
+                                 MOTES_INOUT(vec4) angmom, MOTES_OUT(vec4) angvel, vec3 impulse,
+                                 vec3 moment) {
+  float inv_m = com.w;
+  angvel = vec4(body_angular_velocity(quat, inv_inertia, xyz(angmom)), 0.0f);
+  if (inv_m == 0.0f) {
+    return;
+  }
+  vec3 l = xyz(angmom) + moment;
+  vel = vec4(xyz(vel) + impulse * inv_m, 0.0f);
+  angmom = vec4(l, 0.0f);
+  angvel = vec4(body_angular_velocity(quat, inv_inertia, l), 0.0f);
+}
+
+MOTES_SHARED_END
+
+#endif  // MOTES_SHARED_IMPULSE_H

@@ -1,0 +1,261 @@
+// Impulse contacts (Guendelman et al. 2003; shared/impulse.h), against rigid-body theory:
+// - VALIDATION.md section 2: a solid sphere hits a wall obliquely (no gravity, no spin). With
+//   I = 2/5 m R^2, restitution e and friction mu it leaves with vn' = e vn and, when
+//   vt >= 7/2 mu (1 + e) vn (sliding throughout), vt' = vt - mu (1 + e) vn,
+//   w' = 5/2 mu (1 + e) vn / R; otherwise it ends rolling: vt' = 5/7 vt, w' = 5/7 vt / R.
+//   Pass: 1e-4 relative to the incoming speed, angles 10 to 85 degrees (both branches).
+// - A tilted box lands on one corner particle (frictionless): the normal impulse
+//   j = (1 + e) |vn_c| / (1/M + (r x n) . I^-1 (r x n)) at the contact point gives
+//   v' = v + j n / M and L' = r x j n; every term computed here in double from the body's mass
+//   properties. Pass: 1e-3 relative (the bound).
+// - Stacking: a column of 10 boxes (3 x 3 x 3 particles) and a 5-row pyramid of 15 boxes
+//   (4 x 4 x 4) stand still for 5 s: after settling into the slop in the first 0.1 s (at most
+//   0.002 d per contact), no particle moves more than 1% of a particle diameter.
+// - Momentum: two spinning boxes collide without gravity; the total linear momentum is the same
+//   before and after to 1e-6 relative.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <vector>
+
+#include "physics/physics_scenes.h"
+
+namespace {
+
+using motes_test::to_quat;
+using motes_test::to_vec3;
+
+constexpr double kDensity = 1000.0;
+
+motes::Scene impulse_scene(double dt, const Eigen::Vector3d& gravity, double restitution,
+                           double friction, int iterations = 16) {
+  motes::Material mat = motes_test::material(kDensity, 0.0, 0.0, 0.0, friction);
+  mat.restitution = restitution;
+  motes::Scene scene = motes_test::scene_with(dt, gravity, mat);
+  scene.settings.contact_model = motes::ContactModel::Impulses;
+  scene.settings.impulse_iterations = iterations;
+  return scene;
+}
+
+struct ObliqueCase {
+  double angle_deg;  // from the wall's normal
+  double e;
+  double mu;
+};
+
+class ObliqueSphere : public ::testing::TestWithParam<ObliqueCase> {};
+
+TEST_P(ObliqueSphere, MatchesRigidBodyTheory) {
+  const ObliqueCase c = GetParam();
+  constexpr double kDiameter = 0.1;
+  constexpr double kR = 0.5 * kDiameter;
+  constexpr double kSpeed = 2.0;
+  constexpr double kDt = 1e-4;
+  const double angle = c.angle_deg * std::numbers::pi / 180.0;
+  const double vt = kSpeed * std::sin(angle);
+  const double vn = kSpeed * std::cos(angle);
+  motes::Scene scene = impulse_scene(kDt, Eigen::Vector3d::Zero(), c.e, c.mu);
+  scene.planes.push_back(motes_test::plane(Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero()));
+  // Half a step's travel above the wall: the contact closes during the first step.
+  const double gap = 0.5 * vn * kDt;
+  scene.bodies.push_back(motes_test::body(motes_test::single_particle(kDiameter),
+                                          Eigen::Vector3d(0.0, kR + gap, 0.0),
+                                          Eigen::Vector3d(vt, -vn, 0.0)));
+  auto sim = motes_test::simulate(scene);
+  ASSERT_TRUE(sim) << sim.status().message();
+  ASSERT_TRUE((*sim)->step(20));  // the impact, then free flight away from the wall
+  auto snap = (*sim)->snapshot();
+  ASSERT_TRUE(snap);
+  const Eigen::Vector3d v = to_vec3(snap->body_vel[0]);
+  const Eigen::Vector3d w = to_vec3(snap->body_angvel[0]);
+
+  const double jn = (1.0 + c.e) * vn;  // per unit mass
+  const bool sliding = vt >= 3.5 * c.mu * jn;
+  const double vt_after = sliding ? vt - c.mu * jn : 5.0 / 7.0 * vt;
+  const double w_after = sliding ? 2.5 * c.mu * jn / kR : 5.0 / 7.0 * vt / kR;
+  const double tol = 1e-4 * kSpeed;
+  EXPECT_NEAR(v.y(), c.e * vn, tol) << (sliding ? "sliding" : "rolling");
+  EXPECT_NEAR(v.x(), vt_after, tol) << (sliding ? "sliding" : "rolling");
+  EXPECT_NEAR(v.z(), 0.0, tol);
+  // The wall's friction turns the sphere about -z (it rolls towards +x).
+  EXPECT_NEAR(-w.z() * kR, w_after * kR, tol) << (sliding ? "sliding" : "rolling");
+  EXPECT_NEAR(w.x(), 0.0, tol / kR);
+  EXPECT_NEAR(w.y(), 0.0, tol / kR);
+}
+
+// 10 to 40 degrees end rolling at mu = 0.3, e = 0.5 (tan > 7/2 mu (1 + e) = 1.575 slides: 57.6
+// degrees and up); e = 0 and a frictionless wall too.
+INSTANTIATE_TEST_SUITE_P(Angles, ObliqueSphere,
+                         ::testing::Values(ObliqueCase{10.0, 0.5, 0.3}, ObliqueCase{40.0, 0.5, 0.3},
+                                           ObliqueCase{65.0, 0.5, 0.3}, ObliqueCase{85.0, 0.5, 0.3},
+                                           ObliqueCase{30.0, 0.0, 0.2}, ObliqueCase{75.0, 0.0, 0.2},
+                                           ObliqueCase{45.0, 0.9, 0.0}));
+
+TEST(ImpulseContact, TiltedBoxLandingOnACornerMatchesRigidBodyTheory) {
+  constexpr double kDiameter = 0.05;
+  constexpr double kDt = 1e-4;
+  constexpr double kE = 0.6;
+  constexpr double kVn = 1.5;
+  motes::Scene scene = impulse_scene(kDt, Eigen::Vector3d::Zero(), kE, 0.0);
+  scene.planes.push_back(motes_test::plane(Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero()));
+  auto shape = motes_test::lattice(3, 4, 5, kDiameter);
+  ASSERT_TRUE(shape);
+  const Eigen::Quaterniond tilt(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitX()) *
+                                Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitZ()));
+  const motes::MassProperties mp = motes::mass_properties(*shape, kDensity);
+  // The lowest particle, and the gap to the next one (only one may touch).
+  Eigen::Vector3d lowest(0.0, 1e9, 0.0);
+  double second = 1e9;
+  for (const Eigen::Vector3f& pt : shape->points) {
+    const Eigen::Vector3d r = tilt * (pt.cast<double>() - mp.center);
+    if (r.y() < lowest.y()) {
+      second = lowest.y();
+      lowest = r;
+    } else {
+      second = std::min(second, r.y());
+    }
+  }
+  ASSERT_GT(second - lowest.y(), 0.2 * kDiameter);
+  const double gap = 0.5 * kVn * kDt;
+  const Eigen::Vector3d centre(0.0, 0.5 * kDiameter + gap - lowest.y(), 0.0);
+  scene.bodies.push_back(motes_test::body(shape, centre, Eigen::Vector3d(0.0, -kVn, 0.0),
+                                          Eigen::Vector3d::Zero(), tilt));
+  auto sim = motes_test::simulate(scene);
+  ASSERT_TRUE(sim) << sim.status().message();
+  ASSERT_TRUE((*sim)->step(1));
+  auto snap = (*sim)->snapshot();
+  ASSERT_TRUE(snap);
+
+  // Rigid-body theory in double: contact point c on the lowest particle's surface, arm r.
+  const Eigen::Vector3d n = Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d r = lowest - 0.5 * kDiameter * n;
+  const Eigen::Matrix3d inertia_world =
+      tilt.toRotationMatrix() * mp.inertia * tilt.toRotationMatrix().transpose();
+  const Eigen::Matrix3d inv_inertia = inertia_world.inverse();
+  const Eigen::Vector3d rn = r.cross(n);
+  const double j = (1.0 + kE) * kVn / (1.0 / mp.mass + rn.dot(inv_inertia * rn));
+  const Eigen::Vector3d v_expected = Eigen::Vector3d(0.0, -kVn, 0.0) + j * n / mp.mass;
+  const Eigen::Vector3d l_expected = j * rn;
+  const Eigen::Vector3d v = to_vec3(snap->body_vel[0]);
+  const Eigen::Vector3d l = to_vec3(snap->body_angmom[0]);
+  EXPECT_LT((v - v_expected).norm(), 1e-3 * kVn)
+      << v.transpose() << " vs " << v_expected.transpose();
+  EXPECT_LT((l - l_expected).norm(), 1e-3 * l_expected.norm())
+      << l.transpose() << " vs " << l_expected.transpose();
+  // The contact point leaves at e times its approach speed (Newton's law at c).
+  const Eigen::Vector3d w = to_vec3(snap->body_angvel[0]);
+  EXPECT_NEAR((v + w.cross(r)).dot(n), kE * kVn, 1e-3 * kVn);
+}
+
+/// Largest distance any particle moves between two snapshots.
+double largest_move(const motes::Snapshot& a, const motes::Snapshot& b) {
+  double m = 0.0;
+  for (std::size_t i = 0; i < a.particle_pos.size(); ++i) {
+    m = std::max(m, (to_vec3(a.particle_pos[i]) - to_vec3(b.particle_pos[i])).norm());
+  }
+  return m;
+}
+
+/// Boxes of `side`^3 particles of diameter d placed touching at `centres` on a floor (e = 0.2,
+/// mu = 0.6, dt = 1 ms): how far they settle in the first 0.1 s (each contact sinks into the
+/// overlap the solver leaves alone, MOTES_IMPULSE_SLOP), then how far any particle moves in the
+/// next `seconds` (the drift), and the fastest body at the end.
+struct StackResult {
+  double settle = 0.0;
+  double move = 0.0;
+  double speed = 0.0;
+};
+
+StackResult stand(const std::vector<Eigen::Vector3d>& centres, int side, double diameter,
+                  double seconds) {
+  constexpr double kDt = 1e-3;
+  motes::Scene scene = impulse_scene(kDt, Eigen::Vector3d(0.0, -9.81, 0.0), 0.2, 0.6);
+  scene.planes.push_back(motes_test::plane(Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero()));
+  auto box = motes_test::lattice(side, side, side, diameter);
+  for (const Eigen::Vector3d& c : centres) scene.bodies.push_back(motes_test::body(box, c));
+  auto sim = motes_test::simulate(scene);
+  if (!sim) {
+    ADD_FAILURE() << sim.status().message();
+    return {};
+  }
+  auto placed = (*sim)->snapshot();
+  if (!(*sim)->step(100)) ADD_FAILURE() << "step";
+  auto start = (*sim)->snapshot();
+  if (!(*sim)->step(static_cast<std::uint64_t>(std::lround(seconds / kDt)))) {
+    ADD_FAILURE() << "step";
+  }
+  auto end = (*sim)->snapshot();
+  StackResult r;
+  r.settle = largest_move(*placed, *start);
+  r.move = largest_move(*start, *end);
+  for (const motes::shared::vec4& v : end->body_vel) r.speed = std::max(r.speed, to_vec3(v).norm());
+  return r;
+}
+
+TEST(ImpulseContact, ColumnOfTenBoxesStandsStillForFiveSeconds) {
+  constexpr double kD = 0.02;
+  constexpr double kSize = 3 * kD;
+  std::vector<Eigen::Vector3d> centres;
+  for (int i = 0; i < 10; ++i) centres.emplace_back(0.0, 0.5 * kSize + i * kSize, 0.0);
+  const StackResult r = stand(centres, 3, kD, 5.0);
+  std::printf("column of 10: settles %.3g d, then moves %.3g d in 5 s, last speed %.3g m/s\n",
+              r.settle / kD, r.move / kD, r.speed);
+  // 11 contacts of at most the slop each (0.002 d between boxes, 0.001 d on the floor).
+  EXPECT_LT(r.settle, 11 * 0.002 * kD);
+  EXPECT_LT(r.move, 0.01 * kD);
+}
+
+TEST(ImpulseContact, PyramidOfFiveRowsStandsStillForFiveSeconds) {
+  constexpr double kD = 0.02;
+  constexpr double kSize = 4 * kD;
+  std::vector<Eigen::Vector3d> centres;
+  for (int row = 0; row < 5; ++row) {
+    for (int k = 0; k < 5 - row; ++k) {
+      // Boxes of a row touching, each row centred on the one below: a box rests on half of each
+      // of two boxes (4 x 4 x 4 particles, so the half is two whole particle columns).
+      const double x = (k - 0.5 * (4 - row)) * kSize;
+      centres.emplace_back(x, 0.5 * kSize + row * kSize, 0.0);
+    }
+  }
+  const StackResult r = stand(centres, 4, kD, 5.0);
+  std::printf("pyramid of 15: settles %.3g d, then moves %.3g d in 5 s, last speed %.3g m/s\n",
+              r.settle / kD, r.move / kD, r.speed);
+  EXPECT_LT(r.settle, 6 * 0.002 * kD);
+  EXPECT_LT(r.move, 0.01 * kD);
+}
+
+TEST(ImpulseContact, CollisionWithoutGravityKeepsMomentum) {
+  constexpr double kD = 0.02;
+  motes::Scene scene = impulse_scene(1e-3, Eigen::Vector3d::Zero(), 0.5, 0.4);
+  auto a = motes_test::lattice(3, 3, 3, kD);
+  auto b = motes_test::lattice(2, 4, 3, kD);
+  scene.bodies.push_back(motes_test::body(a, Eigen::Vector3d(-0.06, 0.0, 0.0),
+                                          Eigen::Vector3d(1.0, 0.1, 0.0),
+                                          Eigen::Vector3d(0.0, 3.0, 5.0)));
+  scene.bodies.push_back(motes_test::body(
+      b, Eigen::Vector3d(0.06, 0.013, 0.004), Eigen::Vector3d(-0.5, 0.0, 0.2),
+      Eigen::Vector3d(4.0, 0.0, -2.0),
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1.0, 1.0, 0.0).normalized()))));
+  auto sim = motes_test::simulate(scene);
+  ASSERT_TRUE(sim) << sim.status().message();
+  const auto momentum = [](const motes::Snapshot& s) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < s.body_vel.size(); ++k) {
+      p += to_vec3(s.body_vel[k]) / static_cast<double>(s.body_pos[k].w);
+    }
+    return p;
+  };
+  auto before = (*sim)->snapshot();
+  ASSERT_TRUE((*sim)->step(150));
+  auto after = (*sim)->snapshot();
+  // They did collide: both changed velocity.
+  EXPECT_GT((to_vec3(after->body_vel[0]) - to_vec3(before->body_vel[0])).norm(), 0.1);
+  const Eigen::Vector3d p0 = momentum(*before);
+  const Eigen::Vector3d p1 = momentum(*after);
+  EXPECT_LT((p1 - p0).norm(), 1e-6 * p0.norm()) << p0.transpose() << " -> " << p1.transpose();
+}
+
+}  // namespace
