@@ -55,9 +55,17 @@ void CudaDevice::enqueue(Kernel k, const shared::StepParams& p) {
         sizes_.clusters, sizes_.soft_particles));
     return;
   }
-  if ((k == Kernel::ImpulsesCompute || k == Kernel::ImpulsesApply) && sizes_.impulse == 0) {
+  // ParticleMoment (and the impulse stage's buffers) exist only for impulse contacts, or, the
+  // moment, for cloth and ropes attached to rigid bodies (Sizes::absorb).
+  const bool absorbs = k == Kernel::ImpulsesApply ||
+                       (k == Kernel::ParticlesUpdate && (p.flags & MOTES_FLAG_ABSORB) != 0u);
+  if ((k == Kernel::ImpulsesCompute && sizes_.impulse == 0) ||
+      (absorbs && sizes_.impulse == 0 && sizes_.absorb == 0) ||
+      (k == Kernel::ImpulsesApply && (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u &&
+       sizes_.impulse == 0)) {
     error_ = Status::error(fmt::format(
-        "cuda: {} launched on buffers allocated without impulse contacts", kernel_name(k)));
+        "cuda: {} launched on buffers allocated without impulse contacts or attachments",
+        kernel_name(k)));
     return;
   }
   pending_.push_back({k, p});

@@ -1,5 +1,7 @@
 // particles_update: the rigid particles' positions and velocities follow their body's pose; a
-// neighbour-list rebuild is asked for when one has moved too far since the last build.
+// neighbour-list rebuild is asked for when one has moved too far since the last build. With
+// MOTES_FLAG_ABSORB each first hands what the constraints did to it to its body (an impulse and its
+// moment, shared/body_math.h: particle_absorbed_impulse).
 #include <chrono>
 #include <cstdint>
 
@@ -24,6 +26,9 @@ void OpenMPDevice::particles_update(const shared::StepParams& p) {
   const vec4* angvel = buf<vec4>(Buffer::BodyAngVel);
   vec4* pos = buf<vec4>(Buffer::ParticlePos);
   vec4* vel = buf<vec4>(Buffer::ParticleVel);
+  const bool absorb = (p.flags & MOTES_FLAG_ABSORB) != 0u;
+  vec4* impulse = absorb ? buf<vec4>(Buffer::ParticleForce) : nullptr;
+  vec4* moment = absorb ? buf<vec4>(Buffer::ParticleMoment) : nullptr;
 
   uint moved = 0;
 
@@ -32,6 +37,12 @@ void OpenMPDevice::particles_update(const shared::StepParams& p) {
               : moved)
   for (std::int64_t i = 0; i < n; ++i) {
     const uint b = body[i];
+    if (absorb) {
+      const shared::vec3 j =
+          shared::particle_absorbed_impulse(vel[i], quat[b], body_vel[b], angvel[b], local[i]);
+      impulse[i] = vec4(j, 0.0f);
+      moment[i] = vec4(shared::cross(shared::quat_rotate(quat[b], shared::xyz(local[i])), j), 0.0f);
+    }
     pos[i] = vec4(shared::particle_position(body_pos[b], quat[b], local[i]), pos[i].w);
     vel[i] = vec4(shared::particle_velocity(quat[b], body_vel[b], angvel[b], local[i]), vel[i].w);
     moved |= shared::neighbour_moved_too_far(pos[i], ref[i], p.neighbour_skin) ? 1u : 0u;

@@ -179,7 +179,7 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
     case Buffer::ClusterGather:
       return {kUint, s.clusters > 0 ? std::size_t{s.soft_particles} + 1 + s.cluster_members : 0};
     case Buffer::ParticleMoment:
-      return {kVec4, s.impulse != 0 ? std::size_t{s.rigid_particles} : 0};
+      return {kVec4, s.impulse != 0 || s.absorb != 0 ? std::size_t{s.rigid_particles} : 0};
     case Buffer::BodyVelStart:
     case Buffer::BodyAngVelStart:
       return {kVec4, s.impulse != 0 ? std::size_t{s.bodies} : 0};

@@ -152,7 +152,8 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
                  std::vector<BodyEntry>& entries) {
   bodies.expect_array();
   if (bodies.size() == 0) bodies.fail("a scene needs at least one body");
-  std::map<std::string, std::string> names;  // body name -> JSON path that made it
+  std::map<std::string, std::string> names;                  // body name -> JSON path that made it
+  std::vector<std::pair<std::size_t, Node>> linked_entries;  // objects with attachments
   std::uint64_t particles = 0;
   // Counts before expanding, so an oversized scene is refused before it is built.
   const auto count = [&](const Node& body, std::uint64_t more) {
@@ -180,6 +181,7 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
           spec.velocity, Eigen::Vector3d::Zero(), 0.0, spec.diameter, scene.settings);
       count(body, spec.points.size());
       add_name(body, spec.name, body.path());
+      if (!spec.attached.empty()) linked_entries.emplace_back(scene.linked.size(), body);
       scene.linked.push_back(std::move(spec));
       continue;
     }
@@ -258,6 +260,31 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
           add_name(body, copy.name, repeat.repeated ? body.path() + "/repeat" : body.path());
           scene.bodies.push_back(std::move(copy));
         }
+      }
+    }
+  }
+  // Attachments name bodies anywhere in the array: checked once every body is known.
+  for (const auto& [object, entry] : linked_entries) {
+    const LinkedSpec& spec = scene.linked[object];
+    const Node list = entry.at(spec.kind == LinkedKind::Cloth ? "cloth" : "rope").at("attach");
+    for (std::size_t k = 0; k < spec.attached.size(); ++k) {
+      const Node name = list.at(k).at("body");
+      const std::string& wanted = spec.attached[k].body;
+      const auto it = std::find_if(scene.bodies.begin(), scene.bodies.end(),
+                                   [&](const BodySpec& b) { return b.name == wanted; });
+      if (it == scene.bodies.end()) {
+        const bool linked = std::any_of(scene.linked.begin(), scene.linked.end(),
+                                        [&](const LinkedSpec& l) { return l.name == wanted; });
+        name.fail(linked ? fmt::format("\"{}\" is a cloth or rope: attach to a rigid or static "
+                                       "body (link two cloths by one object instead)",
+                                       wanted)
+                         : fmt::format("no body named \"{}\" in this scene", wanted));
+      }
+      if (it->soft) {
+        name.fail(
+            fmt::format("\"{}\" is a soft body: cloth and ropes attach to rigid or static "
+                        "bodies",
+                        wanted));
       }
     }
   }

@@ -65,9 +65,34 @@ LinkedSpec take(Result<LinkedSpec> result, const Node& where, std::string_view k
   return std::move(result).value();
 }
 
+/// The object's "attach" array: [{"point": ..., "body": "name"}], the point read by `point_of`.
+/// A point is pinned or attached, and attached once. The body's name is checked against the
+/// scene's bodies once they are all read (check_attachments).
+template <typename PointOf>
+void read_attachments(const Node& node, LinkedSpec& spec, PointOf point_of) {
+  auto list = node.find("attach");
+  if (!list) return;
+  list->expect_array();
+  std::map<std::uint32_t, std::string> seen;
+  for (const std::uint32_t k : spec.pinned) seen.emplace(k, "\"pin\"");
+  for (std::size_t k = 0; k < list->size(); ++k) {
+    const Node a = list->at(k);
+    a.expect_object({"point", "body"});
+    const Node point = a.at("point");
+    const std::uint32_t index = point_of(point);
+    if (auto [it, added] = seen.emplace(index, point.path()); !added) {
+      point.fail(
+          fmt::format("point {} is already held by {}: a point is pinned or attached to one "
+                      "body",
+                      index, it->second));
+    }
+    spec.attached.push_back({index, a.at("body").string()});
+  }
+}
+
 LinkedSpec read_cloth(const Node& node, double diameter) {
-  node.expect_object(
-      {"corner", "edge_u", "edge_v", "particles", "bend", "stiffness", "bend_stiffness", "pin"});
+  node.expect_object({"corner", "edge_u", "edge_v", "particles", "bend", "stiffness",
+                      "bend_stiffness", "pin", "attach"});
   ClothOptions o;
   o.diameter = diameter;
   o.corner = node.at("corner").vec3();
@@ -91,12 +116,16 @@ LinkedSpec read_cloth(const Node& node, double diameter) {
     }
     for (const auto& entry : pinned) c.pinned.push_back(entry.first);
   }
+  read_attachments(node, c, [&](const Node& point) {
+    const std::array<int, 2> ij = read_pair(point, 0, {o.nu - 1, o.nv - 1}, "[i, j]");
+    return cloth_index(o, ij[0], ij[1]);
+  });
   return c;
 }
 
 LinkedSpec read_rope(const Node& node, double diameter) {
   node.expect_object(
-      {"from", "to", "path", "particles", "bend", "stiffness", "bend_stiffness", "pin"});
+      {"from", "to", "path", "particles", "bend", "stiffness", "bend_stiffness", "pin", "attach"});
   RopeOptions o;
   o.diameter = diameter;
   if (auto path = node.find("path")) {
@@ -125,6 +154,10 @@ LinkedSpec read_rope(const Node& node, double diameter) {
     }
     for (const auto& entry : pinned) r.pinned.push_back(entry.first);
   }
+  read_attachments(node, r, [&](const Node& point) {
+    const std::int64_t i = point.integer(-o.count, o.count - 1);  // -1: the last
+    return static_cast<std::uint32_t>(i < 0 ? i + o.count : i);
+  });
   return r;
 }
 

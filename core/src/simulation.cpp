@@ -33,6 +33,29 @@ vec4 to_quat(const Eigen::Quaterniond& q) {
           static_cast<float>(q.w())};
 }
 
+/// The constraint that holds cloth or rope particle `point` to a body whose particles are
+/// [first, first + count): from the body's particle nearest the point (the first of equals), at
+/// their distance.
+shared::Constraint attachment_constraint(const std::vector<vec4>& pos, std::uint32_t first,
+                                         std::uint32_t count, std::uint32_t point) {
+  const auto distance = [&](std::uint32_t i) {
+    const Eigen::Vector3d d(static_cast<double>(pos[i].x) - static_cast<double>(pos[point].x),
+                            static_cast<double>(pos[i].y) - static_cast<double>(pos[point].y),
+                            static_cast<double>(pos[i].z) - static_cast<double>(pos[point].z));
+    return d.norm();
+  };
+  std::uint32_t nearest = first;
+  for (std::uint32_t k = 1; k < count; ++k) {
+    if (distance(first + k) < distance(nearest)) nearest = first + k;
+  }
+  shared::Constraint c{};
+  c.a = nearest;
+  c.b = point;
+  c.rest = static_cast<float>(distance(nearest));
+  c.stiffness = 1.0f;
+  return c;
+}
+
 template <typename T>
 Status write_vector(Device& d, Buffer b, const std::vector<T>& v) {
   return d.write(b, v.data(), v.size() * sizeof(T));
@@ -116,7 +139,7 @@ Status Simulation::upload(const Scene& scene) {
                                        scene.source, l.name));
     }
     n += l.points.size();
-    constraint_count += l.links.size();
+    constraint_count += l.links.size() + l.attached.size();
     max_diameter = std::max(max_diameter, l.diameter);
   }
   if (n > std::numeric_limits<std::uint32_t>::max() / 2) {
@@ -356,6 +379,25 @@ Status Simulation::upload(const Scene& scene) {
       c.stiffness = static_cast<float>(link.stiffness);
       constraints.push_back(c);
     }
+    for (const LinkAttachment& a : spec.attached) {
+      const auto it = std::find_if(scene.bodies.begin(), scene.bodies.end(),
+                                   [&](const BodySpec& b) { return b.name == a.body; });
+      if (it == scene.bodies.end() || it->soft || a.point >= count) {
+        return Status::error(
+            fmt::format("{}: '{}' attaches point {} to '{}': no such point, or "
+                        "not a rigid or static body",
+                        scene.source, spec.name, a.point, a.body));
+      }
+      const auto b = static_cast<std::size_t>(it - scene.bodies.begin());
+      const BodyInfo& held = bodies_[b];
+      const std::uint32_t first =
+          held.free_sphere ? device_index_[b] : rigid_first_[device_index_[b]];
+      const shared::Constraint c =
+          attachment_constraint(ppos, first, held.particle_count, next_linked + a.point);
+      // A dynamic rigid body (not a lean free sphere) takes the constraints' pull as impulses.
+      if (!held.free_sphere && pvel[c.a].w != 0.0f) sizes_.absorb = 1;
+      constraints.push_back(c);
+    }
     next_linked += count;
   }
   ConstraintColouring colouring = colour_constraints(constraints, sizes_.particles);
@@ -491,11 +533,26 @@ Status Simulation::step(std::uint64_t count) {
           d.constraints_solve(colour);
         }
       }
+      if (sizes_.absorb != 0) absorb_attachments();
     }
     ++steps_;
     time_ = static_cast<double>(steps_) * settings_.dt;
   }
   return d.synchronize();
+}
+
+void Simulation::absorb_attachments() {
+  // Cloth and ropes attached to rigid bodies: the constraints moved the bodies' particles too; each
+  // body takes what they did as an impulse (shared/body_math.h: particle_absorbed_impulse), summed
+  // over its particles in order (impulses_apply), and its particles follow its pose again.
+  Device& d = *device_;
+  shared::StepParams absorb = params_;
+  absorb.flags = (absorb.flags | MOTES_FLAG_ABSORB) & ~MOTES_FLAG_IMPULSE_COUNT;
+  shared::StepParams apply = params_;
+  apply.flags &= ~MOTES_FLAG_IMPULSE_COUNT;
+  d.particles_update(absorb);
+  d.impulses_apply(apply);
+  d.particles_update(params_);
 }
 
 void Simulation::step_impulses() {

@@ -92,6 +92,19 @@ MOTES_FN vec3 particle_velocity(vec4 quat, vec4 body_vel, vec4 angvel, vec4 loca
   return xyz(body_vel) + cross(xyz(angvel), r);
 }
 
+/// What the constraints did to a rigid particle, as an impulse for its body: m (v - v_point), with
+/// v its velocity now (changed by constraint_apply, as a cloth or rope attached to it pulled) and
+/// v_point its body's velocity at it (particle_velocity); w = 1 / m of the particle (0: static,
+/// no impulse). The other end of each constraint got the opposite momentum, so the body taking
+/// this keeps the total momentum.
+MOTES_FN vec3 particle_absorbed_impulse(vec4 vel, vec4 quat, vec4 body_vel, vec4 angvel,
+                                        vec4 local) {
+  if (vel.w == 0.0f) {
+    return vec3(0.0f);
+  }
+  return (xyz(vel) - particle_velocity(quat, body_vel, angvel, local)) / vel.w;
+}
+
 MOTES_SHARED_END
 
 #endif  // MOTES_SHARED_BODY_MATH_H

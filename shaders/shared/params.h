@@ -20,6 +20,10 @@ MOTES_SHARED_BEGIN
 #define MOTES_FLAG_BODY_VELOCITY 8u
 /// bodies_integrate: only the pose, from the velocities as they are (x += dt v, q from L).
 #define MOTES_FLAG_BODY_POSE 16u
+/// particles_update: first hand what the constraints did to each rigid particle to its body, as
+/// an impulse (shared/body_math.h: particle_absorbed_impulse) into ParticleForce and its moment
+/// into ParticleMoment (cloth and ropes attached to rigid bodies); then the pose as always.
+#define MOTES_FLAG_ABSORB 32u
 
 /// Launch parameters of every kernel family; travels with the launch (push constants).
 struct StepParams {

@@ -98,6 +98,14 @@ void OracleRun::step(std::uint64_t steps) {
           motes_ref::constraints_solve(particles, constraints, colour);
         }
       }
+      if (absorb) {
+        motes_ref::ImpulseState s;
+        motes_ref::absorbed_impulses(bodies, particles, s.impulse, s.moment);
+        StepParams apply = params;
+        apply.flags &= ~MOTES_FLAG_IMPULSE_COUNT;
+        motes_ref::impulses_apply(bodies, apply, s);
+        motes_ref::particles_update(bodies, particles, params);
+      }
     }
   }
 }
@@ -126,6 +134,7 @@ motes::Status capture(motes::Simulation& sim, OracleRun& out) {
   out.particles.rigid = sim.sizes().rigid_particles;
   out.params = sim.step_params();
   out.substeps = sim.settings().substeps;
+  out.absorb = sim.sizes().absorb != 0;
   return s;
 }
 

@@ -52,9 +52,13 @@ struct OracleRun {
   std::vector<motes_ref::Cluster> clusters;
   std::vector<motes_ref::ClusterMember> members;
   std::vector<motes_ref::ClusterFrame> frames;
+  /// Cloth and ropes attached to rigid bodies (Sizes::absorb): the bodies take the constraints'
+  /// pull after the sweeps.
+  bool absorb = false;
   /// Advances `steps` steps with motes_ref::step (each settings.substeps substeps), then the
-  /// soft bodies' clusters (motes_ref::clusters_fit, clusters_goal) and the constraints colour by
-  /// colour (motes_ref::constraints_solve), as Simulation::step does.
+  /// soft bodies' clusters (motes_ref::clusters_fit, clusters_goal), the constraints colour by
+  /// colour (motes_ref::constraints_solve) and, with `absorb`, the bodies' share
+  /// (motes_ref::absorbed_impulses, impulses_apply, particles_update), as Simulation::step does.
   void step(std::uint64_t steps);
 };
 motes::Status capture(motes::Simulation& sim, OracleRun& out);

@@ -8,6 +8,10 @@
 // NeighbourRefPos (the refs sit at 0.3 or 0.6 skin from the new positions), and nothing else of
 // NeighbourState may change.
 //
+// With MOTES_FLAG_ABSORB (cloth and ropes attached to rigid bodies) ParticleForce and
+// ParticleMoment of the rigid particles are read back too: what their velocities as written (random
+// here, so far from their bodies' point velocities) hand to their bodies, before the pose.
+//
 // Tolerance: NMSE 1e-10. The same shared particle_position and particle_velocity run on the same
 // floats, so openmp matches bitwise (measures 0); a GPU's fused multiply-adds change each
 // component by a few ulps (NMSE ~1e-14). Faults measured by breaking the oracle: the velocity
@@ -32,8 +36,14 @@ constexpr double kTolerance = 1.0e-10;
 class ParticlesUpdate : public DeviceTest {
  protected:
   /// `far`: one rigid particle's ref sits 0.6 skin away (a rebuild is due), the others 0.3.
-  void run_case(const std::string& layout, World w, bool far) {
+  void run_case(const std::string& layout, World w, bool far, bool absorb = false) {
     w.params.neighbour_skin = kTestSkin;
+    std::vector<vec4> impulse_want, moment_want;
+    if (absorb) {
+      w.params.flags |= MOTES_FLAG_ABSORB;
+      w.sizes.absorb = 1;
+      motes_ref::absorbed_impulses(w.bodies, w.particles, impulse_want, moment_want);
+    }
     motes_ref::Particles want = w.particles;
     motes_ref::particles_update(w.bodies, want, w.params);
     Rng rng(static_cast<std::uint32_t>(w.sizes.particles) + 99u);
@@ -70,6 +80,11 @@ class ParticlesUpdate : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticlePos, pos));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticleVel, vel));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourState, state));
+    std::vector<vec4> impulse, moment;
+    if (absorb) {
+      ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticleForce, impulse));
+      ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticleMoment, moment));
+    }
 
     const std::size_t rigid = w.particles.rigid;
     std::vector<uint> state_want = state_in;
@@ -87,6 +102,11 @@ class ParticlesUpdate : public DeviceTest {
     check_identical("free particles' ParticleVel untouched", slice(vel, rigid, vel.size()),
                     slice(w.particles.vel, rigid, vel.size()));
     check_identical("NeighbourState", state, state_want);
+    if (absorb) {
+      check_close("ParticleForce (absorbed impulse)", slice(impulse, 0, rigid), impulse_want,
+                  kTolerance);
+      check_close("ParticleMoment (absorbed)", moment, moment_want, kTolerance);
+    }
     end_case();
   }
 };
@@ -97,6 +117,12 @@ TEST_P(ParticlesUpdate, Random31) { run_case("random", random_world(63, 31), tru
 TEST_P(ParticlesUpdate, Random1234) { run_case("random", random_world(64, 1234), false); }
 TEST_P(ParticlesUpdate, Random1234Moved) { run_case("moved_far", random_world(64, 1234), true); }
 TEST_P(ParticlesUpdate, Random65536) { run_case("random", random_world(65, 65536), true); }
+TEST_P(ParticlesUpdate, Random1234Absorb) {
+  run_case("absorb", random_world(66, 1234), false, true);
+}
+TEST_P(ParticlesUpdate, Random31AbsorbMoved) {
+  run_case("absorb", random_world(67, 31), true, true);
+}
 
 INSTANTIATE_TEST_SUITE_P(Conformance, ParticlesUpdate, testing::ValuesIn(device_params()),
                          param_name);

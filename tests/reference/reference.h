@@ -112,6 +112,12 @@ void bodies_integrate(Bodies& bodies, const StepParams& p);
 bool particles_update(const Bodies& bodies, Particles& particles, const StepParams& p,
                       const std::vector<vec4>& ref = {});
 
+/// particles_update's first part with MOTES_FLAG_ABSORB: for each rigid particle [0, Nr),
+/// shared::particle_absorbed_impulse of its velocity as it is (impulse, w = 0) and its moment
+/// (R local) x impulse about the body's centre (moment, w = 0).
+void absorbed_impulses(const Bodies& bodies, const Particles& particles, std::vector<vec4>& impulse,
+                       std::vector<vec4>& moment);
+
 /// particles_integrate: shared::particle_integrate on the free particles [particles.rigid, N)
 /// with `force`, the velocities of the linked ones [p.linked_first, N) first times 1 -
 /// p.linked_damping; returns whether one has moved too far from `ref` (empty ref: false).

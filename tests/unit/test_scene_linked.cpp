@@ -389,6 +389,36 @@ std::vector<BadLinked> bad_cases() {
       {"MaxParticlesBodyAfterCloth",
        scene_text(cloth(R"(, "particles": [10, 10])") + ", " + ball, R"("max_particles": 100)"),
        {"s.json: /bodies/1: the scene would have 101 particles"}},
+      {"AttachToNoBody",
+       scene_text(ball + ", " + rope(kGoodRope + R"(, "attach": [{"point": -1, "body": "bal"}])")),
+       {"s.json: /bodies/1/rope/attach/0/body: no body named \"bal\" in this scene"}},
+      {"AttachToARope",
+       scene_text(rope(kGoodRope + R"(, "attach": [{"point": 0, "body": "r"}])")),
+       {"s.json: /bodies/0/rope/attach/0/body: \"r\" is a cloth or rope"}},
+      {"AttachToASoftBody",
+       scene_text(
+           R"({"name": "jelly", "kind": "soft", "shape": {"type": "box", "particles": [2, 2, 2]},
+                      "position": [0, 1, 0]}, )" +
+           cloth(kGoodCloth + R"(, "attach": [{"point": [4, 4], "body": "jelly"}])")),
+       {"s.json: /bodies/1/cloth/attach/0/body: \"jelly\" is a soft body"}},
+      {"AttachAPinnedPoint",
+       scene_text(
+           ball + ", " +
+           rope(kGoodRope + R"(, "pin": [0, -1], "attach": [{"point": 9, "body": "ball"}])")),
+       {"s.json: /bodies/1/rope/attach/0/point: point 9 is already held by \"pin\""}},
+      {"AttachTwice",
+       scene_text(ball + ", " +
+                  cloth(kGoodCloth + R"(, "attach": [{"point": [1, 1], "body": "ball"},
+                                                       {"point": [1, 1], "body": "ball"}])")),
+       {"s.json: /bodies/1/cloth/attach/1/point: point 6 is already held by "
+        "/bodies/1/cloth/attach/0/point"}},
+      {"AttachPointOutside",
+       scene_text(ball + ", " + rope(kGoodRope + R"(, "attach": [{"point": 10, "body": "ball"}])")),
+       {"s.json: /bodies/1/rope/attach/0/point: must be an integer from -10 to 9, got 10"}},
+      {"AttachUnknownKey",
+       scene_text(ball + ", " +
+                  rope(kGoodRope + R"(, "attach": [{"point": 1, "body": "ball", "at": 2}])")),
+       {"s.json: /bodies/1/rope/attach/0/at: unknown key \"at\" (allowed: point, body)"}},
       {"MaterialWithoutStiffness",
        R"({"materials": {"hemp": {"density": 500}}, "bodies": [)" +
            rope(kGoodRope, R"(, "material": "hemp")") + "]}",

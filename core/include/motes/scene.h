@@ -117,6 +117,14 @@ struct LinkSpec {
 /// integrated by position Verlet and relaxed colour by colour; they collide with everything
 /// through the one grid, themselves included (not within two lattice steps). Built by make_rope
 /// and make_cloth (motes/cloth.h).
+/// A cloth or rope point held by a rigid or static body: a link of the point's rest distance to
+/// the body's nearest particle, relaxed with the others; the body takes what the link does to
+/// that particle (docs/architecture.md, "Cloth and ropes").
+struct LinkAttachment {
+  std::uint32_t point = 0;  ///< index into LinkedSpec::points
+  std::string body;         ///< name of a rigid or static BodySpec
+};
+
 struct LinkedSpec {
   std::string name;
   LinkedKind kind = LinkedKind::Rope;
@@ -126,7 +134,8 @@ struct LinkedSpec {
   std::vector<Eigen::Vector3d> points;  ///< world positions of the particles
   std::vector<std::array<std::uint32_t, 2>> lattice;  ///< (u, v) of each point; a rope: (i, 0)
   std::vector<LinkSpec> links;
-  std::vector<std::uint32_t> pinned;  ///< points held fixed in space (inverse mass 0)
+  std::vector<std::uint32_t> pinned;     ///< points held fixed in space (inverse mass 0)
+  std::vector<LinkAttachment> attached;  ///< points held by bodies (none also pinned)
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   std::optional<Eigen::Vector3d> color;  ///< sRGB, each 0..1, for pictures
 };

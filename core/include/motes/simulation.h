@@ -135,6 +135,8 @@ class Simulation {
   Status upload(const Scene& scene);
   /// The rigid bodies' part of a substep with impulse contacts (docs/architecture.md).
   void step_impulses();
+  /// Cloth and ropes attached to rigid bodies: the bodies take the constraints' pull.
+  void absorb_attachments();
   /// Impulse contacts: every contact's accumulated impulse to zero and its list slots void (a
   /// new state has no contact history to warm-start from).
   Status clear_contact_history();

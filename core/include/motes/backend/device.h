@@ -61,7 +61,7 @@ enum class Buffer : std::uint32_t {
   /// [ClusterGather[k], ClusterGather[k + 1]) (the offsets count from the buffer's start).
   ClusterGather,
   // Impulse contacts (StepParams.flags MOTES_FLAG_IMPULSE; empty otherwise): rigid bodies only.
-  ParticleMoment,   ///< vec4 (Nr): impulses_compute's moment about the body's centre of mass
+  ParticleMoment,   ///< vec4 (Nr): impulses_compute's (or the absorb's) moment about the centre
   BodyVelStart,     ///< vec4 (B): BodyVel at the start of the impulse stage, w = contacts
   BodyAngVelStart,  ///< vec4 (B): BodyAngVel at the start of the impulse stage
   /// vec4 ((K + P) x Nr): accumulated impulse of every contact of rigid particle i (xyz: on the
@@ -113,6 +113,7 @@ struct Sizes {
   std::uint32_t clusters = 0;            ///< S: shape-matching clusters
   std::uint32_t cluster_members = 0;     ///< Sm: their members (a particle may be in several)
   std::uint32_t impulse = 0;             ///< 1: rigid contacts by impulses (buffers for them)
+  std::uint32_t absorb = 0;  ///< 1: cloth or ropes attached to rigid bodies (ParticleMoment)
 };
 
 /// Bytes of one element and number of elements of a buffer.
@@ -233,7 +234,9 @@ class Device {
   /// Semi-implicit Euler on every dynamic body (shared/body_math.h: body_integrate).
   virtual void bodies_integrate(const shared::StepParams& p) = 0;
   /// ParticlePos and ParticleVel xyz of the rigid particles [0, Nr) from their body's pose; asks
-  /// for a rebuild (NeighbourState) when one has moved too far from its NeighbourRefPos.
+  /// for a rebuild (NeighbourState) when one has moved too far from its NeighbourRefPos. With
+  /// MOTES_FLAG_ABSORB, first ParticleForce = shared::particle_absorbed_impulse of the particle's
+  /// velocity as it is and ParticleMoment = (R local) x that impulse.
   virtual void particles_update(const shared::StepParams& p) = 0;
   /// Semi-implicit Euler on the free particles [Nr, N) (shared/body_math.h: particle_integrate),
   /// the velocities of the linked particles [Nl, N) first multiplied by 1 - p.linked_damping; asks
