@@ -107,7 +107,7 @@ class CsvFrames final : public FrameReader {
       return Status::error(fmt::format("cannot read '{}': {}", path_, std::strerror(errno)));
     }
     if (!number) return false;
-    if (!(radius_ > 0.0)) radius_ = typical_radius(frame.particle_pos);
+    if (!(radius_ > 0.0)) radius_ = static_cast<double>(typical_radius(frame.particle_pos));
     for (shared::vec4& p : frame.particle_pos) p.w = static_cast<float>(radius_);
     return true;
   }

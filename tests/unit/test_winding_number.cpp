@@ -315,6 +315,64 @@ TEST(WindingNumber, BunnyWithHolesAgreesWithTheExactSum) {
   }
 }
 
+TEST(WindingNumber, CurtainRunsDecideEveryCellAsTheExactSum) {
+  // A sliver of ten triangles, open and non-manifold (the input the mesh fuzzer found slow:
+  // tests/data/fuzz-regressions/mesh/raw_open_sliver_slow). The automatic rule decides whole runs
+  // of cells from bounds on the curtains (core/src/voxelize.cpp, fill_run); every cell of the
+  // lattice is checked here against the exact sum over the triangles.
+  TriangleMesh sliver;
+  sliver.source = "sliver";
+  sliver.vertices = {{3, 0, 0}, {115, 99, 110}, {-3, 0, 0}, {0, 2, 0}, {0, 0, -1}, {-1, 0, -3}};
+  sliver.triangles = {{0, 0, 0}, {3, 0, 0}, {1, 0, 2}, {4, 2, 1}, {4, 1, 3},
+                      {4, 3, 0}, {4, 2, 0}, {5, 1, 2}, {3, 3, 1}, {5, 0, 3}};
+  std::vector<Eigen::Vector3i> oriented = sliver.triangles;
+  (void)winding::orient_consistently(sliver.vertices, oriented);
+  const winding::WindingNumber w(sliver.vertices, oriented);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
+  for (const auto& v : sliver.vertices) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  for (const double d : {1.8225806431134892, 1.0}) {
+    SCOPED_TRACE(d);
+    auto set = voxelize_with(sliver, d, InsideTest::automatic);
+    ASSERT_TRUE(set) << set.message();
+    const auto chosen = sorted_points(*set);
+    // The lattice of make_lattice: the fewest cells covering the box, centred on it.
+    std::array<long, 3> n{};
+    Eigen::Vector3d first;
+    for (int a = 0; a < 3; ++a) {
+      n[a] = static_cast<long>(std::max(1.0, std::ceil((hi[a] - lo[a]) / d * (1.0 - 1e-9))));
+      first[a] = 0.5 * (lo[a] + hi[a]) - 0.5 * (static_cast<double>(n[a]) - 1.0) * d;
+    }
+    std::size_t inside = 0, wrong = 0, near_half = 0;
+    for (long i = 0; i < n[0]; ++i) {
+      for (long j = 0; j < n[1]; ++j) {
+        for (long k = 0; k < n[2]; ++k) {
+          const Eigen::Vector3d p =
+              first + d * Eigen::Vector3d(static_cast<double>(i), static_cast<double>(j),
+                                          static_cast<double>(k));
+          const double exact = std::abs(w.exact(p));
+          const bool found = std::binary_search(
+              chosen.begin(), chosen.end(),
+              std::make_tuple(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                              static_cast<float>(p.z())));
+          inside += found ? 1 : 0;
+          if (std::abs(exact - 0.5) < 1e-9) {
+            ++near_half;
+          } else if (found != (exact > 0.5)) {
+            ++wrong;
+          }
+        }
+      }
+    }
+    EXPECT_EQ(inside, chosen.size());
+    EXPECT_GT(inside, 10U);
+    EXPECT_EQ(wrong, 0U);
+    EXPECT_EQ(near_half, 0U);
+  }
+}
+
 TEST(WindingNumber, CommandLineWarnsOnceNamingTheFile) {
   motes_test::TempDir tmp;
   const std::string open = mesh_path("cube_open.obj");
