@@ -241,7 +241,25 @@ PYBIND11_MODULE(motes, m) {
       .def(
           "state_hash", [](PySimulation& s) { return take(s.sim().state_hash()); },
           "64-bit hash of the whole state: the same as `motes run` prints for the same run.")
-      .def("check_finite", [](PySimulation& s) { check(s.sim().check_finite()); });
+      .def("check_finite", [](PySimulation& s) { check(s.sim().check_finite()); })
+      .def(
+          "check_motion",
+          [](PySimulation& s) {
+            const motes::MotionReport r = take(s.sim().check_motion());
+            py::dict out;
+            out["moving"] = r.moving;
+            out["travel"] = r.travel;
+            out["speed"] = r.speed;
+            out["diameter"] = r.diameter;
+            out["body"] = r.body;
+            out["particle"] = r.particle;
+            out["safe_dt"] = r.safe_dt;
+            out["warning"] = r.warning;
+            return out;
+          },
+          "The motion guard (docs/reliability.md): the fastest particle's travel per substep (in "
+          "diameters), speed, diameter, body, particle and the largest safe dt, with a tunnelling "
+          "warning past a quarter diameter; raises on a NaN or a runaway speed.");
 
   py::class_<motes::FrameWriter>(m, "FrameWriter", "Output files of the frames of a run")
       .def(py::init([](const std::string& directory, const std::string& format,

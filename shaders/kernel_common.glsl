@@ -54,6 +54,7 @@ layout(std430, binding = B_BODY_VEL_START) buffer BodyVelStartBuf { vec4 body_ve
 layout(std430, binding = B_BODY_ANGVEL_START) buffer BodyAngVelStartBuf { vec4 body_angvel_start[]; };
 layout(std430, binding = B_CONTACT_IMPULSE) buffer ContactImpulseBuf { vec4 contact_impulse_acc[]; };
 layout(std430, binding = B_IMPULSE_STAMP) buffer ImpulseStampBuf { uint impulse_stamp[]; };
+layout(std430, binding = B_MOTION_CHECK) buffer MotionCheckBuf { uint motion_check[]; };
 layout(std430, binding = B_GRID_ARRIVAL) buffer GridArrivalBuf { uint grid_arrival[]; };
 layout(std430, binding = B_GRID_UNSORTED) buffer GridUnsortedBuf { uint grid_unsorted[]; };
 layout(std430, binding = B_SCAN_SCRATCH) buffer ScanScratchBuf { uint scan_scratch[]; };

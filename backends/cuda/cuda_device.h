@@ -66,6 +66,7 @@ class CudaDevice final : public Device {
     enqueue(Kernel::ImpulsesCompute, p);
   }
   void impulses_apply(const shared::StepParams& p) override { enqueue(Kernel::ImpulsesApply, p); }
+  void particles_check(const shared::StepParams& p) override { enqueue(Kernel::ParticlesCheck, p); }
 
   Status synchronize() override;
   Status check_guards() override;
@@ -120,6 +121,7 @@ class CudaDevice final : public Device {
   void launch_clusters_goal(const shared::StepParams& p);
   void launch_impulses_compute(const shared::StepParams& p);
   void launch_impulses_apply(const shared::StepParams& p);
+  void launch_particles_check(const shared::StepParams& p);
   /// bodies_reduce, bodies_integrate and particles_update in one pass (bodies_step.cu), for scenes
   /// whose bodies are small; the same arithmetic as the three kernels.
   void launch_bodies_step(const shared::StepParams& p);

@@ -120,6 +120,9 @@ std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t
     case Kernel::ImpulsesApply:
       launch_impulses_apply(p);
       return 1;
+    case Kernel::ParticlesCheck:
+      launch_particles_check(p);
+      return 1;
     case Kernel::Count:
       break;
   }

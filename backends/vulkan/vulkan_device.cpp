@@ -34,6 +34,7 @@ static_assert(B_CLUSTER_GATHER == static_cast<int>(Buffer::ClusterGather));
 static_assert(B_PARTICLE_MOMENT == static_cast<int>(Buffer::ParticleMoment));
 static_assert(B_BODY_ANGVEL_START == static_cast<int>(Buffer::BodyAngVelStart));
 static_assert(B_IMPULSE_STAMP == static_cast<int>(Buffer::ImpulseStamp));
+static_assert(B_MOTION_CHECK == static_cast<int>(Buffer::MotionCheck));
 static_assert(B_GRID_ARRIVAL == static_cast<int>(Buffer::Count));
 
 namespace {
@@ -43,7 +44,7 @@ constexpr const char* kPipelineShaders[kPipelineCount] = {
     "grid_build_scan_add", "grid_build_scatter",  "grid_build_place", "neighbours_begin",
     "neighbours_build",    "contacts_compute",    "bodies_reduce",    "bodies_integrate",
     "particles_update",    "particles_integrate", "clusters_fit",     "clusters_goal",
-    "constraints_solve",   "impulses_compute",    "impulses_apply"};
+    "constraints_solve",   "impulses_compute",    "impulses_apply",   "particles_check"};
 
 const char* binding_name(std::uint32_t binding) {
   if (binding < kBufferCount) return buffer_name(static_cast<Buffer>(binding));
@@ -686,6 +687,10 @@ void VulkanDevice::particles_update(const shared::StepParams& p) {
 }
 void VulkanDevice::particles_integrate(const shared::StepParams& p) {
   enqueue(Kernel::ParticlesIntegrate, p);
+}
+
+void VulkanDevice::particles_check(const shared::StepParams& p) {
+  enqueue(Kernel::ParticlesCheck, p);
 }
 void VulkanDevice::constraints_solve(const shared::StepParams& p) {
   enqueue(Kernel::ConstraintsSolve, p);

@@ -42,6 +42,7 @@ enum class Pipeline : std::uint32_t {
   ConstraintsSolve,
   ImpulsesCompute,
   ImpulsesApply,
+  ParticlesCheck,
   Count
 };
 constexpr std::size_t kPipelineCount = static_cast<std::size_t>(Pipeline::Count);
@@ -81,6 +82,7 @@ class VulkanDevice final : public Device {
   void bodies_integrate(const shared::StepParams& p) override;
   void particles_update(const shared::StepParams& p) override;
   void particles_integrate(const shared::StepParams& p) override;
+  void particles_check(const shared::StepParams& p) override;
   void constraints_solve(const shared::StepParams& p) override;
   void clusters_fit(const shared::StepParams& p) override;
   void clusters_goal(const shared::StepParams& p) override;
@@ -176,6 +178,7 @@ class VulkanDevice final : public Device {
   void record_grid_build(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_neighbours_build(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_particles_integrate(VkCommandBuffer cb, const shared::StepParams& p) const;
+  void record_particles_check(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_constraints_solve(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_clusters_fit(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_clusters_goal(VkCommandBuffer cb, const shared::StepParams& p) const;

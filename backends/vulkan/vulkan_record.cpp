@@ -188,6 +188,9 @@ Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool ti
       case Kernel::ImpulsesApply:
         record_impulses_apply(cb, p);
         break;
+      case Kernel::ParticlesCheck:
+        record_particles_check(cb, p);
+        break;
       case Kernel::NeighboursUpdate:
       case Kernel::Count:
         break;

@@ -88,6 +88,8 @@ const char* buffer_name(Buffer b) {
       return "ContactImpulse";
     case Buffer::ImpulseStamp:
       return "ImpulseStamp";
+    case Buffer::MotionCheck:
+      return "MotionCheck";
     case Buffer::Count:
       break;
   }
@@ -122,6 +124,8 @@ const char* kernel_name(Kernel k) {
       return "impulses_compute";
     case Kernel::ImpulsesApply:
       return "impulses_apply";
+    case Kernel::ParticlesCheck:
+      return "particles_check";
     case Kernel::Count:
       break;
   }
@@ -150,6 +154,7 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
     case Buffer::NeighbourList:
       return {kUint, std::size_t{s.neighbour_capacity} * s.particles};
     case Buffer::NeighbourState:
+    case Buffer::MotionCheck:
       return {kUint, 4};
     case Buffer::BodyPos:
     case Buffer::BodyQuat:

@@ -190,11 +190,18 @@ double compulsory_bytes(motes::Kernel k, const Measurement& m) {
     case motes::Kernel::ImpulsesApply:  // per sweep: read first, com, quat, inertia, vel, angmom,
                                         // impulses and moments; write vel, angmom, angvel
       return (4.0 * (b + 1) + 128.0 * b + 32.0 * nr) * static_cast<double>(m.impulse_sweeps);
+    case motes::Kernel::ParticlesCheck:  // not in a step (the run's guard): read pos, vel
+      return 32 * n;
     case motes::Kernel::Count:
       break;
   }
   return 0;
 }
+
+/// The kernel families a step runs: all but the last, particles_check (the run's motion guard,
+/// which `motes bench` does not call).
+constexpr std::size_t kStepKernels = static_cast<std::size_t>(motes::Kernel::ParticlesCheck);
+static_assert(kStepKernels + 1 == motes::kKernelCount, "particles_check is the last family");
 
 /// Kernel time of family k per step (ms), from the timed run.
 double kernel_ms(const Measurement& m, std::size_t k) {
@@ -239,7 +246,7 @@ nlohmann::json to_json(const Measurement& m) {
   const double med = median(m.seconds);
   nlohmann::json kernels = nlohmann::json::object();
   nlohmann::json bandwidth = nlohmann::json::object();
-  for (std::size_t k = 0; k < motes::kKernelCount; ++k) {
+  for (std::size_t k = 0; k < kStepKernels; ++k) {
     const auto kernel = static_cast<motes::Kernel>(k);
     const double ms = kernel_ms(m, k);
     kernels[motes::kernel_name(kernel)] = ms;
@@ -281,9 +288,7 @@ void print_row(const Measurement& m) {
   const double med = median(m.seconds);
   const double per = 1e3 * med / static_cast<double>(m.steps);
   std::string ks;
-  for (std::size_t k = 0; k < motes::kKernelCount; ++k) {
-    ks += fmt::format(" {:>8.3f}", kernel_ms(m, k));
-  }
+  for (std::size_t k = 0; k < kStepKernels; ++k) ks += fmt::format(" {:>8.3f}", kernel_ms(m, k));
   fmt::print("{:<9} {:<8} {:>9} {:>6} {:>9.3f} {:>10.3e}{} {:>6.0f} {:>6}\n", m.workload, m.phase,
              m.particles, m.steps, per,
              static_cast<double>(m.particles) * static_cast<double>(m.steps) / med, ks,
@@ -329,7 +334,7 @@ void run_bench(const BenchOptions& o) {
   constexpr std::array kLabels = {"nb_upd",   "grid",     "nb_build", "contacts", "b_reduce",
                                   "b_integr", "p_update", "p_integr", "cl_fit",   "cl_goal",
                                   "constr",   "imp_comp", "imp_appl"};
-  static_assert(kLabels.size() == motes::kKernelCount, "a label per kernel family");
+  static_assert(kLabels.size() == kStepKernels, "a label per kernel family of a step");
   std::string ks;
   for (const char* label : kLabels) ks += fmt::format(" {:>8}", label);
   fmt::print(

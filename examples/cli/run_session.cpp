@@ -103,11 +103,44 @@ class Session {
   }
 
  private:
+  /// The motion guard (Simulation::check_motion): prints a tunnelling warning the first time
+  /// and whenever it is twice as bad as the last one printed; stops the run on an error.
+  void guard() {
+    Simulation& sim = *p_.sim;
+    last_guard_step_ = sim.steps();
+    ++guards_;
+    Result<MotionReport> r = sim.check_motion();
+    if (!r) stop(r.message());
+    if (r->warning.empty()) return;
+    ++warned_checks_;
+    worst_travel_ = std::max(worst_travel_, r->travel);
+    if (r->travel > 2.0 * last_warned_travel_) {
+      if (progress_ != nullptr) progress_->finish();
+      fmt::print(stderr, "motes: warning: {}\n", r->warning);
+      last_warned_travel_ = r->travel;
+    }
+  }
+
+  /// Ends a run the guard stopped: the frames so far are finished (their series stays readable),
+  /// the message says which checkpoint is the last good one, and the exit is non-zero.
+  [[noreturn]] void stop(const std::string& message) {
+    if (progress_ != nullptr) progress_->finish();
+    if (p_.writer) (void)p_.writer->finish();
+    if (p_.render) (void)p_.render->finish();
+    const std::string frames = fmt::format(
+        "{} frame{} written{}", frame_times_.size(), frame_times_.size() == 1 ? "" : "s",
+        p_.writer ? fmt::format(" ({})", p_.writer->main_path()) : "");
+    fail(fmt::format("{}\nmotes: run stopped; {}; {}", message, frames,
+                     last_checkpoint_.empty()
+                         ? std::string("no checkpoint was written (--checkpoint-every N keeps one)")
+                         : fmt::format("the last good checkpoint is {}", last_checkpoint_)));
+  }
+
   /// Checks the state and writes it as the next frame.
   void output_frame() {
     const Clock::time_point start = Clock::now();
     Simulation& sim = *p_.sim;
-    if (Status s = sim.check_finite(); !s) fail(s.message());
+    guard();
     if (p_.writer || p_.render) {
       Result<Snapshot> snapshot = sim.snapshot();
       if (!snapshot) fail(snapshot.message());
@@ -123,10 +156,12 @@ class Session {
     output_seconds_ += seconds_since(start);
   }
 
-  /// Writes checkpoint-<step>.mck (atomically) and removes all but the last two.
+  /// Writes checkpoint-<step>.mck (atomically) and removes all but the last two; only a state
+  /// the guard has passed.
   void save_checkpoint() {
     const Clock::time_point start = Clock::now();
     Simulation& sim = *p_.sim;
+    if (last_guard_step_ != sim.steps()) guard();
     const fs::path dir = p_.record.checkpoint_dir;
     if (Status s = create_output_directory(dir.string(), "checkpoint"); !s) fail(s.message());
     CheckpointRun record = p_.record;
@@ -148,6 +183,7 @@ class Session {
     const auto previous_term = std::signal(SIGTERM, on_signal);
     const Clock::time_point start = Clock::now();
     Progress progress(p_.total, p_.sim->steps());
+    progress_ = &progress;
     first_step_ = p_.sim->steps();
     try {
       run_steps(progress);
@@ -156,6 +192,7 @@ class Session {
       throw;
     }
     progress.finish();
+    progress_ = nullptr;
     if (p_.writer) {
       if (Status s = p_.writer->finish(); !s) fail(s.message());
     }
@@ -189,8 +226,11 @@ class Session {
     const std::uint64_t ck = p_.checkpoint_every;
     if (!p_.resumed) {
       output_frame();
-    } else if (!frame_times_.empty() && frame_times_.back() == sim.time()) {
-      last_frame_step_ = first;  // the checkpoint's step already has its frame
+    } else {
+      guard();  // the checkpoint's state, before the first step
+      if (!frame_times_.empty() && frame_times_.back() == sim.time()) {
+        last_frame_step_ = first;  // the checkpoint's step already has its frame
+      }
     }
     std::uint64_t next_frame = (first / every + 1) * every;
     std::uint64_t next_checkpoint =
@@ -202,8 +242,10 @@ class Session {
         break;
       }
       const std::uint64_t done = sim.steps();
+      const std::uint64_t next_guard = last_guard_step_ + Simulation::kGuardInterval;
       const std::uint64_t n =
-          std::min({chunk, p_.total - done, next_frame - done, next_checkpoint - done});
+          std::min({chunk, p_.total - done, next_frame - done, next_checkpoint - done,
+                    std::max(next_guard, done + 1) - done});
       const Clock::time_point t0 = Clock::now();
       if (Status s = sim.step(n); !s) fail(s.message());
       if (Status s = sim.device().synchronize(); !s) fail(s.message());
@@ -214,6 +256,8 @@ class Session {
       if (sim.steps() == next_frame) {
         output_frame();
         next_frame += every;
+      } else if (sim.steps() >= next_guard) {
+        guard();
       }
       if (sim.steps() == next_checkpoint) {
         // The one at the end comes after the final frame (loop()).
@@ -266,6 +310,12 @@ class Session {
       fmt::print("  {:<16}{} written, the last {}\n", "checkpoints", checkpoints_,
                  last_checkpoint_);
     }
+    fmt::print("  {:<16}{} motion check{}{}\n", "guards", guards_, guards_ == 1 ? "" : "s",
+               warned_checks_ == 0
+                   ? std::string(", no warning")
+                   : fmt::format(", {} with a tunnelling warning (the worst: {:.3g} of a "
+                                 "diameter per substep)",
+                                 warned_checks_, worst_travel_));
     std::fflush(stdout);
   }
 
@@ -275,6 +325,12 @@ class Session {
   std::uint64_t last_frame_step_ = std::numeric_limits<std::uint64_t>::max();
   std::uint64_t checkpoints_ = 0;
   std::string last_checkpoint_;
+  Progress* progress_ = nullptr;  // while the loop runs
+  std::uint64_t last_guard_step_ = 0;
+  std::uint64_t guards_ = 0;
+  std::uint64_t warned_checks_ = 0;
+  double worst_travel_ = 0.0;
+  double last_warned_travel_ = 0.0;
   int signal_ = 0;
   double wall_seconds_ = 0.0;
   double step_seconds_ = 0.0;

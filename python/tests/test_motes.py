@@ -142,3 +142,23 @@ def test_a_scene_too_big_for_the_device_raises_what_the_command_line_prints():
     assert cli.returncode == 2
     assert cli.stderr.strip() == "motes: error: " + str(raised.value)
     assert "at most 32768 particles fit" in str(raised.value)
+
+
+def test_check_motion_names_the_fastest_particle_and_raises_on_a_runaway():
+    sim = motes.Simulation(motes.default_scene(), backend="openmp")
+    v = np.zeros((sim.body_count, 3))
+    w = np.zeros((sim.body_count, 3))
+    sim.set_body_velocities(v, w)
+    assert not sim.check_motion()["moving"]
+    v[5] = [3.0, 0.0, 0.0]
+    sim.set_body_velocities(v, w)
+    report = sim.check_motion()
+    assert report["moving"] and report["body"] == 5 and report["warning"] == ""
+    assert np.isclose(report["speed"], 3.0, rtol=1e-6)
+    scene = motes.default_scene()
+    assert np.isclose(report["travel"], 3.0 * scene.dt / report["diameter"], rtol=1e-5)
+    v[5] = [1e9, 0.0, 0.0]
+    sim.set_body_velocities(v, w)
+    with pytest.raises(Exception, match="speed out of bounds"):
+        sim.check_motion()
+

@@ -10,6 +10,7 @@
 #include "shared/body_math.h"
 #include "shared/contact_force.h"
 #include "shared/grid_hash.h"
+#include "shared/motion_check.h"
 #include "shared/neighbours.h"
 
 namespace motes_ref {
@@ -196,6 +197,30 @@ void absorbed_impulses(const Bodies& bodies, const Particles& particles, std::ve
     const vec3 r = motes::shared::quat_rotate(bodies.quat[b], xyz(particles.local[i]));
     moment[i] = vec4(motes::shared::cross(r, j), 0.0f);
   }
+}
+
+std::vector<uint> particles_check(const Particles& particles) {
+  using namespace motes::shared;  // NOLINT: the MotionCheck helpers
+  std::vector<uint> words = {0u, MOTES_MOTION_NONE, MOTES_MOTION_NONE, 0u};
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    if (!motion_finite(particles.pos[i], particles.vel[i])) {
+      if (words[MOTES_MOTION_NON_FINITE] == MOTES_MOTION_NONE) {
+        words[MOTES_MOTION_NON_FINITE] = static_cast<uint>(i);
+      }
+    } else {
+      words[MOTES_MOTION_RATE2] = std::max(words[MOTES_MOTION_RATE2],
+                                           motion_rate2_bits(particles.pos[i], particles.vel[i]));
+    }
+  }
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    if (motion_finite(particles.pos[i], particles.vel[i]) &&
+        motion_rate2_bits(particles.pos[i], particles.vel[i]) == words[MOTES_MOTION_RATE2]) {
+      words[MOTES_MOTION_FASTEST] = static_cast<uint>(i);
+      words[MOTES_MOTION_SPEED2] = float_bits(motion_speed2(particles.vel[i]));
+      break;
+    }
+  }
+  return words;
 }
 
 bool particles_integrate(Particles& particles, const std::vector<vec4>& force, const StepParams& p,

@@ -118,6 +118,11 @@ bool particles_update(const Bodies& bodies, Particles& particles, const StepPara
 void absorbed_impulses(const Bodies& bodies, const Particles& particles, std::vector<vec4>& impulse,
                        std::vector<vec4>& moment);
 
+/// particles_check: the four MotionCheck words (shared/motion_check.h) over every particle, by
+/// the definitions: the largest rate bits of a finite particle, the first finite particle with
+/// them and its |v|^2 bits, the first particle that is not finite.
+std::vector<uint> particles_check(const Particles& particles);
+
 /// particles_integrate: shared::particle_integrate on the free particles [particles.rigid, N)
 /// with `force`, the velocities of the linked ones [p.linked_first, N) first times 1 -
 /// p.linked_damping; returns whether one has moved too far from `ref` (empty ref: false).

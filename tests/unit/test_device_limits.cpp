@@ -56,6 +56,7 @@ class LimitedDevice final : public motes::Device {
   void bodies_integrate(const StepParams& p) override { inner_->bodies_integrate(p); }
   void particles_update(const StepParams& p) override { inner_->particles_update(p); }
   void particles_integrate(const StepParams& p) override { inner_->particles_integrate(p); }
+  void particles_check(const StepParams& p) override { inner_->particles_check(p); }
   void constraints_solve(const StepParams& p) override { inner_->constraints_solve(p); }
   void clusters_fit(const StepParams& p) override { inner_->clusters_fit(p); }
   void clusters_goal(const StepParams& p) override { inner_->clusters_goal(p); }

@@ -61,6 +61,24 @@ struct NeighbourStats {
   std::uint32_t max_count = 0;      ///< the largest neighbour count at the last build
 };
 
+/// What the motion guard found (Simulation::check_motion, docs/reliability.md "Guards while
+/// running"): the particle that travels the most of its diameter per substep.
+struct MotionReport {
+  std::uint64_t step = 0;
+  double time = 0.0;
+  bool moving = false;         ///< some particle moves (the fields below describe the fastest)
+  double travel = 0.0;         ///< its travel per substep, in its own diameters
+  double speed = 0.0;          ///< its speed (m/s)
+  double diameter = 0.0;       ///< its diameter (m)
+  std::uint32_t body = 0;      ///< its scene body
+  std::uint32_t particle = 0;  ///< its index in the scene's particle order (Snapshot)
+  /// The largest dt (at the run's substeps) at which it would travel kSafeTravel of its diameter.
+  double safe_dt = 0.0;
+  /// Non-empty when travel > kSafeTravel: contacts can be missed (tunnelling); names step, body,
+  /// particle, speed and the largest safe dt.
+  std::string warning;
+};
+
 struct CheckpointRun;  // motes/checkpoint.h
 
 class Simulation {
@@ -78,6 +96,18 @@ class Simulation {
   Result<std::uint64_t> state_hash();
   /// Checks every body and particle for NaN or infinity; the error names step, body and particle.
   Status check_finite();
+  /// The motion guard (a reduction on the device, Device::particles_check; cheap: call it at
+  /// output frames and at least every kGuardInterval steps). An error, naming step, body and
+  /// particle, when a particle's position or velocity is not finite, or when the fastest particle
+  /// is faster than kBlowUpFactor times what its start speed, gravity since the first check and
+  /// the contact scale (kSafeTravel of its diameter per substep) can give: the run has gone
+  /// unstable. Otherwise the report, with a warning when the fastest particle travels more than
+  /// kSafeTravel of its diameter per substep.
+  Result<MotionReport> check_motion();
+  /// Half a particle radius per substep: the scene loader's limit for initial speeds.
+  static constexpr double kSafeTravel = 0.25;
+  static constexpr double kBlowUpFactor = 1000.0;
+  static constexpr std::uint64_t kGuardInterval = 1000;
   /// Reads the neighbour-list figures from the device.
   Result<NeighbourStats> neighbour_stats();
 
@@ -143,6 +173,8 @@ class Simulation {
   /// Writes a scene-ordered state (a snapshot or a checkpoint's) to the device and asks for a
   /// neighbour-list rebuild.
   Status restore(const Snapshot& state);
+  /// The scene body and scene particle index of device particle i.
+  [[nodiscard]] std::pair<std::uint32_t, std::uint32_t> locate_particle(std::uint32_t i) const;
   /// load_state for a version 1 file (bytes: the whole file).
   Status load_state_v1(const std::string& path, const std::vector<unsigned char>& bytes);
 
@@ -168,6 +200,10 @@ class Simulation {
   /// ParticlePos and ParticleVel, device order), which a checkpoint's particles must match.
   std::uint64_t setup_hash_ = 0;
   std::uint64_t particle_w_hash_ = 0;
+  /// check_motion's reference: the fastest particle's speed and the time at its first call.
+  bool motion_started_ = false;
+  double motion_start_speed_ = 0.0;
+  double motion_start_time_ = 0.0;
   double time_ = 0.0;
   std::uint64_t steps_ = 0;
 };

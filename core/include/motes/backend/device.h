@@ -71,6 +71,8 @@ enum class Buffer : std::uint32_t {
   /// uint (Nr): NeighbourState[MOTES_NEIGHBOUR_BUILDS] when particle i's list slots of
   /// ContactImpulse were last written; another value: the lists were rebuilt, the slots are void.
   ImpulseStamp,
+  // Run-time checks.
+  MotionCheck,  ///< uint (4): particles_check's MOTES_MOTION_* words (shared/motion_check.h)
   Count
 };
 
@@ -90,6 +92,7 @@ enum class Kernel : std::uint32_t {
   ConstraintsSolve,
   ImpulsesCompute,
   ImpulsesApply,
+  ParticlesCheck,  ///< not part of a step: the motion guard, at output frames and checks
   Count
 };
 
@@ -269,6 +272,12 @@ class Device {
   /// MOTES_FLAG_IMPULSE_COUNT instead: BodyVelStart = (BodyVel xyz, the summed count),
   /// BodyAngVelStart = BodyAngVel.
   virtual void impulses_apply(const shared::StepParams& p) = 0;
+
+  /// The motion guard's reduction over particles [0, particle_count): MotionCheck gets the
+  /// largest (|v| / d)^2 of a finite particle, the first particle with it and its |v|^2, and the
+  /// first particle whose position or velocity is not finite (shared/motion_check.h). Reads
+  /// ParticlePos and ParticleVel only.
+  virtual void particles_check(const shared::StepParams& p) = 0;
 
   /// Waits for queued work; reports any error it raised.
   virtual Status synchronize() = 0;
