@@ -61,74 +61,69 @@ std::unique_ptr<Simulation> simulation(const std::string& text, const std::strin
 }
 
 void names_the_fastest_warns_and_stops(const std::string& backend) {
-  {
-    SCOPED_TRACE(backend);
-    auto sim = simulation(balls(20.0), backend);
-    ASSERT_TRUE(sim);
-    // 20 m/s, 1 cm, 1e-4 s: 0.2 of a diameter per substep; the safe dt (a quarter) 1.25e-4 s.
-    Result<MotionReport> r = sim->check_motion();
-    ASSERT_TRUE(r) << r.message();
-    EXPECT_TRUE(r->moving);
-    EXPECT_EQ(r->body, 1u);
-    EXPECT_EQ(r->particle, 1u);
-    EXPECT_NEAR(r->speed, 20.0, 20.0 * 1e-6);
-    EXPECT_NEAR(r->diameter, 0.01, 0.01 * 1e-6);
-    EXPECT_NEAR(r->travel, 0.2, 0.2 * 1e-6);
-    EXPECT_NEAR(r->safe_dt, 1.25e-4, 1.25e-4 * 1e-6);
-    EXPECT_TRUE(r->warning.empty()) << r->warning;
+  SCOPED_TRACE(backend);
+  auto sim = simulation(balls(20.0), backend);
+  ASSERT_TRUE(sim);
+  // 20 m/s, 1 cm, 1e-4 s: 0.2 of a diameter per substep; the safe dt (a quarter) 1.25e-4 s.
+  Result<MotionReport> r = sim->check_motion();
+  ASSERT_TRUE(r) << r.message();
+  EXPECT_TRUE(r->moving);
+  EXPECT_EQ(r->body, 1u);
+  EXPECT_EQ(r->particle, 1u);
+  EXPECT_NEAR(r->speed, 20.0, 20.0 * 1e-6);
+  EXPECT_NEAR(r->diameter, 0.01, 0.01 * 1e-6);
+  EXPECT_NEAR(r->travel, 0.2, 0.2 * 1e-6);
+  EXPECT_NEAR(r->safe_dt, 1.25e-4, 1.25e-4 * 1e-6);
+  EXPECT_TRUE(r->warning.empty()) << r->warning;
 
-    // 40 m/s after a kick: 0.4 of a diameter per substep, a warning with the safe dt 6.25e-5 s.
-    ASSERT_TRUE(sim->set_body_velocities({{0, 0, 0}, {40, 0, 0}}));
-    r = sim->check_motion();
-    ASSERT_TRUE(r) << r.message();
-    EXPECT_NEAR(r->travel, 0.4, 0.4 * 1e-6);
-    EXPECT_TRUE(contains(r->warning,
-                         "step 0 (t = 0 s): particle 1 of body 1 'fast' moves 0.4 of "
-                         "its diameter (0.01 m) per substep at 40 m/s"))
-        << r->warning;
-    EXPECT_TRUE(
-        contains(r->warning, "the largest safe dt at this speed is 6.25e-05 s at substeps 1"))
-        << r->warning;
+  // 40 m/s after a kick: 0.4 of a diameter per substep, a warning with the safe dt 6.25e-5 s.
+  ASSERT_TRUE(sim->set_body_velocities({{0, 0, 0}, {40, 0, 0}}));
+  r = sim->check_motion();
+  ASSERT_TRUE(r) << r.message();
+  EXPECT_NEAR(r->travel, 0.4, 0.4 * 1e-6);
+  EXPECT_TRUE(contains(r->warning,
+                       "step 0 (t = 0 s): particle 1 of body 1 'fast' moves 0.4 of "
+                       "its diameter (0.01 m) per substep at 40 m/s"))
+      << r->warning;
+  EXPECT_TRUE(contains(r->warning, "the largest safe dt at this speed is 6.25e-05 s at substeps 1"))
+      << r->warning;
 
-    // The start speed (20 m/s) and the contact scale (25 m/s) give 45 m/s: 1000 times more is
-    // an error; just under it only a warning.
-    ASSERT_TRUE(sim->set_body_velocities({{0, 0, 0}, {44000, 0, 0}}));
-    r = sim->check_motion();
-    ASSERT_TRUE(r) << r.message();
-    EXPECT_FALSE(r->warning.empty());
-    ASSERT_TRUE(sim->set_body_velocities({{0, 0, 0}, {46000, 0, 0}}));
-    r = sim->check_motion();
-    ASSERT_FALSE(r);
-    EXPECT_TRUE(contains(r.message(),
-                         "speed out of bounds at step 0 (t = 0 s): particle 1 of body 1 "
-                         "'fast' moves at 4.6e+04 m/s"))
-        << r.message();
+  // The start speed (20 m/s) and the contact scale (25 m/s) give 45 m/s: 1000 times more is
+  // an error; just under it only a warning.
+  ASSERT_TRUE(sim->set_body_velocities({{0, 0, 0}, {44000, 0, 0}}));
+  r = sim->check_motion();
+  ASSERT_TRUE(r) << r.message();
+  EXPECT_FALSE(r->warning.empty());
+  ASSERT_TRUE(sim->set_body_velocities({{0, 0, 0}, {46000, 0, 0}}));
+  r = sim->check_motion();
+  ASSERT_FALSE(r);
+  EXPECT_TRUE(contains(r.message(),
+                       "speed out of bounds at step 0 (t = 0 s): particle 1 of body 1 "
+                       "'fast' moves at 4.6e+04 m/s"))
+      << r.message();
 
-    // At rest: nothing moves.
-    ASSERT_TRUE(sim->set_body_velocities({{0, 0, 0}, {0, 0, 0}}));
-    r = sim->check_motion();
-    ASSERT_TRUE(r) << r.message();
-    EXPECT_FALSE(r->moving);
-  }
+  // At rest: nothing moves.
+  ASSERT_TRUE(sim->set_body_velocities({{0, 0, 0}, {0, 0, 0}}));
+  r = sim->check_motion();
+  ASSERT_TRUE(r) << r.message();
+  EXPECT_FALSE(r->moving);
 }
 
 void non_finite_is_an_error(const std::string& backend) {
-  {
-    SCOPED_TRACE(backend);
-    auto sim = simulation(balls(1.0), backend);
-    ASSERT_TRUE(sim);
-    ASSERT_TRUE(sim->step(10));
-    std::vector<shared::vec4> vel(sim->particle_count());
-    ASSERT_TRUE(sim->device().read(Buffer::ParticleVel, vel.data(), vel.size() * sizeof vel[0]));
-    vel[1].y = std::numeric_limits<float>::quiet_NaN();
-    ASSERT_TRUE(sim->device().write(Buffer::ParticleVel, vel.data(), vel.size() * sizeof vel[0]));
-    Result<MotionReport> r = sim->check_motion();
-    ASSERT_FALSE(r);
-    EXPECT_TRUE(contains(r.message(),
-                         "non-finite state at step 10 (t = 0.001 s): particle 1 of "
-                         "body 1 'fast': position (1.001"))
-        << r.message();
-  }
+  SCOPED_TRACE(backend);
+  auto sim = simulation(balls(1.0), backend);
+  ASSERT_TRUE(sim);
+  ASSERT_TRUE(sim->step(10));
+  std::vector<shared::vec4> vel(sim->particle_count());
+  ASSERT_TRUE(sim->device().read(Buffer::ParticleVel, vel.data(), vel.size() * sizeof vel[0]));
+  vel[1].y = std::numeric_limits<float>::quiet_NaN();
+  ASSERT_TRUE(sim->device().write(Buffer::ParticleVel, vel.data(), vel.size() * sizeof vel[0]));
+  Result<MotionReport> r = sim->check_motion();
+  ASSERT_FALSE(r);
+  EXPECT_TRUE(contains(r.message(),
+                       "non-finite state at step 10 (t = 0.001 s): particle 1 of "
+                       "body 1 'fast': position (1.001"))
+      << r.message();
 }
 
 TEST(MotionGuard, NamesTheFastestParticleWarnsAndStops) {
