@@ -36,7 +36,8 @@ std::vector<float> xyz_floats(const std::vector<shared::vec4>& v) {
 std::vector<float> speeds(const std::vector<shared::vec4>& v) {
   std::vector<float> out(v.size());
   for (std::size_t i = 0; i < v.size(); ++i) {
-    const double x = v[i].x, y = v[i].y, z = v[i].z;
+    const auto x = static_cast<double>(v[i].x), y = static_cast<double>(v[i].y),
+               z = static_cast<double>(v[i].z);
     out[i] = static_cast<float>(std::sqrt(x * x + y * y + z * z));
   }
   return out;

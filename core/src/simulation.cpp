@@ -634,8 +634,8 @@ Result<Snapshot> Simulation::snapshot() {
       for (std::uint32_t k = 0; k < info.particle_count; ++k) {
         const vec4 p = ppos[first + k];
         const vec4 u = pvel[first + k];
-        x += Eigen::Vector3d(p.x, p.y, p.z);
-        v += Eigen::Vector3d(u.x, u.y, u.z);
+        x += Eigen::Vector3f(p.x, p.y, p.z).cast<double>();
+        v += Eigen::Vector3f(u.x, u.y, u.z).cast<double>();
       }
       const double count = static_cast<double>(info.particle_count);
       s.body_pos[b] = to_vec4(x / count, 1.0 / info.mass);
@@ -748,7 +748,8 @@ Status Simulation::set_body_velocities(const std::vector<Eigen::Vector3d>& veloc
            ++k) {
         const vec4 old = state.particle_vel[k];
         const vec4 x = state.particle_pos[k];
-        const Eigen::Vector3d r(x.x - mean.x, x.y - mean.y, x.z - mean.z);
+        const Eigen::Vector3d r =
+            Eigen::Vector3f(x.x - mean.x, x.y - mean.y, x.z - mean.z).cast<double>();
         const vec4 spin = to_vec4(velocity[b] + w.cross(r), 0.0);
         if (old.w != 0.0f) state.particle_vel[k] = vec4(spin.x, spin.y, spin.z, old.w);
       }
@@ -759,7 +760,7 @@ Status Simulation::set_body_velocities(const std::vector<Eigen::Vector3d>& veloc
     // L = R diag(I) R^T w, in double, with the moments the body was uploaded with.
     const vec4 q = state.body_quat[b];
     const Eigen::Matrix3d rot =
-        Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
+        Eigen::Quaternionf(q.w, q.x, q.y, q.z).cast<double>().normalized().toRotationMatrix();
     const vec4 inv = rigid_inv_inertia_[device_index_[b]];
     const auto moment = [](float inverse) {
       return inverse > 0.0f ? 1.0 / static_cast<double>(inverse) : 0.0;
