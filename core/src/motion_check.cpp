@@ -4,23 +4,13 @@
 // that is not finite, or speeds no cause in the scene can give).
 #include <fmt/format.h>
 
+#include <bit>
 #include <cmath>
-#include <cstring>
 
 #include "motes/simulation.h"
 #include "shared/motion_check.h"
 
 namespace motes {
-
-namespace {
-
-double float_of(std::uint32_t bits) {
-  float f = 0.0f;
-  std::memcpy(&f, &bits, sizeof f);
-  return static_cast<double>(f);
-}
-
-}  // namespace
 
 std::pair<std::uint32_t, std::uint32_t> Simulation::locate_particle(std::uint32_t i) const {
   for (std::uint32_t b = 0; b < bodies_.size(); ++b) {
@@ -70,8 +60,9 @@ Result<MotionReport> Simulation::check_motion() {
   r.moving = true;
   r.body = b;
   r.particle = particle;
-  const double rate = std::sqrt(float_of(words[MOTES_MOTION_RATE2]));  // diameters per second
-  r.speed = std::sqrt(float_of(words[MOTES_MOTION_SPEED2]));
+  const double rate = std::sqrt(static_cast<double>(
+      std::bit_cast<float>(words[MOTES_MOTION_RATE2])));  // diameters per second
+  r.speed = std::sqrt(static_cast<double>(std::bit_cast<float>(words[MOTES_MOTION_SPEED2])));
   r.diameter = r.speed / rate;
   r.travel = rate * h;
   r.safe_dt = kSafeTravel / rate * settings_.substeps;
@@ -80,9 +71,7 @@ Result<MotionReport> Simulation::check_motion() {
     motion_start_speed_ = r.speed;
     motion_start_time_ = time_;
   }
-  const double gravity = std::sqrt(static_cast<double>(
-      params_.gravity_dt.x * params_.gravity_dt.x + params_.gravity_dt.y * params_.gravity_dt.y +
-      params_.gravity_dt.z * params_.gravity_dt.z));
+  const double gravity = settings_.gravity.norm();
   const double contact_speed = kSafeTravel * r.diameter / h;
   const double reference =
       motion_start_speed_ + gravity * (time_ - motion_start_time_) + contact_speed;

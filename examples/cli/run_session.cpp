@@ -242,10 +242,10 @@ class Session {
         break;
       }
       const std::uint64_t done = sim.steps();
+      // > done: a guard runs at the start and whenever a chunk reaches it.
       const std::uint64_t next_guard = last_guard_step_ + Simulation::kGuardInterval;
-      const std::uint64_t n =
-          std::min({chunk, p_.total - done, next_frame - done, next_checkpoint - done,
-                    std::max(next_guard, done + 1) - done});
+      const std::uint64_t n = std::min(
+          {chunk, p_.total - done, next_frame - done, next_checkpoint - done, next_guard - done});
       const Clock::time_point t0 = Clock::now();
       if (Status s = sim.step(n); !s) fail(s.message());
       if (Status s = sim.device().synchronize(); !s) fail(s.message());

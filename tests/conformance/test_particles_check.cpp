@@ -9,8 +9,8 @@
 // nothing moving), and no particle at all.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
@@ -27,14 +27,9 @@ using motes::Buffer;
 
 constexpr double kTolerance = 1.0e-6;
 
-double as_float(uint bits) {
-  float f = 0.0f;
-  std::memcpy(&f, &bits, sizeof f);
-  return static_cast<double>(f);
-}
-
 double relative(uint device, uint oracle) {
-  const double a = as_float(device), b = as_float(oracle);
+  const auto a = static_cast<double>(std::bit_cast<float>(device));
+  const auto b = static_cast<double>(std::bit_cast<float>(oracle));
   if (a == b) return 0.0;
   return std::abs(a - b) / std::max(std::abs(b), 1e-30);
 }
