@@ -636,7 +636,7 @@ Status Simulation::load_state_v1(const std::string& path, const std::vector<unsi
   for (std::vector<shared::vec4>* v : payload_arrays_v1(state)) {
     const std::size_t n = v == &state.particle_pos || v == &state.particle_vel ? p_bytes : b_bytes;
     v->resize(n / 16);
-    std::memcpy(v->data(), bytes.data() + at, n);
+    if (n > 0) std::memcpy(v->data(), bytes.data() + at, n);
     at += n;
   }
   if (Status s = restore(state); !s) return s;

@@ -83,16 +83,18 @@ class VtuFile {
     }
     const std::size_t offset = std::strtoull(attribute(tag, "offset").c_str(), nullptr, 10);
     std::uint64_t size = 0;
-    const std::size_t start = data_ + offset;
-    if (start > bytes_.size() || bytes_.size() - start < sizeof size) {
+    // offset is compared before it is added: a huge one must not wrap around to a small start.
+    if (offset > bytes_.size() - data_ || bytes_.size() - data_ - offset < sizeof size) {
       return Status::error(fmt::format("'{}': truncated at array \"{}\"", path_, name));
     }
+    const std::size_t start = data_ + offset;
     std::memcpy(&size, bytes_.data() + start, sizeof size);
     if (size != expected || bytes_.size() - start - sizeof size < size) {
       return Status::error(fmt::format("'{}': array \"{}\" is truncated or has {} bytes, not {}",
                                        path_, name, size, expected));
     }
-    std::memcpy(out, bytes_.data() + start + sizeof size, expected);
+    // A file of 0 points has empty arrays: `out` is then the null data() of an empty vector.
+    if (expected > 0) std::memcpy(out, bytes_.data() + start + sizeof size, expected);
     return true;
   }
 
