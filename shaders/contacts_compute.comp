@@ -9,6 +9,7 @@
 #include "shared/contact_force.h"
 #include "shared/grid_hash.h"
 #include "grid_walk.glsl"
+#include "link_exclusions.glsl"
 
 void main() {
   uint i = thread_index();
@@ -41,8 +42,8 @@ void main() {
     int ranges = grid_walk(neighbour_ref_pos[i], lo, hi);
     for (int r = 0; r < ranges; ++r) {
       for (uint t = lo[r]; t < hi[r]; ++t) {
-        if (contact_excluded(sorted_body[t], body_i)) continue;
         uint j = grid_order[t];
+        if (contact_skipped(body_i, sorted_body[t], i, j)) continue;
         if (by_impulse && j < p.rigid_particle_count) continue;
         vec4 pj = particle_pos[j];
         vec4 vj = particle_vel[j];

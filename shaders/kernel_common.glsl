@@ -55,6 +55,7 @@ layout(std430, binding = B_BODY_ANGVEL_START) buffer BodyAngVelStartBuf { vec4 b
 layout(std430, binding = B_CONTACT_IMPULSE) buffer ContactImpulseBuf { vec4 contact_impulse_acc[]; };
 layout(std430, binding = B_IMPULSE_STAMP) buffer ImpulseStampBuf { uint impulse_stamp[]; };
 layout(std430, binding = B_MOTION_CHECK) buffer MotionCheckBuf { uint motion_check[]; };
+layout(std430, binding = B_LINK_EXCLUSIONS) readonly buffer LinkExclusionsBuf { uint link_exclusions[]; };
 layout(std430, binding = B_GRID_ARRIVAL) buffer GridArrivalBuf { uint grid_arrival[]; };
 layout(std430, binding = B_GRID_UNSORTED) buffer GridUnsortedBuf { uint grid_unsorted[]; };
 layout(std430, binding = B_SCAN_SCRATCH) buffer ScanScratchBuf { uint scan_scratch[]; };

@@ -9,6 +9,7 @@
 #include "shared/grid_hash.h"
 #include "shared/neighbours.h"
 #include "grid_walk.glsl"
+#include "link_exclusions.glsl"
 
 shared uint group_over;
 shared uint group_most;
@@ -31,11 +32,12 @@ void main() {
       int ranges = grid_walk(pi, lo, hi);
       for (int r = 0; r < ranges; ++r) {
         for (uint t = lo[r]; t < hi[r]; ++t) {
-          if (contact_excluded(sorted_body[t], body_i) ||
+          uint j = grid_order[t];
+          if (contact_skipped(body_i, sorted_body[t], i, j) ||
               !neighbour_within(pi, sorted_pos[t], p.neighbour_skin)) {
             continue;
           }
-          if (c < p.neighbour_capacity) neighbour_list[c * p.particle_count + i] = grid_order[t];
+          if (c < p.neighbour_capacity) neighbour_list[c * p.particle_count + i] = j;
           ++c;
         }
       }

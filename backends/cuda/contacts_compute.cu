@@ -30,6 +30,7 @@ struct ContactInputs {
   const uint* __restrict__ sbody;
   const shared::ContactLaw* __restrict__ laws;
   const shared::PlaneData* __restrict__ planes;
+  const uint* __restrict__ exclusions;  ///< LinkExclusions (shared/links.h)
 };
 
 __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
@@ -63,7 +64,11 @@ __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
     const uint body_i = in.body[i];
     grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
       for (uint t = lo; t < hi; ++t) {
-        if (!shared::contact_excluded(in.sbody[t], body_i)) add_contact(in.order[t]);
+        const uint j = in.order[t];
+        if (!shared::contact_skipped(body_i, in.sbody[t], uint(i), j, in.exclusions,
+                                     p.particle_count, p.linked_first)) {
+          add_contact(j);
+        }
       }
     });
   }
@@ -90,7 +95,8 @@ void CudaDevice::launch_contacts_compute(const shared::StepParams& p) {
                          buf<uint>(Buffer::GridCellStart),
                          buf<uint>(Buffer::SortedBody),
                          buf<shared::ContactLaw>(Buffer::ContactLaws),
-                         buf<shared::PlaneData>(Buffer::Planes)};
+                         buf<shared::PlaneData>(Buffer::Planes),
+                         buf<uint>(Buffer::LinkExclusions)};
   contacts_compute_kernel<<<blocks_for(p.particle_count), kBlock, 0, stream_>>>(
       p, in, buf<vec4>(Buffer::ParticleForce));
 }

@@ -32,6 +32,7 @@ struct BuildInputs {
   const uint* __restrict__ cell_start;
   const vec4* __restrict__ spos;
   const uint* __restrict__ sbody;
+  const uint* __restrict__ exclusions;  ///< LinkExclusions (shared/links.h)
 };
 
 struct BuildOutputs {
@@ -59,11 +60,13 @@ __global__ void neighbours_build_kernel(shared::StepParams p, BuildInputs in, Bu
       const std::size_t stride = p.particle_count;
       grid_walk(p, pi, in.cell_start, [&](uint lo, uint hi) {
         for (uint t = lo; t < hi; ++t) {
-          if (shared::contact_excluded(in.sbody[t], body_i) ||
+          const uint j = in.order[t];
+          if (shared::contact_skipped(body_i, in.sbody[t], uint(i), j, in.exclusions,
+                                      p.particle_count, p.linked_first) ||
               !shared::neighbour_within(pi, in.spos[t], p.neighbour_skin)) {
             continue;
           }
-          if (c < p.neighbour_capacity) out.list[std::size_t{c} * stride + i] = in.order[t];
+          if (c < p.neighbour_capacity) out.list[std::size_t{c} * stride + i] = j;
           ++c;
         }
       });
@@ -93,7 +96,7 @@ void CudaDevice::launch_neighbours_build(const shared::StepParams& p) {
   const BuildInputs in{buf<vec4>(Buffer::ParticlePos),   buf<vec4>(Buffer::ParticleVel),
                        buf<uint>(Buffer::ParticleBody),  buf<uint>(Buffer::GridOrder),
                        buf<uint>(Buffer::GridCellStart), buf<vec4>(Buffer::SortedPos),
-                       buf<uint>(Buffer::SortedBody)};
+                       buf<uint>(Buffer::SortedBody),    buf<uint>(Buffer::LinkExclusions)};
   const BuildOutputs out{buf<uint>(Buffer::NeighbourList), buf<uint>(Buffer::NeighbourCount),
                          buf<vec4>(Buffer::NeighbourRefPos), state};
   neighbours_build_kernel<<<blocks_for(p.particle_count), kBlock, 0, stream_>>>(p, in, out);

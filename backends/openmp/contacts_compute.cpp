@@ -32,6 +32,7 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
   const uint* order = buf<uint>(Buffer::GridOrder);
   const uint* cell_start = buf<uint>(Buffer::GridCellStart);
   const uint* sbody = buf<uint>(Buffer::SortedBody);
+  const uint* exclusions = buf<uint>(Buffer::LinkExclusions);
   const auto* laws = buf<shared::ContactLaw>(Buffer::ContactLaws);
   const auto* planes = buf<shared::PlaneData>(Buffer::Planes);
   vec4* force = buf<vec4>(Buffer::ParticleForce);
@@ -65,7 +66,11 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
       const GridRanges ranges = grid_walk(p, ref[i], cell_start);
       for (int r = 0; r < ranges.count; ++r) {
         for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
-          if (!shared::contact_excluded(sbody[t], body_i)) add_contact(order[t]);
+          const uint j = order[t];
+          if (!shared::contact_skipped(body_i, sbody[t], uint(i), j, exclusions, p.particle_count,
+                                       p.linked_first)) {
+            add_contact(j);
+          }
         }
       }
     }

@@ -36,6 +36,7 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
   const uint* cell_start = buf<uint>(Buffer::GridCellStart);
   const vec4* spos = buf<vec4>(Buffer::SortedPos);
   const uint* sbody = buf<uint>(Buffer::SortedBody);
+  const uint* exclusions = buf<uint>(Buffer::LinkExclusions);
   uint* list = buf<uint>(Buffer::NeighbourList);
   uint* count = buf<uint>(Buffer::NeighbourCount);
   vec4* ref = buf<vec4>(Buffer::NeighbourRefPos);
@@ -56,11 +57,13 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
     uint c = 0;
     for (int r = 0; r < ranges.count; ++r) {
       for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
-        if (shared::contact_excluded(sbody[t], body_i) ||
+        const uint j = order[t];
+        if (shared::contact_skipped(body_i, sbody[t], uint(i), j, exclusions, p.particle_count,
+                                    p.linked_first) ||
             !shared::neighbour_within(pi, spos[t], p.neighbour_skin)) {
           continue;
         }
-        if (c < capacity) list[std::size_t{c} * stride + static_cast<std::size_t>(i)] = order[t];
+        if (c < capacity) list[std::size_t{c} * stride + static_cast<std::size_t>(i)] = j;
         ++c;
       }
     }

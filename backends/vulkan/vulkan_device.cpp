@@ -35,6 +35,7 @@ static_assert(B_PARTICLE_MOMENT == static_cast<int>(Buffer::ParticleMoment));
 static_assert(B_BODY_ANGVEL_START == static_cast<int>(Buffer::BodyAngVelStart));
 static_assert(B_IMPULSE_STAMP == static_cast<int>(Buffer::ImpulseStamp));
 static_assert(B_MOTION_CHECK == static_cast<int>(Buffer::MotionCheck));
+static_assert(B_LINK_EXCLUSIONS == static_cast<int>(Buffer::LinkExclusions));
 static_assert(B_GRID_ARRIVAL == static_cast<int>(Buffer::Count));
 
 namespace {

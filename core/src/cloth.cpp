@@ -5,8 +5,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <numbers>
+#include <set>
+#include <utility>
 
 namespace motes {
 
@@ -111,6 +115,115 @@ Result<LinkedSpec> make_cloth(const ClothOptions& o) {
     }
   }
   return c;
+}
+
+Result<LinkedSpec> make_mesh_cloth(const TriangleMesh& mesh, const MeshClothOptions& o) {
+  if (Status s = check_common("cloth", o.diameter, o.stiffness, o.bend_stiffness); !s) return s;
+  if (mesh.triangles.empty()) {
+    return Status::error(fmt::format("{}: the mesh has no triangles", mesh.source));
+  }
+  // Particles at the vertices the triangles use, in the order of their first use.
+  constexpr std::uint32_t kUnused = ~0u;
+  std::vector<std::uint32_t> point_of(mesh.vertices.size(), kUnused);
+  LinkedSpec c;
+  c.kind = LinkedKind::Cloth;
+  c.diameter = o.diameter;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    std::array<std::uint32_t, 3> tri{};
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<std::size_t>(t[k]);
+      if (t[k] < 0 || v >= mesh.vertices.size()) {
+        return Status::error(fmt::format("{}: a triangle uses vertex {} of {}", mesh.source, t[k],
+                                         mesh.vertices.size()));
+      }
+      if (point_of[v] == kUnused) {
+        if (!mesh.vertices[v].allFinite()) {
+          return Status::error(fmt::format("{}: vertex {} is not finite", mesh.source, v));
+        }
+        point_of[v] = static_cast<std::uint32_t>(c.points.size());
+        c.points.push_back(mesh.vertices[v]);
+      }
+      tri[static_cast<std::size_t>(k)] = point_of[v];
+    }
+    if (tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2]) triangles.push_back(tri);
+  }
+  if (c.points.size() > kLinkedMaxMeshPoints) {
+    return Status::error(fmt::format("{}: {} vertices; a cloth from a mesh has at most {}",
+                                     mesh.source, c.points.size(), kLinkedMaxMeshPoints));
+  }
+  // Each edge once, with the vertices opposite it (at most two are used for a bend link).
+  struct Edge {
+    std::uint32_t opposite[2] = {0, 0};
+    int triangles = 0;
+  };
+  std::map<std::pair<std::uint32_t, std::uint32_t>, Edge> edges;
+  for (const auto& t : triangles) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t a = t[k], b = t[(k + 1) % 3];
+      Edge& e = edges[{std::min(a, b), std::max(a, b)}];
+      if (e.triangles < 2) e.opposite[e.triangles] = t[(k + 2) % 3];
+      ++e.triangles;
+    }
+  }
+  std::set<std::pair<std::uint32_t, std::uint32_t>> linked;
+  for (const auto& [ab, e] : edges) {
+    linked.insert(ab);
+    c.links.push_back({ab.first, ab.second, o.stiffness});
+  }
+  if (o.bend) {
+    for (const auto& [ab, e] : edges) {
+      if (e.triangles != 2) continue;  // a boundary edge, or one of a non-manifold fan
+      const std::uint32_t a = std::min(e.opposite[0], e.opposite[1]);
+      const std::uint32_t b = std::max(e.opposite[0], e.opposite[1]);
+      if (a != b && linked.insert({a, b}).second) c.links.push_back({a, b, o.bend_stiffness});
+    }
+  }
+  // The pairs within two links (which never touch) are listed per particle: at most the sum of
+  // the squared link counts. A fan (one vertex in many triangles) would make that quadratic.
+  std::vector<std::uint64_t> degree(c.points.size(), 0);
+  for (const LinkSpec& l : c.links) {
+    ++degree[l.a];
+    ++degree[l.b];
+  }
+  std::uint64_t reach = 0;
+  for (const std::uint64_t d : degree) reach += d * d;
+  if (reach > kMaxNearPerPoint * c.points.size()) {
+    const auto most =
+        static_cast<std::size_t>(std::max_element(degree.begin(), degree.end()) - degree.begin());
+    const Eigen::Vector3d& x = c.points[most];
+    return Status::error(fmt::format(
+        "{}: the vertex at [{}, {}, {}] has {} links (a fan of triangles): the particle pairs "
+        "within two links, which motes lists so that they never touch, would number up to {}, "
+        "over {} per particle; use a mesh whose vertices each join a few triangles",
+        mesh.source, x.x(), x.y(), x.z(), degree[most], reach, kMaxNearPerPoint));
+  }
+  return c;
+}
+
+LinkNeighbourhoods link_neighbourhoods(const std::vector<LinkSpec>& links, std::uint32_t count) {
+  std::vector<std::vector<std::uint32_t>> next(count);
+  for (const LinkSpec& l : links) {
+    next[l.a].push_back(l.b);
+    next[l.b].push_back(l.a);
+  }
+  LinkNeighbourhoods out;
+  out.start.push_back(0);
+  std::vector<std::uint32_t> near;
+  for (std::uint32_t k = 0; k < count; ++k) {
+    near.clear();
+    for (const std::uint32_t a : next[k]) {
+      near.push_back(a);
+      for (const std::uint32_t b : next[a]) near.push_back(b);
+    }
+    std::sort(near.begin(), near.end());
+    near.erase(std::unique(near.begin(), near.end()), near.end());
+    for (const std::uint32_t a : near) {
+      if (a != k) out.list.push_back(a);
+    }
+    out.start.push_back(static_cast<std::uint32_t>(out.list.size()));
+  }
+  return out;
 }
 
 ConstraintColouring colour_constraints(const std::vector<shared::Constraint>& constraints,

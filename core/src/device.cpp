@@ -90,6 +90,8 @@ const char* buffer_name(Buffer b) {
       return "ImpulseStamp";
     case Buffer::MotionCheck:
       return "MotionCheck";
+    case Buffer::LinkExclusions:
+      return "LinkExclusions";
     case Buffer::Count:
       break;
   }
@@ -194,6 +196,8 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
                                     : 0};
     case Buffer::ImpulseStamp:
       return {kUint, s.impulse != 0 ? std::size_t{s.rigid_particles} : 0};
+    case Buffer::LinkExclusions:
+      return {kUint, s.link_exclusions};
     case Buffer::Count:
       break;
   }
@@ -230,6 +234,7 @@ Sizes scale_sizes(const Sizes& sizes, std::uint32_t particles) {
   s.constraints = scale(sizes.constraints);
   s.clusters = scale(sizes.clusters);
   s.cluster_members = scale(sizes.cluster_members);
+  s.link_exclusions = scale(sizes.link_exclusions);
   s.table = grid_table_size(particles);
   return s;
 }

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <string_view>
@@ -90,6 +91,72 @@ void read_attachments(const Node& node, LinkedSpec& spec, PointOf point_of) {
   }
 }
 
+/// The index of the point of `c` nearest to `where` (the lowest index among equals); fails at
+/// `where` when none is within one particle diameter.
+std::uint32_t nearest_point(const Node& where, const LinkedSpec& c) {
+  const Eigen::Vector3d x = where.vec3();
+  std::uint32_t best = 0;
+  double best_d = HUGE_VAL;
+  for (std::size_t k = 0; k < c.points.size(); ++k) {
+    const double d = (c.points[k] - x).norm();
+    if (d < best_d) {
+      best_d = d;
+      best = static_cast<std::uint32_t>(k);
+    }
+  }
+  if (!(best_d <= c.diameter)) {
+    const Eigen::Vector3d& p = c.points[best];
+    where.fail(fmt::format(
+        "no vertex of the mesh within one particle diameter ({} m) of this point; the nearest, "
+        "[{:.6g}, {:.6g}, {:.6g}], is {:.6g} m away",
+        c.diameter, p.x(), p.y(), p.z(), best_d));
+  }
+  return best;
+}
+
+/// A cloth from a triangle mesh: {"mesh": file, "scale", "rotation", "position", "bend",
+/// "stiffness", "bend_stiffness", "pin": [[x, y, z], ...], "attach"}; pins and attachments name
+/// points in space, each taking the nearest vertex (after scale, rotation and position).
+LinkedSpec read_mesh_cloth(const Node& node, double diameter, ShapeCache& cache) {
+  for (const char* key : {"corner", "edge_u", "edge_v", "particles"}) {
+    if (node.has(key)) {
+      node.at(key).fail(
+          "a cloth is a \"mesh\" or a rectangle (\"corner\", \"edge_u\", \"edge_v\", "
+          "\"particles\"), not both");
+    }
+  }
+  node.expect_object({"mesh", "scale", "rotation", "position", "bend", "stiffness",
+                      "bend_stiffness", "pin", "attach"});
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+  if (auto s = node.find("scale")) {
+    scale = s->json().is_array() ? s->vec3(Sign::Positive)
+                                 : Eigen::Vector3d::Constant(s->number(Sign::Positive));
+  }
+  const Eigen::Quaterniond rotation =
+      node.has("rotation") ? read_rotation(node.at("rotation")) : Eigen::Quaterniond::Identity();
+  const Eigen::Vector3d position =
+      node.has("position") ? node.at("position").vec3() : Eigen::Vector3d::Zero();
+  MeshClothOptions o;
+  o.diameter = diameter;
+  if (auto v = node.find("bend")) o.bend = v->boolean();
+  if (auto v = node.find("stiffness")) o.stiffness = read_stiffness(*v);
+  if (auto v = node.find("bend_stiffness")) o.bend_stiffness = read_stiffness(*v);
+  TriangleMesh mesh = *load_mesh_once(node.at("mesh"), cache);
+  for (Eigen::Vector3d& v : mesh.vertices) v = rotation * v.cwiseProduct(scale) + position;
+  LinkedSpec c = take(make_mesh_cloth(mesh, o), node.at("mesh"), "cloth");
+  if (auto pins = node.find("pin")) {
+    pins->expect_array();
+    std::map<std::uint32_t, std::string> pinned;
+    for (std::size_t k = 0; k < pins->size(); ++k) {
+      const Node pin = pins->at(k);
+      add_pin(pin, nearest_point(pin, c), pinned);
+    }
+    for (const auto& entry : pinned) c.pinned.push_back(entry.first);
+  }
+  read_attachments(node, c, [&](const Node& point) { return nearest_point(point, c); });
+  return c;
+}
+
 LinkedSpec read_cloth(const Node& node, double diameter) {
   node.expect_object({"corner", "edge_u", "edge_v", "particles", "bend", "stiffness",
                       "bend_stiffness", "pin", "attach"});
@@ -170,7 +237,7 @@ bool is_linked(const Node& entry) {
   return kind != json.end() && kind->is_string() && (*kind == "cloth" || *kind == "rope");
 }
 
-LinkedSpec read_linked(const Node& entry, std::size_t index, const ShapeCache& cache,
+LinkedSpec read_linked(const Node& entry, std::size_t index, ShapeCache& cache,
                        const Scene& scene) {
   const std::string kind = entry.at("kind").string();
   if (scene.linked.size() >= kLinkedMaxObjects) {
@@ -186,7 +253,9 @@ LinkedSpec read_linked(const Node& entry, std::size_t index, const ShapeCache& c
   const double diameter =
       entry.has("diameter") ? entry.at("diameter").number(Sign::Positive) : cache.default_diameter;
   const Node shape = entry.at(kind);
-  LinkedSpec spec = kind == "cloth" ? read_cloth(shape, diameter) : read_rope(shape, diameter);
+  LinkedSpec spec = kind == "rope"      ? read_rope(shape, diameter)
+                    : shape.has("mesh") ? read_mesh_cloth(shape, diameter, cache)
+                                        : read_cloth(shape, diameter);
   for (const Eigen::Vector3d& p : spec.points) {
     if (!(p.cwiseAbs().maxCoeff() <= static_cast<double>(std::numeric_limits<float>::max()))) {
       shape.fail("a particle lands outside the float range");

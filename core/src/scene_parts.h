@@ -32,6 +32,9 @@ struct ShapeCache {
 /// Reads a "shape" object and builds its particles (errors carry the shape's JSON path).
 std::shared_ptr<const ParticleSet> read_shape(const Node& shape, ShapeCache& cache);
 
+/// The mesh named by `file` (a path relative to cache.base_dir), loaded once per scene.
+std::shared_ptr<const TriangleMesh> load_mesh_once(const Node& file, ShapeCache& cache);
+
 /// Reads {"axis": [x, y, z], "degrees": a}.
 Eigen::Quaterniond read_rotation(const Node& rotation);
 
@@ -57,9 +60,9 @@ Eigen::Vector3d read_color(const Node& node);
 bool is_linked(const Node& entry);
 /// Reads such an entry, the index-th of "bodies", into a LinkedSpec (materials must already be in
 /// scene.materials; scene.linked holds the ones before it). Errors carry the JSON path; those of
-/// make_cloth and make_rope that of the entry's "cloth" or "rope" object (scene_linked.cpp).
-LinkedSpec read_linked(const Node& entry, std::size_t index, const ShapeCache& cache,
-                       const Scene& scene);
+/// make_cloth, make_mesh_cloth and make_rope that of the entry's "cloth" or "rope" object
+/// (scene_linked.cpp). A cloth's "mesh" is loaded through `cache`.
+LinkedSpec read_linked(const Node& entry, std::size_t index, ShapeCache& cache, const Scene& scene);
 
 /// Largest distance a particle may travel in one substep at the start, as a fraction of its radius
 /// (docs/reliability.md, "Initial speeds").

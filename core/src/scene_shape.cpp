@@ -52,28 +52,6 @@ double mesh_volume(const TriangleMesh& mesh) {
   return std::abs(six_v) / 6.0;
 }
 
-std::shared_ptr<const TriangleMesh> load_mesh_once(const Node& file, ShapeCache& cache) {
-  const std::string name = file.string();
-  fs::path path(name);
-  if (path.is_relative() && !cache.base_dir.empty()) path = fs::path(cache.base_dir) / path;
-  std::error_code ec;
-  const fs::path resolved = fs::weakly_canonical(path, ec);
-  const std::string key = ec ? path.lexically_normal().string() : resolved.string();
-  if (auto it = cache.meshes.find(key); it != cache.meshes.end()) return it->second;
-
-  if (!fs::exists(path, ec)) {
-    file.fail(fmt::format("cannot open mesh \"{}\": no such file", path.string()));
-  }
-  if (fs::is_directory(path, ec)) {
-    file.fail(fmt::format("cannot open mesh \"{}\": is a directory", path.string()));
-  }
-  Result<TriangleMesh> mesh = load_mesh(path.string());
-  if (!mesh) file.fail(mesh.message());
-  auto shared = std::make_shared<const TriangleMesh>(std::move(mesh).value());
-  cache.meshes.emplace(key, shared);
-  return shared;
-}
-
 std::shared_ptr<const ParticleSet> read_mesh(const Node& shape, ShapeCache& cache) {
   shape.expect_object({"type", "file", "scale", "particle_diameter", "particle_count"});
   Eigen::Vector3d scale = Eigen::Vector3d::Ones();
@@ -101,6 +79,28 @@ std::shared_ptr<const ParticleSet> read_mesh(const Node& shape, ShapeCache& cach
 }
 
 }  // namespace
+
+std::shared_ptr<const TriangleMesh> load_mesh_once(const Node& file, ShapeCache& cache) {
+  const std::string name = file.string();
+  fs::path path(name);
+  if (path.is_relative() && !cache.base_dir.empty()) path = fs::path(cache.base_dir) / path;
+  std::error_code ec;
+  const fs::path resolved = fs::weakly_canonical(path, ec);
+  const std::string key = ec ? path.lexically_normal().string() : resolved.string();
+  if (auto it = cache.meshes.find(key); it != cache.meshes.end()) return it->second;
+
+  if (!fs::exists(path, ec)) {
+    file.fail(fmt::format("cannot open mesh \"{}\": no such file", path.string()));
+  }
+  if (fs::is_directory(path, ec)) {
+    file.fail(fmt::format("cannot open mesh \"{}\": is a directory", path.string()));
+  }
+  Result<TriangleMesh> mesh = load_mesh(path.string());
+  if (!mesh) file.fail(mesh.message());
+  auto shared = std::make_shared<const TriangleMesh>(std::move(mesh).value());
+  cache.meshes.emplace(key, shared);
+  return shared;
+}
 
 Eigen::Quaterniond read_rotation(const Node& rotation) {
   rotation.expect_object({"axis", "degrees"});

@@ -134,9 +134,13 @@ Status Simulation::upload(const Scene& scene) {
   }
   std::uint64_t constraint_count = 0;
   for (const LinkedSpec& l : scene.linked) {
-    if (l.points.empty() || l.lattice.size() != l.points.size()) {
-      return Status::error(fmt::format("{}: '{}' has no particles, or not one lattice place each",
-                                       scene.source, l.name));
+    const bool mesh = l.lattice.empty() && l.kind == LinkedKind::Cloth;
+    if (l.points.empty() || (!mesh && l.lattice.size() != l.points.size()) ||
+        (mesh && l.points.size() > kLinkedMaxMeshPoints)) {
+      return Status::error(fmt::format(
+          "{}: '{}' has no particles, not one lattice place each, or (a cloth from a mesh) more "
+          "than {} particles",
+          scene.source, l.name, kLinkedMaxMeshPoints));
     }
     n += l.points.size();
     constraint_count += l.links.size() + l.attached.size();
@@ -325,6 +329,12 @@ Status Simulation::upload(const Scene& scene) {
   std::vector<shared::Constraint> constraints;
   constraints.reserve(sizes_.constraints);
   std::uint32_t next_linked = linked_first;
+  // LinkExclusions (shared/links.h), when a cloth is made from a mesh: a start for every linked
+  // particle, then the lists.
+  const bool any_mesh = std::any_of(scene.linked.begin(), scene.linked.end(),
+                                    [](const LinkedSpec& l) { return l.lattice.empty(); });
+  std::vector<std::uint32_t> exclusion_start, exclusion_list;
+  if (any_mesh) exclusion_start.push_back(0);
   for (std::size_t li = 0; li < scene.linked.size(); ++li) {
     const LinkedSpec& spec = scene.linked[li];
     if (spec.material < 0 || static_cast<std::size_t>(spec.material) >= scene.materials.size()) {
@@ -355,17 +365,34 @@ Status Simulation::upload(const Scene& scene) {
     bodies_.push_back(info);
     device_index_.push_back(next_linked);
     scene_particle += count;
+    const bool mesh = spec.lattice.empty();
     for (std::uint32_t k = 0; k < count; ++k) {
+      const std::uint32_t i = next_linked + k;
+      ppos[i] = to_vec4(spec.points[k], 0.5 * spec.diameter);
+      pvel[i] = pinned[k] ? vec4(0.0f) : to_vec4(spec.velocity, 1.0 / particle_mass);
+      pmat[i] = static_cast<std::uint32_t>(spec.material);
+      if (mesh) {
+        pbody[i] = shared::linked_mesh_body(static_cast<std::uint32_t>(li), k);
+        continue;
+      }
       const std::array<std::uint32_t, 2> uv = spec.lattice[k];
       if (uv[0] >= kLinkedMaxSide || uv[1] >= kLinkedMaxSide) {
         return Status::error(fmt::format("{}: '{}': lattice place ({}, {}) beyond {}", scene.source,
                                          spec.name, uv[0], uv[1], kLinkedMaxSide));
       }
-      const std::uint32_t i = next_linked + k;
-      ppos[i] = to_vec4(spec.points[k], 0.5 * spec.diameter);
-      pvel[i] = pinned[k] ? vec4(0.0f) : to_vec4(spec.velocity, 1.0 / particle_mass);
       pbody[i] = shared::linked_body(static_cast<std::uint32_t>(li), uv[0], uv[1]);
-      pmat[i] = static_cast<std::uint32_t>(spec.material);
+    }
+    if (any_mesh) {
+      const LinkNeighbourhoods near =
+          mesh ? link_neighbourhoods(spec.links, count) : LinkNeighbourhoods{};
+      for (std::uint32_t k = 0; k < count; ++k) {
+        if (mesh) {
+          for (std::uint32_t e = near.start[k]; e < near.start[k + 1]; ++e) {
+            exclusion_list.push_back(next_linked + near.list[e]);
+          }
+        }
+        exclusion_start.push_back(static_cast<std::uint32_t>(exclusion_list.size()));
+      }
     }
     for (const LinkSpec& link : spec.links) {
       if (link.a >= count || link.b >= count || link.a == link.b) {
@@ -440,6 +467,14 @@ Status Simulation::upload(const Scene& scene) {
 
   sizes_.clusters = static_cast<std::uint32_t>(soft.clusters.size());
   sizes_.cluster_members = static_cast<std::uint32_t>(soft.members.size());
+  std::vector<std::uint32_t> exclusions = std::move(exclusion_start);
+  exclusions.insert(exclusions.end(), exclusion_list.begin(), exclusion_list.end());
+  if (exclusions.size() > std::numeric_limits<std::uint32_t>::max() / 2) {
+    return Status::error(fmt::format(
+        "{}: the cloths made from meshes have {} pairs within two links; motes supports 2^31",
+        scene.source, exclusion_list.size()));
+  }
+  sizes_.link_exclusions = static_cast<std::uint32_t>(exclusions.size());
   if (Status st = check_memory(); !st) return st;
 
   // The setup's fingerprint: every fixed input of a step (checkpoints load only where it is
@@ -462,6 +497,7 @@ Status Simulation::upload(const Scene& scene) {
   add(soft.clusters);
   add(soft.members);
   add(gather);
+  add(exclusions);
   for (const auto& [body, q] : sphere_turns_) {
     h = fnv1a64(&body, sizeof body, h);
     h = fnv1a64(&q, sizeof q, h);
@@ -498,6 +534,7 @@ Status Simulation::upload(const Scene& scene) {
   if (s) s = write_vector(d, Buffer::ClusterMembers, soft.members);
   if (s) s = write_vector(d, Buffer::ClusterFrames, frames);
   if (s) s = write_vector(d, Buffer::ClusterGather, gather);
+  if (s) s = write_vector(d, Buffer::LinkExclusions, exclusions);
   if (s) s = clear_contact_history();
   if (!s) return s;
   // Rigid particles take their pose from the bodies with the device's own arithmetic.

@@ -20,33 +20,76 @@ struct Constraint {
   float stiffness;  // fraction of the error removed per projection, in (0, 1]
 };
 
-/// ParticleBody of a cloth or rope particle: this bit, then the object (11 bits) and the
-/// particle's place (u, v) on the object's lattice (10 bits each; a rope has v = 0). Particles of
-/// one object within two lattice steps in u and in v are excluded from contact with each other:
-/// they are linked, or two links apart.
+/// ParticleBody of a cloth or rope particle: this bit, a clear MESH bit, then the object (10
+/// bits) and the particle's place (u, v) on the object's lattice (10 bits each; a rope has v = 0).
+/// Particles of one object within two lattice steps in u and in v are excluded from contact with
+/// each other: they are linked, or two links apart.
+/// A cloth made from a triangle mesh has no lattice: its particles' words are LINKED | MESH | the
+/// object | the vertex (20 bits), and the particles within two links of each one are listed in
+/// the LinkExclusions buffer (contact_listed, contact_skipped).
 #define MOTES_LINKED_BIT 0x80000000u
-#define MOTES_LINKED_MAX_OBJECTS 2048u
+#define MOTES_LINKED_MESH_BIT 0x40000000u
+#define MOTES_LINKED_MAX_OBJECTS 1024u
 #define MOTES_LINKED_MAX_SIDE 1024u
+#define MOTES_LINKED_MAX_MESH_POINTS 0x100000u
 
 MOTES_FN uint linked_body(uint object, uint u, uint v) {
   return MOTES_LINKED_BIT | (object << 20) | (u << 10) | v;
+}
+
+MOTES_FN uint linked_mesh_body(uint object, uint vertex) {
+  return MOTES_LINKED_BIT | MOTES_LINKED_MESH_BIT | (object << 20) | vertex;
 }
 
 /// |a - b| <= 2 for lattice coordinates a, b.
 MOTES_FN bool lattice_near(uint a, uint b) { return (a > b ? a - b : b - a) <= 2u; }
 
 /// True when particles with these ParticleBody words never touch: the same rigid body (or the
-/// same particle), or two particles of one cloth or rope within two lattice steps.
+/// same particle), or two particles of one lattice cloth or rope within two lattice steps. Two
+/// particles of one mesh cloth are not decided here (contact_listed).
 MOTES_FN bool contact_excluded(uint body_i, uint body_j) {
   if (body_i == body_j) {
     return true;
   }
-  if ((body_i & body_j & MOTES_LINKED_BIT) == 0u || (body_i >> 20) != (body_j >> 20)) {
+  if ((body_i & body_j & MOTES_LINKED_BIT) == 0u || (body_i >> 20) != (body_j >> 20) ||
+      (body_i & MOTES_LINKED_MESH_BIT) != 0u) {
     return false;
   }
   return lattice_near((body_i >> 10) & 1023u, (body_j >> 10) & 1023u) &&
          lattice_near(body_i & 1023u, body_j & 1023u);
 }
+
+/// True for two particles of one mesh cloth: they touch unless the second is in the first's
+/// LinkExclusions list. That buffer holds, for the linked particles [Nl, N), N - Nl + 1 starts
+/// (counted from the lists' beginning, right after them), then each particle's list of the
+/// particle ids within two links of it, ascending.
+MOTES_FN bool contact_listed(uint body_i, uint body_j) {
+  return (body_i & MOTES_LINKED_MESH_BIT) != 0u && (body_i >> 20) == (body_j >> 20);
+}
+
+#ifdef __cplusplus
+/// contact_excluded, then for two particles i and j of one mesh cloth whether j is in i's
+/// LinkExclusions list `exclusions` (C++ and CUDA; shaders/link_exclusions.glsl is the same in
+/// GLSL). Used wherever contacts are found: neighbours_build and contacts_compute's grid walk.
+MOTES_FN bool contact_skipped(uint body_i, uint body_j, uint i, uint j, const uint* exclusions,
+                              uint particle_count, uint linked_first) {
+  if (contact_excluded(body_i, body_j)) {
+    return true;
+  }
+  if (!contact_listed(body_i, body_j)) {
+    return false;
+  }
+  const uint lists = particle_count - linked_first + 1u;
+  const uint end = exclusions[i - linked_first + 1u];
+  for (uint e = exclusions[i - linked_first]; e < end; ++e) {
+    const uint k = exclusions[lists + e];
+    if (k >= j) {
+      return k == j;
+    }
+  }
+  return false;
+}
+#endif
 
 /// Velocity of particle i before particle_integrate: Jakobsen's damping (the velocity times
 /// 1 - damping per substep) for the linked particles [linked_first, N), unchanged for the others.

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 #include <utility>
 
 #include "motes/devices.h"
@@ -110,6 +111,33 @@ void OracleRun::step(std::uint64_t steps) {
   }
 }
 
+/// The pairs of a cloth made from a mesh that never touch, found from the constraints (not from
+/// the simulation's LinkExclusions): two of its particles joined by a path of at most two
+/// constraints between its own particles.
+std::set<std::pair<uint, uint>> mesh_never_touch(
+    const std::vector<uint>& body, const std::vector<motes::shared::Constraint>& constraints) {
+  const auto mesh_pair = [&](uint a, uint b) {
+    return (body[a] & MOTES_LINKED_MESH_BIT) != 0 && (body[a] >> 20) == (body[b] >> 20);
+  };
+  std::map<uint, std::vector<uint>> next;
+  for (const motes::shared::Constraint& c : constraints) {
+    if (c.a < body.size() && c.b < body.size() && mesh_pair(c.a, c.b)) {
+      next[c.a].push_back(c.b);
+      next[c.b].push_back(c.a);
+    }
+  }
+  std::set<std::pair<uint, uint>> out;
+  for (const auto& [a, near] : next) {
+    for (const uint b : near) {
+      out.insert({a, b});
+      for (const uint c : next[b]) {
+        if (c != a) out.insert({a, c});
+      }
+    }
+  }
+  return out;
+}
+
 motes::Status capture(motes::Simulation& sim, OracleRun& out) {
   motes::Status s = read_all(sim, motes::Buffer::ParticlePos, out.particles.pos);
   if (s) s = read_all(sim, motes::Buffer::ParticleVel, out.particles.vel);
@@ -129,6 +157,7 @@ motes::Status capture(motes::Simulation& sim, OracleRun& out) {
   if (s) s = read_all(sim, motes::Buffer::Clusters, out.clusters);
   if (s) s = read_all(sim, motes::Buffer::ClusterMembers, out.members);
   if (s) s = read_all(sim, motes::Buffer::ClusterFrames, out.frames);
+  out.particles.never_touch = mesh_never_touch(out.particles.body, out.constraints);
   out.colour_first = sim.constraint_colours();
   out.iterations = sim.settings().constraint_iterations;
   out.particles.rigid = sim.sizes().rigid_particles;

@@ -52,7 +52,9 @@ class ContactsCompute : public DeviceTest {
     poison_all_but({Buffer::ParticlePos, Buffer::ParticleVel, Buffer::ParticleBody,
                     Buffer::ParticleMaterial, Buffer::NeighbourList, Buffer::NeighbourCount,
                     Buffer::NeighbourRefPos, Buffer::GridOrder, Buffer::GridCellStart,
-                    Buffer::SortedBody, Buffer::ContactLaws, Buffer::Planes});
+                    Buffer::SortedBody, Buffer::ContactLaws, Buffer::Planes,
+                    Buffer::LinkExclusions});
+    write(Buffer::LinkExclusions, w.link_exclusions);
     write(Buffer::ParticlePos, now.pos);
     write(Buffer::ParticleVel, now.vel);
     write(Buffer::ParticleBody, now.body);
@@ -134,6 +136,10 @@ TEST_P(ContactsCompute, Random1234Clamped) {
 TEST_P(ContactsCompute, Linked1234) {
   // Cloth and rope particles: no force between particles of one object within two lattice steps.
   run_case("linked", with_linked(random_world(25, 1234, 0, kTestSkin), 25));
+}
+TEST_P(ContactsCompute, MeshLinked1234) {
+  // Cloths from meshes: no force between the pairs their LinkExclusions lists hold.
+  run_case("mesh_linked", with_mesh_linked(random_world(29, 1234, 0, kTestSkin), 29));
 }
 TEST_P(ContactsCompute, Random20000) {
   run_case("random_clamped", random_world(25, 20000, MOTES_FLAG_CLAMP_ATTRACTION, kTestSkin));

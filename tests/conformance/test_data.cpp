@@ -306,6 +306,46 @@ World with_linked(World w, std::uint32_t seed) {
   return w;
 }
 
+World with_mesh_linked(World w, std::uint32_t seed) {
+  Rng rng(seed);
+  motes_ref::Particles& p = w.particles;
+  const std::size_t nl = p.rigid;
+  const std::size_t n = p.size();
+  std::vector<uint> object(n, 0u);
+  uint vertices[2] = {0u, 0u};
+  for (std::size_t i = nl; i < n; ++i) {
+    object[i] = rng.below(2);
+    p.body[i] = motes::shared::linked_mesh_body(object[i], vertices[object[i]]++);
+  }
+  float rmax = 0.0f;
+  for (const vec4& x : p.pos) rmax = std::max(rmax, x.w);
+  const float reach = 3.0f * rmax;
+  for (std::size_t i = nl; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n; ++j) {
+      const float dx = p.pos[i].x - p.pos[j].x, dy = p.pos[i].y - p.pos[j].y;
+      const float dz = p.pos[i].z - p.pos[j].z;
+      if (object[i] != object[j] || dx * dx + dy * dy + dz * dz >= reach * reach) continue;
+      if (rng.below(2) == 0) continue;
+      p.never_touch.insert({uint(i), uint(j)});
+      p.never_touch.insert({uint(j), uint(i)});
+    }
+  }
+  // The buffer: a start for every linked particle, then the lists (a set's order: ascending).
+  std::vector<uint> lists;
+  w.link_exclusions.assign(1, 0u);
+  auto at = p.never_touch.begin();
+  for (std::size_t i = nl; i < n; ++i) {
+    for (; at != p.never_touch.end() && at->first == i; ++at) lists.push_back(at->second);
+    w.link_exclusions.push_back(static_cast<uint>(lists.size()));
+  }
+  w.link_exclusions.insert(w.link_exclusions.end(), lists.begin(), lists.end());
+  w.sizes.link_exclusions = static_cast<uint>(w.link_exclusions.size());
+  w.params.linked_first = static_cast<uint>(nl);
+  w.params.soft_first = w.params.linked_first;  // no soft bodies
+  w.params.linked_damping = 0.25f;
+  return w;
+}
+
 World random_world(std::uint32_t seed, std::size_t n, std::uint32_t flags, float skin) {
   Rng rng(seed);
   const float rmax = 0.005f;

@@ -48,6 +48,7 @@ struct World {
   std::vector<PlaneData> planes;
   StepParams params{};
   motes::Sizes sizes;
+  std::vector<uint> link_exclusions;  ///< the LinkExclusions buffer (empty without a mesh cloth)
 };
 
 // Particle layouts: xyz = centre, w = radius (the largest radius, rmax, always occurs once).
@@ -87,6 +88,12 @@ World random_world(std::uint32_t seed, std::size_t n, std::uint32_t flags = 0, f
 /// pairs are within two lattice steps: excluded from contact), linked_first = Nr, linked damping
 /// 0.25 per substep.
 World with_linked(World w, std::uint32_t seed);
+
+/// The free particles of w [Nr, N) made particles of two cloths from meshes (ParticleBody =
+/// shared::linked_mesh_body), with random never-touch pairs: each pair of one object closer than
+/// 3 rmax is one with probability 1/2 (both ways), written as LinkExclusions lists and as the
+/// oracle's set Particles::never_touch. linked_first = Nr.
+World with_mesh_linked(World w, std::uint32_t seed);
 
 /// The oracle's lists as a NeighbourList buffer of capacity K (entry k of particle i at k N + i;
 /// unused entries 0xFFFFFFFF).

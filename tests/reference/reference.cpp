@@ -84,8 +84,10 @@ Neighbours neighbours_build(const Particles& particles, const Grid& grid, const 
     const std::vector<uint> walk = walk_buckets(particles.pos[i], p);
     std::vector<std::pair<std::size_t, uint>> found;  // (place on the walk, slot) of each j
     for (std::size_t j = 0; j < n; ++j) {
-      if (motes::shared::contact_excluded(particles.body[j], particles.body[i]))
-        continue;  // j == i
+      if (motes::shared::contact_excluded(particles.body[j], particles.body[i]) ||
+          particles.never_touch.count({uint(i), uint(j)}) != 0) {
+        continue;  // j == i, or j never touches i
+      }
       const auto on_walk = std::find(walk.begin(), walk.end(), grid.bucket[j]);
       if (on_walk == walk.end()) continue;
       if (!motes::shared::neighbour_within(particles.pos[i], particles.pos[j], p.neighbour_skin)) {
@@ -119,8 +121,10 @@ std::vector<vec4> contacts_compute(const Particles& particles, const std::vector
       sum[2] += static_cast<double>(f.z);
     };
     for (std::size_t j = 0; j < n; ++j) {
-      if (motes::shared::contact_excluded(particles.body[j], particles.body[i]))
-        continue;  // j == i
+      if (motes::shared::contact_excluded(particles.body[j], particles.body[i]) ||
+          particles.never_touch.count({uint(i), uint(j)}) != 0) {
+        continue;  // j == i, or j never touches i
+      }
       const vec4 xj = particles.pos[j];
       const vec4 vj = particles.vel[j];
       const ContactLaw law = laws[particles.material[i] * m + particles.material[j]];

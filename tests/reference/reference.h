@@ -8,6 +8,8 @@
 #pragma once
 
 #include <cstdint>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "shared/common.h"
@@ -37,6 +39,9 @@ struct Particles {
                                ///< shared::linked_body)
   std::vector<uint> material;  ///< material index
   std::size_t rigid = 0;       ///< Nr: particles of rigid bodies
+  /// Ordered pairs (i, j) of particles of a cloth made from a mesh that never touch: what the
+  /// LinkExclusions lists hold (shared::linked_mesh_body words; the lists are a set here).
+  std::set<std::pair<uint, uint>> never_touch;
   [[nodiscard]] std::size_t size() const { return pos.size(); }
 };
 

@@ -9,6 +9,7 @@
 
 #include "motes/api.h"
 #include "motes/scene.h"
+#include "motes/shapes.h"
 #include "motes/status.h"
 #include "shared/links.h"
 
@@ -62,6 +63,36 @@ Result<LinkedSpec> make_cloth(const ClothOptions& options);
 inline std::uint32_t cloth_index(const ClothOptions& options, int i, int j) {
   return static_cast<std::uint32_t>(j * options.nu + i);
 }
+
+/// Options of a cloth made from a triangle mesh: a particle at every vertex that a triangle uses,
+/// a structural link along every edge and, with `bend`, a bend link across every edge that two
+/// triangles share (between the two vertices opposite it). Rest lengths are the mesh's.
+struct MeshClothOptions {
+  double diameter = 0.01;
+  bool bend = true;
+  double stiffness = 1.0;
+  double bend_stiffness = 1.0;
+};
+/// A cloth from `mesh` (kind Cloth, no lattice; name, material, pins, velocity and colour left to
+/// the caller). Errors name mesh.source: no triangles, more than kLinkedMaxMeshPoints vertices
+/// in use, a non-finite vertex, a bad option.
+Result<LinkedSpec> make_mesh_cloth(const TriangleMesh& mesh, const MeshClothOptions& options);
+
+/// make_mesh_cloth refuses a mesh whose sum over vertices of (links per vertex)^2, the bound on
+/// the pairs within two links, exceeds this many per vertex (a regular mesh has about 150).
+constexpr std::uint64_t kMaxNearPerPoint = 512;
+
+/// Most vertices of a cloth made from a mesh (the vertex travels in 20 bits of ParticleBody).
+constexpr std::uint32_t kLinkedMaxMeshPoints = MOTES_LINKED_MAX_MESH_POINTS;
+
+/// For each of `count` points, the other points within two links of it (the links' graph),
+/// ascending: point k's are list[start[k], start[k + 1]). Such particles never touch
+/// (LinkExclusions, shared/links.h).
+struct LinkNeighbourhoods {
+  std::vector<std::uint32_t> start;  ///< count + 1 entries
+  std::vector<std::uint32_t> list;
+};
+LinkNeighbourhoods link_neighbourhoods(const std::vector<LinkSpec>& links, std::uint32_t count);
 
 /// Constraints grouped by colour: no two constraints of one colour share a particle. Colour c is
 /// constraints[first[c], first[c + 1]).

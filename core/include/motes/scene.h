@@ -113,10 +113,6 @@ struct LinkSpec {
   double stiffness = 1.0;  ///< fraction of the error one projection removes, in (0, 1]
 };
 
-/// A cloth or a rope (Jakobsen 2001): equal spheres on a lattice, joined by distance constraints,
-/// integrated by position Verlet and relaxed colour by colour; they collide with everything
-/// through the one grid, themselves included (not within two lattice steps). Built by make_rope
-/// and make_cloth (motes/cloth.h).
 /// A cloth or rope point held by a rigid or static body: a link of the point's rest distance to
 /// the body's nearest particle, relaxed with the others; the body takes what the link does to
 /// that particle (docs/architecture.md, "Cloth and ropes").
@@ -125,6 +121,11 @@ struct LinkAttachment {
   std::string body;         ///< name of a rigid or static BodySpec
 };
 
+/// A cloth or a rope (Jakobsen 2001): equal spheres on a lattice or at a mesh's vertices, joined
+/// by distance constraints, integrated by position Verlet and relaxed colour by colour; they
+/// collide with everything through the one grid, themselves included (not within two lattice
+/// steps, or two links for a cloth from a mesh). Built by make_rope, make_cloth and
+/// make_mesh_cloth (motes/cloth.h).
 struct LinkedSpec {
   std::string name;
   LinkedKind kind = LinkedKind::Rope;
@@ -132,7 +133,9 @@ struct LinkedSpec {
                                         ///< density x pi/6 diameter^3, as a lone sphere
   double diameter = 0.0;                ///< particle diameter (m)
   std::vector<Eigen::Vector3d> points;  ///< world positions of the particles
-  std::vector<std::array<std::uint32_t, 2>> lattice;  ///< (u, v) of each point; a rope: (i, 0)
+  /// (u, v) of each point; a rope: (i, 0). Empty for a cloth made from a triangle mesh: its
+  /// particles within two links of each other do not touch (link_neighbourhoods).
+  std::vector<std::array<std::uint32_t, 2>> lattice;
   std::vector<LinkSpec> links;
   std::vector<std::uint32_t> pinned;     ///< points held fixed in space (inverse mass 0)
   std::vector<LinkAttachment> attached;  ///< points held by bodies (none also pinned)

@@ -73,6 +73,11 @@ enum class Buffer : std::uint32_t {
   ImpulseStamp,
   // Run-time checks.
   MotionCheck,  ///< uint (4): particles_check's MOTES_MOTION_* words (shared/motion_check.h)
+  // Cloth from triangle meshes (empty without one; after the others: checkpoints name buffers
+  // by their number).
+  /// uint (N - Nl + 1 + E): for each linked particle, where its list of the particles within
+  /// two links starts, then the lists, ascending (shared/links.h, contact_listed).
+  LinkExclusions,
   Count
 };
 
@@ -117,6 +122,7 @@ struct Sizes {
   std::uint32_t cluster_members = 0;     ///< Sm: their members (a particle may be in several)
   std::uint32_t impulse = 0;             ///< 1: rigid contacts by impulses (buffers for them)
   std::uint32_t absorb = 0;  ///< 1: cloth or ropes attached to rigid bodies (ParticleMoment)
+  std::uint32_t link_exclusions = 0;  ///< words of LinkExclusions: 0 without a mesh cloth
 };
 
 /// Bytes of one element and number of elements of a buffer.
@@ -133,9 +139,9 @@ std::uint64_t buffers_bytes(const Sizes& sizes);
 std::uint32_t grid_table_size(std::uint32_t particles);
 
 /// `sizes` for `particles` particles in the same proportions: rigid particles, bodies, soft
-/// particles, constraints, clusters and their members scaled with N (rounded down), materials,
-/// planes and the neighbour capacity kept, the table grid_table_size(particles). What "the largest
-/// particle count that fits" is counted in.
+/// particles, constraints, clusters and their members, and the mesh-cloth exclusion lists scaled
+/// with N (rounded down), materials, planes and the neighbour capacity kept, the table
+/// grid_table_size(particles). What "the largest particle count that fits" is counted in.
 Sizes scale_sizes(const Sizes& sizes, std::uint32_t particles);
 
 /// One buffer a device would allocate: its name and bytes.
