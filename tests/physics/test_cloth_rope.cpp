@@ -16,7 +16,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "motes/cloth.h"
@@ -242,6 +244,87 @@ TEST(Cloth, DrapedOverASphereStaysOutside) {
       kRadius, closest);
   // The sphere's surface particles reach kRadius + d/2; a cloth particle's centre stays beyond it.
   EXPECT_GT(closest, kRadius);
+}
+
+TEST(Cloth, MeshClothFoldedOnItselfDoesNotPassThrough) {
+  // A strip made from a triangle mesh (37 x 6 vertices 1 cm apart, alternating diagonals) lying on
+  // the floor folded over on itself: 20 cm flat, a half turn of radius 7.5 mm, then 14 cm back on
+  // top, its particles 1.5 diameters above the lower layer. The upper layer falls onto the lower
+  // one and must come to rest on it: the layers are one cloth, but more than two links apart, so
+  // they touch like any two particles. Were they excluded, the upper layer would fall through to
+  // the floor (its particles 0 to 0.5 d above the lower layer's).
+  constexpr double kDiameter = 0.01, kFlat = 0.2, kTurn = 0.0075, kY = 0.005;
+  constexpr int kAlong = 37, kAcross = 6;
+  motes::Scene scene = linked_scene(1.0e-4, Eigen::Vector3d(0.0, -9.81, 0.0));
+  scene.settings.link_damping = 1.0;
+  scene.planes.push_back(
+      motes::PlaneSpec{"floor", Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero(), 0});
+  motes::TriangleMesh strip;
+  strip.source = "folded strip";
+  for (int k = 0; k < kAcross; ++k) {
+    for (int i = 0; i < kAlong; ++i) {
+      const double s = i * kDiameter, z = k * kDiameter;  // s: length along the strip
+      const double turned = (s - kFlat) / kTurn;          // angle into the half turn
+      if (s <= kFlat) {
+        strip.vertices.emplace_back(s, kY, z);
+      } else if (turned <= std::numbers::pi) {
+        strip.vertices.emplace_back(kFlat + kTurn * std::sin(turned),
+                                    kY + kTurn * (1.0 - std::cos(turned)), z);
+      } else {
+        strip.vertices.emplace_back(kFlat - (s - kFlat - std::numbers::pi * kTurn), kY + 2 * kTurn,
+                                    z);
+      }
+    }
+  }
+  const auto at = [&](int i, int k) { return k * kAlong + i; };
+  for (int k = 0; k + 1 < kAcross; ++k) {
+    for (int i = 0; i + 1 < kAlong; ++i) {
+      if ((i + k) % 2 == 0) {
+        strip.triangles.emplace_back(at(i, k), at(i + 1, k), at(i + 1, k + 1));
+        strip.triangles.emplace_back(at(i, k), at(i + 1, k + 1), at(i, k + 1));
+      } else {
+        strip.triangles.emplace_back(at(i, k), at(i + 1, k), at(i, k + 1));
+        strip.triangles.emplace_back(at(i + 1, k), at(i + 1, k + 1), at(i, k + 1));
+      }
+    }
+  }
+  motes::MeshClothOptions options;
+  options.diameter = kDiameter;
+  options.bend_stiffness = 0.01;
+  motes::Result<motes::LinkedSpec> cloth = motes::make_mesh_cloth(strip, options);
+  ASSERT_TRUE(cloth) << cloth.message();
+  cloth->name = "strip";
+  const std::size_t n = cloth->points.size();
+  ASSERT_EQ(n, std::size_t{kAlong * kAcross});
+  // Which particles start on the upper layer (by height), and each one's lower neighbour below.
+  std::vector<std::size_t> upper;
+  for (std::size_t a = 0; a < n; ++a) {
+    if (cloth->points[a].y() > kY + 1.5 * kTurn) upper.push_back(a);
+  }
+  ASSERT_GE(upper.size(), 60u);
+  scene.linked.push_back(*cloth);
+  auto created = motes_test::simulate(scene);
+  ASSERT_TRUE(created) << created.message();
+  motes::Simulation& sim = *created.value();
+  ASSERT_TRUE(sim.step(5000));  // 0.5 s: fallen and settled
+  const auto s = sim.snapshot();
+  ASSERT_TRUE(s);
+  double lowest_upper = 1.0, highest_lower = 0.0;
+  for (std::size_t a = 0; a < n; ++a) {
+    const double y = to_vec3(s->particle_pos[a]).y();
+    if (std::find(upper.begin(), upper.end(), a) != upper.end()) {
+      lowest_upper = std::min(lowest_upper, y);
+    } else if (cloth->points[a].x() < kFlat - 0.02) {  // the lower layer, away from the turn
+      highest_lower = std::max(highest_lower, y);
+    }
+  }
+  std::printf(
+      "[cloth] folded mesh strip: upper layer's lowest particle centre %.4f m, lower layer's "
+      "highest %.4f m (diameter %.3f)\n",
+      lowest_upper, highest_lower, kDiameter);
+  // The upper layer rests on the lower one, about a diameter above it.
+  EXPECT_LT(highest_lower, kY + 0.1 * kDiameter);
+  EXPECT_GT(lowest_upper, highest_lower + 0.7 * kDiameter);
 }
 
 TEST(Cloth, ThinClothStopsASphereOfItsParticleSize) {
