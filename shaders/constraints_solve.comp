@@ -1,8 +1,8 @@
 #version 450
 // constraints_solve: one colour of distance constraints (no two share a particle), one thread per
-// constraint (shared/links.h), and a neighbour-list rebuild asked for when a particle it moved is
-// too far from where the lists were built (one store per workgroup at most); as
-// backends/openmp/constraints_solve.cpp.
+// constraint (shared/links.h), and with MOTES_FLAG_SKIN_CHECK (the last sweep) a neighbour-list
+// rebuild asked for when a particle it moved is too far from where the lists were built (one
+// store per workgroup at most); as backends/openmp/constraints_solve.cpp.
 #extension GL_GOOGLE_include_directive : require
 #include "kernel_common.glsl"
 #include "shared/neighbours.h"
@@ -27,8 +27,9 @@ void main() {
     particle_pos[c.b] = xb;
     particle_vel[c.a] = va;
     particle_vel[c.b] = vb;
-    if (neighbour_moved_too_far(xa, neighbour_ref_pos[c.a], p.neighbour_skin) ||
-        neighbour_moved_too_far(xb, neighbour_ref_pos[c.b], p.neighbour_skin)) {
+    if ((p.flags & MOTES_FLAG_SKIN_CHECK) != 0u &&
+        (neighbour_moved_too_far(xa, neighbour_ref_pos[c.a], p.neighbour_skin) ||
+         neighbour_moved_too_far(xb, neighbour_ref_pos[c.b], p.neighbour_skin))) {
       atomicOr(group_moved, 1u);
     }
   }

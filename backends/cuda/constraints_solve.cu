@@ -1,6 +1,7 @@
 // constraints_solve: one colour of distance constraints (no two share a particle), one thread per
-// constraint (shared/links.h), and a neighbour-list rebuild asked for when a particle it moved is
-// too far from where the lists were built (one store per block at most).
+// constraint (shared/links.h), and with MOTES_FLAG_SKIN_CHECK (the last sweep) a neighbour-list
+// rebuild asked for when a particle it moved is too far from where the lists were built (one
+// store per block at most).
 #include "cuda_device.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
@@ -33,8 +34,9 @@ __global__ void constraints_solve_kernel(shared::StepParams p,
     pos[c.b] = xb;
     vel[c.a] = va;
     vel[c.b] = vb;
-    moved = shared::neighbour_moved_too_far(xa, ref[c.a], p.neighbour_skin) ||
-            shared::neighbour_moved_too_far(xb, ref[c.b], p.neighbour_skin);
+    moved = (p.flags & MOTES_FLAG_SKIN_CHECK) != 0 &&
+            (shared::neighbour_moved_too_far(xa, ref[c.a], p.neighbour_skin) ||
+             shared::neighbour_moved_too_far(xb, ref[c.b], p.neighbour_skin));
   }
   if (__syncthreads_or(moved) != 0 && threadIdx.x == 0) state[MOTES_NEIGHBOUR_REBUILD] = 1;
 }

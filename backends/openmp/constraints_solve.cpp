@@ -24,6 +24,7 @@ void OpenMPDevice::constraints_solve(const shared::StepParams& p) {
   vec4* pos = buf<vec4>(Buffer::ParticlePos);
   vec4* vel = buf<vec4>(Buffer::ParticleVel);
   uint moved = 0;
+  const bool check = (p.flags & MOTES_FLAG_SKIN_CHECK) != 0;
 
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(end - first)) \
     reduction(|                                                                            \
@@ -35,8 +36,8 @@ void OpenMPDevice::constraints_solve(const shared::StepParams& p) {
     const vec3 d = shared::constraint_correction(pos[c.a], pos[c.b], wa, wb, c.rest, c.stiffness);
     shared::constraint_apply(pos[c.a], vel[c.a], d * wa, inv_dt);
     shared::constraint_apply(pos[c.b], vel[c.b], d * -wb, inv_dt);
-    moved |= (shared::neighbour_moved_too_far(pos[c.a], ref[c.a], p.neighbour_skin) ||
-              shared::neighbour_moved_too_far(pos[c.b], ref[c.b], p.neighbour_skin))
+    moved |= (check && (shared::neighbour_moved_too_far(pos[c.a], ref[c.a], p.neighbour_skin) ||
+                        shared::neighbour_moved_too_far(pos[c.b], ref[c.b], p.neighbour_skin)))
                  ? 1u
                  : 0u;
   }

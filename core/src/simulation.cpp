@@ -565,6 +565,8 @@ Status Simulation::step(std::uint64_t count) {
       for (int it = 0; it < settings_.constraint_iterations && colour_first_.size() > 1; ++it) {
         for (std::size_t c = 0; c + 1 < colour_first_.size(); ++c) {
           shared::StepParams colour = params_;
+          // Only the last sweep's positions are the ones the next contacts see.
+          if (it + 1 == settings_.constraint_iterations) colour.flags |= MOTES_FLAG_SKIN_CHECK;
           colour.constraint_first = colour_first_[c];
           colour.constraint_count = colour_first_[c + 1] - colour_first_[c];
           d.constraints_solve(colour);

@@ -56,6 +56,7 @@ struct Measurement {
   std::uint32_t rigid_particles = 0, rigid_bodies = 0;
   std::uint32_t table = 0;
   std::uint64_t constraint_sweeps = 0;  // constraints projected per step (C x iterations)
+  std::uint64_t constraint_checks = 0;  // of them, in the last sweep (with the skin test)
   std::uint64_t impulse_sweeps = 0;     // impulse passes per step ((iterations + 1) x substeps)
   std::uint32_t soft_particles = 0, clusters = 0, cluster_members = 0;
   std::uint64_t steps = 0;         // per timed repeat
@@ -123,6 +124,8 @@ Measurement measure(const motes::Scene& scene, const BenchOptions& o, std::uint6
       m.constraint_sweeps = std::uint64_t{sim->sizes().constraints} *
                             static_cast<std::uint64_t>(sim->settings().constraint_iterations) *
                             static_cast<std::uint64_t>(sim->settings().substeps);
+      m.constraint_checks = std::uint64_t{sim->sizes().constraints} *
+                            static_cast<std::uint64_t>(sim->settings().substeps);
       if (sim->sizes().impulse != 0) {
         m.impulse_sweeps = static_cast<std::uint64_t>(sim->settings().impulse_iterations + 1) *
                            static_cast<std::uint64_t>(sim->settings().substeps);
@@ -180,8 +183,10 @@ double compulsory_bytes(motes::Kernel k, const Measurement& m) {
                                        // write pos, vel
       return (52.0 + 32.0) * m.soft_particles + 52.0 * m.cluster_members + 272.0 * m.clusters;
     case motes::Kernel::ConstraintsSolve:  // per projection: read the constraint, both
-                                           // particles' pos, vel, ref; write their pos, vel
-      return (16.0 + 96.0 + 64.0) * static_cast<double>(m.constraint_sweeps);
+                                           // particles' pos, vel; write their pos, vel; in
+                                           // the last sweep also read their ref
+      return (16.0 + 64.0 + 64.0) * static_cast<double>(m.constraint_sweeps) +
+             32.0 * static_cast<double>(m.constraint_checks);
     case motes::Kernel::ImpulsesCompute:  // per sweep: read own pos, vel, body, material, count,
                                           // the body's 7 vec4 once; write impulse, moment (the
                                           // entries, the neighbours gathered and the contacts'

@@ -24,6 +24,10 @@ MOTES_SHARED_BEGIN
 /// an impulse (shared/body_math.h: particle_absorbed_impulse) into ParticleForce and its moment
 /// into ParticleMoment (cloth and ropes attached to rigid bodies); then the pose as always.
 #define MOTES_FLAG_ABSORB 32u
+/// constraints_solve: also ask for a neighbour-list rebuild when a particle it moved is too far
+/// from where the lists were built. Set on the last sweep of a substep only: the positions of the
+/// earlier sweeps are not the ones contacts see, and the test reads 32 B per projection more.
+#define MOTES_FLAG_SKIN_CHECK 64u
 
 /// Launch parameters of every kernel family; travels with the launch (push constants).
 struct StepParams {

@@ -264,7 +264,7 @@ bool constraints_solve(Particles& particles, const std::vector<Constraint>& cons
     motes::shared::constraint_apply(particles.pos[c.a], particles.vel[c.a], d * wa, inv_dt);
     motes::shared::constraint_apply(particles.pos[c.b], particles.vel[c.b], d * -wb, inv_dt);
     for (const uint i : {c.a, c.b}) {
-      if (!ref.empty()) {
+      if (!ref.empty() && (p.flags & MOTES_FLAG_SKIN_CHECK) != 0) {
         moved =
             motes::shared::neighbour_moved_too_far(particles.pos[i], ref[i], p.neighbour_skin) ||
             moved;

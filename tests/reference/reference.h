@@ -137,7 +137,7 @@ bool particles_integrate(Particles& particles, const std::vector<vec4>& force, c
 /// constraints_solve: constraints [p.constraint_first, + p.constraint_count) projected one after
 /// the other (shared::constraint_correction, constraint_apply); throws std::invalid_argument when
 /// two of them share a particle (the colour would not be parallel). Returns whether a particle it
-/// moved ends too far from `ref` (empty ref: false).
+/// moved ends too far from `ref` (empty ref, or p.flags without MOTES_FLAG_SKIN_CHECK: false).
 bool constraints_solve(Particles& particles, const std::vector<Constraint>& constraints,
                        const StepParams& p, const std::vector<vec4>& ref = {});
 
