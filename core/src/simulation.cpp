@@ -391,6 +391,11 @@ Status Simulation::upload(const Scene& scene) {
             exclusion_list.push_back(next_linked + near.list[e]);
           }
         }
+        if (exclusion_list.size() > std::numeric_limits<std::uint32_t>::max() / 2) {
+          return Status::error(fmt::format(
+              "{}: the cloths made from meshes have more than 2^31 pairs within two links",
+              scene.source));
+        }
         exclusion_start.push_back(static_cast<std::uint32_t>(exclusion_list.size()));
       }
     }
@@ -469,10 +474,9 @@ Status Simulation::upload(const Scene& scene) {
   sizes_.cluster_members = static_cast<std::uint32_t>(soft.members.size());
   std::vector<std::uint32_t> exclusions = std::move(exclusion_start);
   exclusions.insert(exclusions.end(), exclusion_list.begin(), exclusion_list.end());
-  if (exclusions.size() > std::numeric_limits<std::uint32_t>::max() / 2) {
-    return Status::error(fmt::format(
-        "{}: the cloths made from meshes have {} pairs within two links; motes supports 2^31",
-        scene.source, exclusion_list.size()));
+  if (exclusions.size() > std::numeric_limits<std::uint32_t>::max()) {
+    return Status::error(fmt::format("{}: the cloths made from meshes need {} words of lists",
+                                     scene.source, exclusions.size()));
   }
   sizes_.link_exclusions = static_cast<std::uint32_t>(exclusions.size());
   if (Status st = check_memory(); !st) return st;

@@ -26,7 +26,8 @@ using Json = nlohmann::ordered_json;
 constexpr int kCap = 5000;
 
 /// work_dir()/scenes, with cube.obj, open_box.obj and garbage.obj in it and beside it and
-/// assets/bunny.obj beside it: every mesh path of examples/scenes and tests/data/scenes resolves.
+/// assets/bunny.obj and assets/tablecloth.obj beside it: every mesh path of examples/scenes and
+/// tests/data/scenes resolves.
 const std::string& base_dir() {
   static const std::string dir = [] {
     const fs::path work = work_dir();
@@ -40,8 +41,10 @@ const std::string& base_dir() {
         fs::copy_file(from, to / from.filename(), fs::copy_options::overwrite_existing);
       }
     }
-    fs::copy_file(source / "examples/assets/bunny.obj", work / "assets/bunny.obj",
-                  fs::copy_options::overwrite_existing);
+    for (const char* asset : {"bunny.obj", "tablecloth.obj"}) {
+      fs::copy_file(source / "examples/assets" / asset, work / "assets" / asset,
+                    fs::copy_options::overwrite_existing);
+    }
     return (work / "scenes").string();
   }();
   return dir;
@@ -120,6 +123,16 @@ void check_invariants(const Scene& scene) {
     }
     for (std::uint32_t pin : l.pinned) {
       if (pin >= l.points.size()) broken("a pin's index");
+    }
+    for (const LinkAttachment& a : l.attached) {
+      if (a.point >= l.points.size()) broken("an attachment's index");
+    }
+    for (const Eigen::Vector3d& x : l.points) {
+      if (!x.allFinite()) broken("a cloth or rope point is not finite");
+    }
+    // A lattice place per point, or none at all for a cloth made from a mesh.
+    if (l.lattice.empty() ? l.kind != LinkedKind::Cloth : l.lattice.size() != l.points.size()) {
+      broken("a cloth's or rope's lattice");
     }
   }
   for (const PlaneSpec& p : scene.planes) {
