@@ -23,6 +23,7 @@
 
 #include "motes/cloth.h"
 #include "physics/physics_scenes.h"
+#include "unit/test_support.h"
 
 namespace {
 
@@ -276,18 +277,7 @@ TEST(Cloth, MeshClothFoldedOnItselfDoesNotPassThrough) {
       }
     }
   }
-  const auto at = [&](int i, int k) { return k * kAlong + i; };
-  for (int k = 0; k + 1 < kAcross; ++k) {
-    for (int i = 0; i + 1 < kAlong; ++i) {
-      if ((i + k) % 2 == 0) {
-        strip.triangles.emplace_back(at(i, k), at(i + 1, k), at(i + 1, k + 1));
-        strip.triangles.emplace_back(at(i, k), at(i + 1, k + 1), at(i, k + 1));
-      } else {
-        strip.triangles.emplace_back(at(i, k), at(i + 1, k), at(i, k + 1));
-        strip.triangles.emplace_back(at(i + 1, k), at(i + 1, k + 1), at(i, k + 1));
-      }
-    }
-  }
+  motes_test::add_grid_triangles(strip, kAlong, kAcross);
   motes::MeshClothOptions options;
   options.diameter = kDiameter;
   options.bend_stiffness = 0.01;

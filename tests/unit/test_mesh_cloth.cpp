@@ -35,18 +35,7 @@ TriangleMesh grid_mesh(int nx, int nz, double h, double y = 0.0) {
   for (int k = 0; k <= nz; ++k) {
     for (int i = 0; i <= nx; ++i) m.vertices.emplace_back(i * h, y, k * h);
   }
-  const auto at = [&](int i, int k) { return k * (nx + 1) + i; };
-  for (int k = 0; k < nz; ++k) {
-    for (int i = 0; i < nx; ++i) {
-      if ((i + k) % 2 == 0) {
-        m.triangles.emplace_back(at(i, k), at(i + 1, k), at(i + 1, k + 1));
-        m.triangles.emplace_back(at(i, k), at(i + 1, k + 1), at(i, k + 1));
-      } else {
-        m.triangles.emplace_back(at(i, k), at(i + 1, k), at(i, k + 1));
-        m.triangles.emplace_back(at(i + 1, k), at(i + 1, k + 1), at(i, k + 1));
-      }
-    }
-  }
+  motes_test::add_grid_triangles(m, nx + 1, nz + 1);
   return m;
 }
 
@@ -177,15 +166,7 @@ TEST(MeshCloth, NeverTouchingPairsAreExactlyThoseWithinTwoLinks) {
 
 std::unique_ptr<Simulation> simulate(const std::string& text, const std::string& dir,
                                      const std::string& backend) {
-  Result<Scene> scene = load_scene_text(text, "cloth.json", dir);
-  EXPECT_TRUE(scene) << scene.message();
-  if (!scene) return nullptr;
-  auto device = open_device(backend);
-  EXPECT_TRUE(device) << device.message();
-  if (!device) return nullptr;
-  auto sim = Simulation::create(*scene, std::move(device.value()));
-  EXPECT_TRUE(sim) << sim.message();
-  return sim ? std::move(sim).value() : nullptr;
+  return motes_test::simulate_text(text, "cloth.json", dir, backend);
 }
 
 std::string cloth_scene(const std::string& cloth, double diameter, double gravity = 0.0) {
@@ -249,12 +230,6 @@ TEST(MeshCloth, SceneErrorsNameTheFieldAndTheReason) {
             std::string::npos);
 }
 
-std::vector<std::string> backends() {
-  std::vector<std::string> out = {"openmp"};
-  if (open_device("vulkan")) out.emplace_back("vulkan");
-  return out;
-}
-
 TEST(MeshCloth, LinkedNeighboursOverlapWithoutPushing) {
   // Without gravity, a grid cloth whose particles are 1.9 edges wide: each overlaps its
   // neighbours within two links by up to 0.9 edge. Those pairs never touch, so nothing moves
@@ -262,7 +237,7 @@ TEST(MeshCloth, LinkedNeighboursOverlapWithoutPushing) {
   TempDir dir;
   const double h = 0.01, d = 1.9 * h;
   write_file(dir / "grid.obj", obj_text(grid_mesh(10, 10, h)));
-  for (const std::string& backend : backends()) {
+  for (const std::string& backend : motes_test::cpu_backends()) {
     SCOPED_TRACE(backend);
     auto sim = simulate(cloth_scene(R"({"mesh": "grid.obj"})", d), dir.path().string(), backend);
     ASSERT_TRUE(sim);
@@ -297,7 +272,7 @@ TEST(MeshCloth, PartsFarApartInLinksCollide) {
     two.triangles.push_back(t + Eigen::Vector3i::Constant(base));
   }
   write_file(dir / "two.obj", obj_text(two));
-  for (const std::string& backend : backends()) {
+  for (const std::string& backend : motes_test::cpu_backends()) {
     SCOPED_TRACE(backend);
     auto sim = simulate(cloth_scene(R"({"mesh": "two.obj"})", d), dir.path().string(), backend);
     ASSERT_TRUE(sim);

@@ -40,24 +40,8 @@ std::string balls(double fast_speed, double gravity = 0.0, double dt = 1e-4) {
       dt, -gravity, fast_speed);
 }
 
-/// OpenMP, and Vulkan where it is built (CI: lavapipe); CUDA has its own test, which says when it
-/// is skipped.
-std::vector<std::string> backends() {
-  std::vector<std::string> out = {"openmp"};
-  if (open_device("vulkan")) out.emplace_back("vulkan");
-  return out;
-}
-
 std::unique_ptr<Simulation> simulation(const std::string& text, const std::string& backend) {
-  Result<Scene> scene = load_scene_text(text, "balls", "");
-  EXPECT_TRUE(scene) << scene.message();
-  if (!scene) return nullptr;
-  auto device = open_device(backend);
-  EXPECT_TRUE(device) << device.message();
-  if (!device) return nullptr;
-  auto sim = Simulation::create(*scene, std::move(device.value()));
-  EXPECT_TRUE(sim) << sim.message();
-  return sim ? std::move(sim.value()) : nullptr;
+  return motes_test::simulate_text(text, "balls", "", backend);
 }
 
 void names_the_fastest_warns_and_stops(const std::string& backend) {
@@ -127,11 +111,12 @@ void non_finite_is_an_error(const std::string& backend) {
 }
 
 TEST(MotionGuard, NamesTheFastestParticleWarnsAndStops) {
-  for (const std::string& backend : backends()) names_the_fastest_warns_and_stops(backend);
+  for (const std::string& backend : motes_test::cpu_backends())
+    names_the_fastest_warns_and_stops(backend);
 }
 
 TEST(MotionGuard, NonFiniteStateIsAnErrorNamingTheParticle) {
-  for (const std::string& backend : backends()) non_finite_is_an_error(backend);
+  for (const std::string& backend : motes_test::cpu_backends()) non_finite_is_an_error(backend);
 }
 
 TEST(MotionGuard, CudaNamesTheFastestAndStopsOnNaN) {

@@ -1,4 +1,5 @@
-// Helpers shared by the unit tests: temporary directories and a closed box mesh.
+// Helpers shared by the unit tests: temporary directories, a closed box mesh, grid triangles, and
+// simulations of scene text on the backends CI has.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -6,10 +7,16 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <system_error>
+#include <utility>
+#include <vector>
 
+#include "motes/devices.h"
+#include "motes/scene.h"
 #include "motes/shapes.h"
+#include "motes/simulation.h"
 
 namespace motes_test {
 
@@ -58,6 +65,48 @@ inline motes::TriangleMesh box_mesh(const Eigen::Vector3d& size, const Eigen::Ma
     mesh.triangles.emplace_back(q[0], q[2], q[3]);
   }
   return mesh;
+}
+
+/// Adds the triangles of an along x across grid of vertices (vertex (i, k) is k * along + i) to
+/// `m`, each square cut along alternating diagonals.
+inline void add_grid_triangles(motes::TriangleMesh& m, int along, int across) {
+  const auto at = [&](int i, int k) { return k * along + i; };
+  for (int k = 0; k + 1 < across; ++k) {
+    for (int i = 0; i + 1 < along; ++i) {
+      if ((i + k) % 2 == 0) {
+        m.triangles.emplace_back(at(i, k), at(i + 1, k), at(i + 1, k + 1));
+        m.triangles.emplace_back(at(i, k), at(i + 1, k + 1), at(i, k + 1));
+      } else {
+        m.triangles.emplace_back(at(i, k), at(i + 1, k), at(i, k + 1));
+        m.triangles.emplace_back(at(i + 1, k), at(i + 1, k + 1), at(i, k + 1));
+      }
+    }
+  }
+}
+
+/// OpenMP, and Vulkan where it is built (CI: lavapipe); CUDA has tests of its own, which say when
+/// they are skipped.
+inline std::vector<std::string> cpu_backends() {
+  std::vector<std::string> out = {"openmp"};
+  if (motes::open_device("vulkan")) out.emplace_back("vulkan");
+  return out;
+}
+
+/// A simulation of scene `text` (named `source`, meshes relative to `base_dir`) on `backend`;
+/// null, with a failure recorded, when the scene, the device or the simulation cannot be made.
+inline std::unique_ptr<motes::Simulation> simulate_text(const std::string& text,
+                                                        const std::string& source,
+                                                        const std::string& base_dir,
+                                                        const std::string& backend) {
+  motes::Result<motes::Scene> scene = motes::load_scene_text(text, source, base_dir);
+  EXPECT_TRUE(scene) << scene.message();
+  if (!scene) return nullptr;
+  auto device = motes::open_device(backend);
+  EXPECT_TRUE(device) << device.message();
+  if (!device) return nullptr;
+  auto sim = motes::Simulation::create(*scene, std::move(device.value()));
+  EXPECT_TRUE(sim) << sim.message();
+  return sim ? std::move(sim.value()) : nullptr;
 }
 
 }  // namespace motes_test
