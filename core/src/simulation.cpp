@@ -78,6 +78,12 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene,
   return sim;
 }
 
+std::unique_ptr<Device> Simulation::take_device(std::unique_ptr<Simulation> sim) {
+  if (!sim) return nullptr;
+  (void)sim->device_->synchronize();
+  return std::move(sim->device_);
+}
+
 Status Simulation::upload(const Scene& scene) {
   settings_ = scene.settings;
   if (!(settings_.dt > 0.0) || !std::isfinite(settings_.dt) || settings_.substeps < 1) {
@@ -706,7 +712,23 @@ Result<Snapshot> Simulation::snapshot() {
   return s;
 }
 
-Status Simulation::restore(const Snapshot& state) {
+Status Simulation::write_state(const Snapshot& state) {
+  const std::size_t n = sizes_.particles;
+  const std::size_t nb = bodies_.size();
+  if (state.particle_pos.size() != n || state.particle_vel.size() != n ||
+      state.body_pos.size() != nb || state.body_quat.size() != nb || state.body_vel.size() != nb ||
+      state.body_angmom.size() != nb || state.body_angvel.size() != nb) {
+    return Status::error(fmt::format(
+        "write_state: a state of {} particles and {} bodies for a simulation of {} and {}",
+        state.particle_pos.size(), state.body_pos.size(), n, nb));
+  }
+  if (Status s = restore(state, false); !s) return s;
+  steps_ = state.step;
+  time_ = static_cast<double>(steps_) * settings_.dt;
+  return Status::ok();
+}
+
+Status Simulation::restore(const Snapshot& state, bool rebuild) {
   Device& d = *device_;
   const std::size_t n = sizes_.particles;
   const std::size_t nb = sizes_.bodies;
@@ -735,8 +757,8 @@ Status Simulation::restore(const Snapshot& state) {
   if (s) s = write_vector(d, Buffer::BodyVel, bvel);
   if (s) s = write_vector(d, Buffer::BodyAngMom, bangmom);
   if (s) s = write_vector(d, Buffer::BodyAngVel, bangvel);
-  if (s) s = d.write(Buffer::NeighbourState, neighbour_state, sizeof neighbour_state);
-  if (s) s = clear_contact_history();
+  if (s && rebuild) s = d.write(Buffer::NeighbourState, neighbour_state, sizeof neighbour_state);
+  if (s && rebuild) s = clear_contact_history();
   if (s && state.cluster_rotation.size() == sizes_.clusters && sizes_.clusters > 0) {
     std::vector<shared::ClusterFrame> frames;
     s = read_vector(d, Buffer::ClusterFrames, frames, sizes_.clusters);

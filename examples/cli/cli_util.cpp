@@ -1,5 +1,6 @@
 // Helpers shared by the subcommands.
 #include "cli_util.h"
+#include "run_mpi.h"
 
 #include <fmt/format.h>
 
@@ -13,7 +14,8 @@
 namespace motes::cli {
 
 void fail(const std::string& message) {
-  fmt::print(stderr, "motes: error: {}\n", message);
+  // Over MPI every rank fails together with the same message (mpi_agree_or_fail): rank 0 says it.
+  if (mpi_rank() == 0) fmt::print(stderr, "motes: error: {}\n", message);
   // CLI::App::exit() returns a RuntimeError's code without printing anything more.
   throw CLI::RuntimeError(kErrorExit);
 }

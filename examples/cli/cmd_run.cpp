@@ -13,11 +13,13 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "motes/checkpoint.h"
+#include "motes/decomposition.h"
 #include "motes/devices.h"
 #include "motes/output.h"
 #include "motes/scene.h"
 #include "motes/simulation.h"
 #include "render_args.h"
+#include "run_mpi.h"
 #include "run_session.h"
 
 namespace motes::cli {
@@ -39,6 +41,7 @@ struct RunArgs {
   std::string render_dir;
   std::uint64_t checkpoint_every = 0;
   std::string checkpoint_dir;
+  std::string decomposition;
   RenderArgs render;
   CLI::Option* steps_option = nullptr;
   CLI::Option* duration_option = nullptr;
@@ -66,12 +69,12 @@ std::uint64_t output_every(const RunArgs& a, const Settings& s) {
 void run(const RunArgs& args) {
   const Clock::time_point start = Clock::now();
   Result<Scene> scene = args.scene.empty() ? builtin_default_scene() : load_scene_file(args.scene);
-  if (!scene) fail(scene.message());
+  mpi_agree_or_fail(scene ? Status::ok() : scene.status());
   // Mesh shapes filled by their winding number (open or non-manifold meshes) carry a warning;
   // bodies that share a mesh share it, so each is printed once.
   std::set<std::string> warned;
   for (const BodySpec& body : scene->bodies) {
-    if (!body.shape) continue;
+    if (!body.shape || mpi_rank() != 0) continue;
     for (const std::string& warning : body.shape->warnings) {
       if (warned.insert(warning).second) fmt::print(stderr, "motes: warning: {}\n", warning);
     }
@@ -85,6 +88,34 @@ void run(const RunArgs& args) {
   plan.total = total_steps(args, scene->settings);
   plan.every = output_every(args, scene->settings);
   plan.checkpoint_every = args.checkpoint_every;
+
+  if (mpi_ranks() > 1 || !args.decomposition.empty()) {
+    // Over MPI ranks (docs/scale-out.md): what a distributed run cannot do yet is refused.
+    if (mpi_ranks() == 1) fail("--decomposition needs several MPI ranks: mpirun -np N motes run");
+    if (args.checkpoint_every > 0 || !args.checkpoint_dir.empty() || !args.render_dir.empty()) {
+      fail(
+          "--checkpoint-every, --checkpoint-dir and --render do not run over several MPI ranks "
+          "yet (docs/scale-out.md): render the frames afterwards with motes render");
+    }
+    DistributedRun d;
+    if (!args.decomposition.empty()) {
+      Result<std::array<int, 3>> cells = parse_decomposition(args.decomposition);
+      if (!cells) fail(cells.message());
+      d.decomposition = cells.value();
+    }
+    d.scene = std::move(scene).value();
+    d.scene_name = plan.scene_name;
+    d.backend = args.backend;
+    d.device = args.device;
+    d.threads = args.threads;
+    d.total = plan.total;
+    d.every = plan.every;
+    d.format = format.value();
+    d.out = args.out;
+    d.setup_seconds = seconds_since(start);
+    run_distributed(std::move(d));
+    return;
+  }
 
   // What each checkpoint records, so that `motes resume` can go on with the same series.
   CheckpointRun& record = plan.record;
@@ -191,6 +222,9 @@ void add_run_command(CLI::App& app) {
                   "write a checkpoint every K steps (the last two kept; motes resume goes on "
                   "from one)")
       ->check(whole_number(1));
+  sub->add_option("--decomposition", args->decomposition,
+                  "under mpirun: bricks along x, y, z as X,Y,Z (their product = the rank count; "
+                  "default: the least cut area; docs/scale-out.md)");
   sub->add_option("--checkpoint-dir", args->checkpoint_dir,
                   "directory of the checkpoints (default: OUT/checkpoints)");
   sub->callback([args] { run(*args); });

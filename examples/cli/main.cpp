@@ -9,8 +9,11 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "run_mpi.h"
 
 int main(int argc, char** argv) {
+  // Under mpirun: MPI from here to the end of main (docs/scale-out.md).
+  motes::cli::MpiSession mpi(argc, argv);
   CLI::App app("motes: rigid bodies made of particles, on OpenMP, CUDA and Vulkan", "motes");
   app.set_version_flag("--version", std::string("motes ") + MOTES_VERSION);
   app.require_subcommand(1);

@@ -87,6 +87,11 @@ class Simulation {
   static Result<std::unique_ptr<Simulation>> create(const Scene& scene,
                                                     std::unique_ptr<Device> device);
 
+  /// Ends a simulation and hands its device back, to be given to the next Simulation::create
+  /// (which allocates anew): a new scene on the same device without opening it again (CUDA
+  /// context and kernels, Vulkan device and pipelines).
+  static std::unique_ptr<Device> take_device(std::unique_ptr<Simulation> sim);
+
   /// Advances `count` steps of settings.dt (each settings.substeps substeps).
   Status step(std::uint64_t count = 1);
 
@@ -134,6 +139,14 @@ class Simulation {
   /// untouched. Version 1 files (bodies and particles only) are still read; the neighbour lists
   /// are then rebuilt at the next step.
   Status load_state(const std::string& path);
+  /// Writes a state in the scene's order (as snapshot() gives it: particles' positions and
+  /// velocities, rigid bodies' poses and momenta, the soft bodies' fits when their count matches)
+  /// as the start of the next step, and sets the step count and time to the state's. The
+  /// neighbour lists are kept: they are rebuilt, as in any step, once a particle has moved past
+  /// the skin from where the last build saw it. Wrong sizes are an error and change nothing.
+  /// With it an owner writes the halo copies of its bodies into a neighbour rank's simulation
+  /// (motes/distributed.h).
+  Status write_state(const Snapshot& state);
   /// Fingerprint (FNV-1a 64) of everything fixed when the simulation was created: sizes, step
   /// parameters, materials, planes, body frames, constraints, clusters, particle radii and
   /// masses. Equal on every backend; a checkpoint loads only where it is equal.
@@ -170,9 +183,9 @@ class Simulation {
   /// Impulse contacts: every contact's accumulated impulse to zero and its list slots void (a
   /// new state has no contact history to warm-start from).
   Status clear_contact_history();
-  /// Writes a scene-ordered state (a snapshot or a checkpoint's) to the device and asks for a
-  /// neighbour-list rebuild.
-  Status restore(const Snapshot& state);
+  /// Writes a scene-ordered state (a snapshot or a checkpoint's) to the device and, with
+  /// `rebuild`, asks for a neighbour-list rebuild and clears the impulse contacts' history.
+  Status restore(const Snapshot& state, bool rebuild = true);
   /// The scene body and scene particle index of device particle i.
   [[nodiscard]] std::pair<std::uint32_t, std::uint32_t> locate_particle(std::uint32_t i) const;
   /// load_state for a version 1 file (bytes: the whole file).

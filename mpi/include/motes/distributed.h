@@ -1,0 +1,141 @@
+// motes::DistributedSimulation: one scene over several MPI ranks, one device per rank
+// (docs/scale-out.md). Each rank owns the bodies whose centre lies in its brick of the
+// decomposition (motes/decomposition.h) and holds halo copies of the bodies near what it owns;
+// it steps an ordinary Simulation of those on its own device, on any backend.
+#pragma once
+
+#include <mpi.h>
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "motes/backend/device.h"
+#include "motes/decomposition.h"
+#include "motes/scene.h"
+#include "motes/simulation.h"
+#include "motes/status.h"
+
+namespace motes {
+
+/// Opens the device of this rank, once: every partition's simulation runs on it
+/// (Simulation::take_device). A rank that holds no body has none until it gets one.
+using DeviceOpener = std::function<Result<std::unique_ptr<Device>>()>;
+
+/// Collective: every rank learns whether any rank's `mine` is an error; all then return the
+/// lowest failing rank's message, prefixed "rank R: " unless every rank failed.
+/// With `largest`, also the largest of every rank's *largest, in the same reduction.
+Status agree(MPI_Comm comm, const Status& mine, double* largest = nullptr);
+
+struct DistributedOptions {
+  /// Bricks along x, y, z (their product = the rank count); none: choose_decomposition.
+  std::optional<std::array<int, 3>> decomposition;
+  /// How far (m) a particle may move before bodies are re-partitioned (migration) and the halos
+  /// chosen again; < 0: half the largest particle diameter. The halo holds every body with a
+  /// particle within the largest diameter + 2 margins of what a rank owns, so no contact is missed
+  /// in between.
+  double margin = -1.0;
+};
+
+/// What the ranks did (the same on every rank after a collective call).
+struct DistributedStats {
+  std::uint64_t partitions = 0;    ///< partitions so far (the first at create)
+  std::uint64_t migrations = 0;    ///< bodies that changed rank, over all partitions
+  std::uint64_t owned_bodies = 0;  ///< this rank's bodies now
+  std::uint64_t halo_bodies = 0;   ///< this rank's halo copies now
+  std::uint64_t owned_particles = 0;
+  std::uint64_t halo_particles = 0;
+  std::uint64_t halo_bytes = 0;  ///< bytes this rank sent in halo updates since create
+  /// This rank's seconds since create: its own steps, halo updates' own work (state from and to the
+  /// device, packing), their MPI calls (the transfer and the wait for slower ranks), partitions
+  /// (all).
+  double step_seconds = 0.0;  ///< this rank's own steps
+  double copy_seconds = 0.0;
+  double mpi_seconds = 0.0;
+  double partition_seconds = 0.0;
+};
+
+class DistributedSimulation {
+ public:
+  /// Collective over `comm`: every rank passes the same scene. Refuses, on every rank with the
+  /// same message, what it cannot split yet: impulse contacts, cloth or ropes attached to bodies,
+  /// soft bodies.
+  static Result<std::unique_ptr<DistributedSimulation>> create(const Scene& scene, MPI_Comm comm,
+                                                               DeviceOpener open_device,
+                                                               const DistributedOptions& options);
+
+  /// Collective: `count` steps; the halo copies are brought up to date after every step.
+  Status step(std::uint64_t count = 1);
+  /// Collective: the whole state in the scene's order (as Simulation::snapshot) on rank `root`;
+  /// the other ranks get an empty Snapshot (time and step set).
+  Result<Snapshot> gather(int root = 0);
+  /// Collective: this rank's stats, with partitions and migrations as everywhere.
+  [[nodiscard]] DistributedStats stats() const { return stats_; }
+
+  [[nodiscard]] int rank() const { return rank_; }
+  [[nodiscard]] int size() const { return size_; }
+  [[nodiscard]] const Decomposition& decomposition() const { return decomposition_; }
+  [[nodiscard]] std::uint64_t steps() const { return steps_; }
+  [[nodiscard]] double time() const { return static_cast<double>(steps_) * scene_.settings.dt; }
+  [[nodiscard]] const Settings& settings() const { return scene_.settings; }
+  /// Every scene body's facts in the scene's order (particle ranges as in a gathered Snapshot).
+  [[nodiscard]] const std::vector<BodyInfo>& bodies() const { return bodies_; }
+  [[nodiscard]] std::uint64_t particle_count() const { return particles_; }
+  /// Scene bodies this rank owns now, ascending.
+  [[nodiscard]] std::vector<std::uint32_t> owned() const;
+  /// This rank's simulation (owned bodies and halo copies, in scene order).
+  [[nodiscard]] Simulation& local() { return *local_; }
+  /// The device this rank runs on.
+  [[nodiscard]] const DeviceInfo& device_info() const { return device_info_; }
+
+  /// A body's state as ranks exchange it: its body vectors, then its particles' positions and
+  /// velocities (Snapshot layouts).
+  struct Record {
+    std::uint32_t body = 0;               ///< scene body index
+    std::array<shared::vec4, 5> state{};  ///< position, orientation, velocity, L, omega
+    std::vector<shared::vec4> pos, vel;
+  };
+
+ private:
+  DistributedSimulation() = default;
+  /// Sends owned records to their new owners, chooses the halos and builds the local
+  /// simulation from `owned` (the records this rank holds, any owner).
+  Status partition(std::vector<Record> owned);
+  /// Brings every halo copy up to date from its owner; returns the largest distance (on every
+  /// rank) an owned particle has moved since the partition, or the first error of any rank
+  /// (`stepped`: this rank's step).
+  Result<double> exchange_halos(Status stepped);
+  /// This rank's records of its owned bodies, from the local simulation.
+  Result<std::vector<Record>> owned_records();
+
+  Scene scene_;
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  int rank_ = 0;
+  int size_ = 1;
+  DeviceOpener open_device_;
+  Decomposition decomposition_;
+  double margin_ = 0.0;
+  double halo_width_ = 0.0;
+  std::vector<BodyInfo> bodies_;
+  std::uint64_t particles_ = 0;
+  std::uint64_t steps_ = 0;
+
+  std::unique_ptr<Simulation> local_;
+  std::unique_ptr<Device> spare_;  ///< this rank's device while it holds no body
+  DeviceInfo device_info_;
+  /// Scene bodies in the local simulation (ascending) and whether this rank owns each.
+  std::vector<std::uint32_t> local_bodies_;
+  std::vector<char> local_owned_;
+  /// Halo sends: for each rank, the local indices of owned bodies it holds copies of (ascending
+  /// scene order); halo receives: for each rank, the local indices of its copies here.
+  std::vector<std::vector<std::uint32_t>> send_;
+  std::vector<std::vector<std::uint32_t>> receive_;
+  /// Owned particles' positions at the partition (local particle order, owned bodies only).
+  std::vector<shared::vec4> reference_;
+  DistributedStats stats_;
+};
+
+}  // namespace motes

@@ -1,0 +1,623 @@
+// motes::DistributedSimulation (motes/distributed.h, docs/scale-out.md): ownership by brick,
+// whole-body records sent to new owners at each partition, halo copies refreshed after every step.
+#include "motes/distributed.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace motes {
+
+using shared::vec4;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// One vec4 on the wire.
+MPI_Datatype vec4_type() {
+  static MPI_Datatype type = [] {
+    MPI_Datatype t;
+    MPI_Type_contiguous(4, MPI_FLOAT, &t);
+    MPI_Type_commit(&t);
+    return t;
+  }();
+  return type;
+}
+
+/// Sends out[r] to rank r and returns what every rank sent here, in rank order, with the
+/// counts per source rank (collective).
+Result<std::vector<vec4>> all_to_all(MPI_Comm comm, const std::vector<std::vector<vec4>>& out,
+                                     std::vector<int>& received) {
+  const int size = static_cast<int>(out.size());
+  std::vector<int> sent(out.size()), sent_at(out.size()), received_at(out.size());
+  received.assign(out.size(), 0);
+  bool too_big = false;
+  std::size_t total = 0;
+  for (std::size_t r = 0; r < out.size(); ++r) {
+    too_big = too_big || out[r].size() > static_cast<std::size_t>(std::numeric_limits<int>::max());
+    sent[r] = static_cast<int>(out[r].size());
+    total += out[r].size();
+  }
+  too_big = too_big || total > static_cast<std::size_t>(std::numeric_limits<int>::max());
+  if (too_big) {
+    // Nothing is sent; the caller's agree() reports it on every rank.
+    for (int& c : sent) c = 0;
+  }
+  std::vector<vec4> packed;
+  packed.reserve(total);
+  for (std::size_t r = 0; r < out.size(); ++r) {
+    sent_at[r] = static_cast<int>(packed.size());
+    packed.insert(packed.end(), out[r].begin(), out[r].end());
+  }
+  MPI_Alltoall(sent.data(), 1, MPI_INT, received.data(), 1, MPI_INT, comm);
+  std::size_t incoming = 0;
+  for (int r = 0; r < size; ++r) {
+    received_at[static_cast<std::size_t>(r)] = static_cast<int>(incoming);
+    incoming += static_cast<std::size_t>(received[static_cast<std::size_t>(r)]);
+  }
+  std::vector<vec4> in(incoming);
+  MPI_Alltoallv(packed.data(), sent.data(), sent_at.data(), vec4_type(), in.data(), received.data(),
+                received_at.data(), vec4_type(), comm);
+  if (too_big) return Status::error("more than 2^31 vec4s to send in one exchange");
+  return in;
+}
+
+using Record = DistributedSimulation::Record;
+
+template <typename T>
+Status status_of(const Result<T>& r) {
+  return r ? Status::ok() : r.status();
+}
+
+void append(std::vector<vec4>& out, const Record& r) {
+  out.push_back(vec4(std::bit_cast<float>(r.body),
+                     std::bit_cast<float>(static_cast<std::uint32_t>(r.pos.size())), 0.0f, 0.0f));
+  out.insert(out.end(), r.state.begin(), r.state.end());
+  out.insert(out.end(), r.pos.begin(), r.pos.end());
+  out.insert(out.end(), r.vel.begin(), r.vel.end());
+}
+
+std::vector<Record> parse(const std::vector<vec4>& in) {
+  std::vector<Record> records;
+  for (std::size_t at = 0; at < in.size();) {
+    Record r;
+    r.body = std::bit_cast<std::uint32_t>(in[at].x);
+    const std::size_t n = std::bit_cast<std::uint32_t>(in[at].y);
+    std::copy_n(in.begin() + static_cast<std::ptrdiff_t>(at + 1), 5, r.state.begin());
+    const auto first = in.begin() + static_cast<std::ptrdiff_t>(at + 6);
+    r.pos.assign(first, first + static_cast<std::ptrdiff_t>(n));
+    r.vel.assign(first + static_cast<std::ptrdiff_t>(n),
+                 first + static_cast<std::ptrdiff_t>(2 * n));
+    at += 6 + 2 * n;
+    records.push_back(std::move(r));
+  }
+  return records;
+}
+
+Eigen::Vector3d centre_of(const vec4& v) {
+  return {static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z)};
+}
+
+/// Lower and upper corners of a record's particles, each grown by its radius.
+std::array<double, 6> record_box(const Record& r) {
+  std::array<double, 6> box{};
+  for (int a = 0; a < 3; ++a) {
+    box[static_cast<std::size_t>(a)] = std::numeric_limits<double>::infinity();
+    box[static_cast<std::size_t>(a + 3)] = -std::numeric_limits<double>::infinity();
+  }
+  for (const vec4& p : r.pos) {
+    const Eigen::Vector3d c = centre_of(p);
+    const double radius = static_cast<double>(p.w);
+    for (int a = 0; a < 3; ++a) {
+      box[static_cast<std::size_t>(a)] = std::min(box[static_cast<std::size_t>(a)], c[a] - radius);
+      box[static_cast<std::size_t>(a + 3)] =
+          std::max(box[static_cast<std::size_t>(a + 3)], c[a] + radius);
+    }
+  }
+  return box;
+}
+
+bool overlap(const std::array<double, 6>& a, const double* b) {
+  for (int k = 0; k < 3; ++k) {
+    if (a[static_cast<std::size_t>(k)] > b[k + 3] || b[k] > a[static_cast<std::size_t>(k + 3)]) {
+      return false;
+    }
+  }
+  return true;
+}
+
+/// The scene with only `bodies` (ascending scene body indices; cloths and ropes after the
+/// scene's bodies).
+Scene sub_scene(const Scene& scene, const std::vector<std::uint32_t>& bodies) {
+  Scene sub;
+  sub.source = scene.source;
+  sub.settings = scene.settings;
+  sub.materials = scene.materials;
+  sub.planes = scene.planes;
+  sub.camera = scene.camera;
+  const std::size_t rigid = scene.bodies.size();
+  for (std::uint32_t b : bodies) {
+    if (b < rigid) {
+      sub.bodies.push_back(scene.bodies[b]);
+    } else {
+      sub.linked.push_back(scene.linked[b - rigid]);
+    }
+  }
+  return sub;
+}
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+Status agree(MPI_Comm comm, const Status& mine, double* largest) {
+  int rank = 0;
+  int size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  // One reduction: the largest of `largest`, and size - (lowest failing rank) (0: none failed).
+  double in[2] = {largest != nullptr ? *largest : 0.0,
+                  mine ? 0.0 : static_cast<double>(size - rank)};
+  double out[2] = {0.0, 0.0};
+  MPI_Allreduce(in, out, 2, MPI_DOUBLE, MPI_MAX, comm);
+  if (largest != nullptr) *largest = out[0];
+  if (out[1] == 0.0) return Status::ok();
+  const int first = size - static_cast<int>(out[1]);
+  // A failure every rank shares (a scene it cannot split, a wrong decomposition) needs no rank.
+  int failures = mine ? 0 : 1;
+  int total = 0;
+  MPI_Allreduce(&failures, &total, 1, MPI_INT, MPI_SUM, comm);
+  std::string text = rank == first ? mine.message() : std::string();
+  int length = static_cast<int>(text.size());
+  MPI_Bcast(&length, 1, MPI_INT, first, comm);
+  text.resize(static_cast<std::size_t>(length));
+  MPI_Bcast(text.data(), length, MPI_CHAR, first, comm);
+  return Status::error(total < size ? fmt::format("rank {}: {}", first, text) : text);
+}
+
+Result<std::unique_ptr<DistributedSimulation>> DistributedSimulation::create(
+    const Scene& scene, MPI_Comm comm, DeviceOpener open_device,
+    const DistributedOptions& options) {
+  std::unique_ptr<DistributedSimulation> d(new DistributedSimulation());
+  d->comm_ = comm;
+  MPI_Comm_rank(comm, &d->rank_);
+  MPI_Comm_size(comm, &d->size_);
+  d->open_device_ = std::move(open_device);
+  d->scene_ = scene;
+
+  // What a partition cannot split yet is refused the same way on every rank.
+  Status supported = Status::ok();
+  if (scene.settings.contact_model == ContactModel::Impulses) {
+    supported = Status::error(scene.source +
+                              ": impulse contacts do not run over several MPI ranks yet "
+                              "(docs/scale-out.md); run this scene on one rank");
+  }
+  for (const BodySpec& b : scene.bodies) {
+    if (supported && b.soft) {
+      supported = Status::error(
+          fmt::format("{}: body '{}' is soft: soft bodies do not run over several MPI ranks yet "
+                      "(docs/scale-out.md); run this scene on one rank",
+                      scene.source, b.name));
+    }
+  }
+  for (const LinkedSpec& l : scene.linked) {
+    if (supported && !l.attached.empty()) {
+      supported = Status::error(fmt::format(
+          "{}: '{}' is attached to a body: attachments do not run over several MPI ranks yet "
+          "(docs/scale-out.md); run this scene on one rank",
+          scene.source, l.name));
+    }
+  }
+  const std::vector<Eigen::Vector3d> centres = body_centres(scene);
+  Result<Decomposition> decomposition =
+      supported ? choose_decomposition(centres, d->size_, options.decomposition)
+                : Result<Decomposition>(supported);
+  if (Status s = agree(comm, status_of(decomposition)); !s) return s;
+  d->decomposition_ = decomposition.value();
+
+  // The scene's bodies as a gathered Snapshot lays them out.
+  double diameter = 0.0;
+  std::uint32_t first = 0;
+  for (const BodySpec& b : scene.bodies) {
+    BodyInfo info;
+    info.name = b.name;
+    info.kind = b.kind;
+    info.first_particle = first;
+    info.particle_count = static_cast<std::uint32_t>(b.shape ? b.shape->points.size() : 0);
+    first += info.particle_count;
+    if (b.shape) diameter = std::max(diameter, b.shape->diameter);
+    d->bodies_.push_back(info);
+  }
+  for (const LinkedSpec& l : scene.linked) {
+    BodyInfo info;
+    info.name = l.name;
+    info.linked = true;
+    info.first_particle = first;
+    info.particle_count = static_cast<std::uint32_t>(l.points.size());
+    first += info.particle_count;
+    diameter = std::max(diameter, l.diameter);
+    d->bodies_.push_back(info);
+  }
+  d->particles_ = first;
+  d->margin_ = options.margin >= 0.0 ? options.margin : 0.5 * diameter;
+  d->halo_width_ = 2.0 * d->margin_;
+
+  // Each rank builds the bodies whose centre starts in its brick; the first partition then sends
+  // any whose centre of mass lies elsewhere to its owner and chooses the halos.
+  std::vector<std::uint32_t> mine;
+  for (std::uint32_t b = 0; b < centres.size(); ++b) {
+    if (d->decomposition_.owner(centres[b]) == d->rank_) mine.push_back(b);
+  }
+  Status built = Status::ok();
+  if (!mine.empty()) {
+    Result<std::unique_ptr<Device>> device = d->open_device_();
+    Result<std::unique_ptr<Simulation>> start =
+        device ? Simulation::create(sub_scene(scene, mine), std::move(device).value())
+               : Result<std::unique_ptr<Simulation>>(status_of(device));
+    if (start) {
+      d->local_ = std::move(start).value();
+      d->local_bodies_ = mine;
+      d->local_owned_.assign(mine.size(), 1);
+    } else {
+      built = start.status();
+    }
+  }
+  if (Status s = agree(comm, built); !s) return s;
+  Result<std::vector<Record>> records = d->owned_records();
+  if (Status s = agree(comm, status_of(records)); !s) return s;
+  if (Status s = d->partition(std::move(records).value()); !s) return s;
+  d->stats_.migrations = 0;  // the start's moves from the scene's centres are not migrations
+  return d;
+}
+
+std::vector<std::uint32_t> DistributedSimulation::owned() const {
+  std::vector<std::uint32_t> out;
+  for (std::size_t k = 0; k < local_bodies_.size(); ++k) {
+    if (local_owned_[k] != 0) out.push_back(local_bodies_[k]);
+  }
+  return out;
+}
+
+Result<std::vector<Record>> DistributedSimulation::owned_records() {
+  std::vector<Record> records;
+  if (!local_) return records;
+  Result<Snapshot> snap = local_->snapshot();
+  if (!snap) return status_of(snap);
+  const std::vector<BodyInfo>& infos = local_->bodies();
+  for (std::size_t k = 0; k < local_bodies_.size(); ++k) {
+    if (local_owned_[k] == 0) continue;
+    const BodyInfo& info = infos[k];
+    Record r;
+    r.body = local_bodies_[k];
+    r.state = {snap->body_pos[k], snap->body_quat[k], snap->body_vel[k], snap->body_angmom[k],
+               snap->body_angvel[k]};
+    const auto p = snap->particle_pos.begin() + info.first_particle;
+    const auto v = snap->particle_vel.begin() + info.first_particle;
+    r.pos.assign(p, p + info.particle_count);
+    r.vel.assign(v, v + info.particle_count);
+    records.push_back(std::move(r));
+  }
+  return records;
+}
+
+Status DistributedSimulation::partition(std::vector<Record> held) {
+  const Clock::time_point start = Clock::now();
+  const auto ranks = static_cast<std::size_t>(size_);
+  // 1. Every body to the rank whose brick holds its centre (of mass).
+  std::vector<std::vector<vec4>> out(ranks);
+  std::uint64_t moved = 0;
+  for (const Record& r : held) {
+    const int to = decomposition_.owner(centre_of(r.state[0]));
+    if (to != rank_) ++moved;
+    append(out[static_cast<std::size_t>(to)], r);
+  }
+  held.clear();
+  std::vector<int> counts;
+  Result<std::vector<vec4>> arrived = all_to_all(comm_, out, counts);
+  if (Status st = agree(comm_, status_of(arrived)); !st) return st;
+  std::vector<Record> owned = parse(arrived.value());
+  std::sort(owned.begin(), owned.end(),
+            [](const Record& a, const Record& b) { return a.body < b.body; });
+  std::uint64_t migrations = 0;
+  MPI_Allreduce(&moved, &migrations, 1, MPI_UINT64_T, MPI_SUM, comm_);
+
+  // 2. Halos: every owned body whose particles come within 2 margins of the particles another
+  // rank owns (boxes grown by the radii) goes there as a copy.
+  double mine[6];
+  for (int a = 0; a < 3; ++a) {
+    mine[a] = std::numeric_limits<double>::infinity();
+    mine[a + 3] = -std::numeric_limits<double>::infinity();
+  }
+  std::vector<std::array<double, 6>> boxes;
+  boxes.reserve(owned.size());
+  for (const Record& r : owned) {
+    boxes.push_back(record_box(r));
+    for (int a = 0; a < 3; ++a) {
+      mine[a] = std::min(mine[a], boxes.back()[static_cast<std::size_t>(a)] - halo_width_);
+      mine[a + 3] =
+          std::max(mine[a + 3], boxes.back()[static_cast<std::size_t>(a + 3)] + halo_width_);
+    }
+  }
+  std::vector<double> all(6 * ranks);
+  MPI_Allgather(mine, 6, MPI_DOUBLE, all.data(), 6, MPI_DOUBLE, comm_);
+  std::vector<std::vector<std::uint32_t>> sent_bodies(ranks);
+  for (auto& o : out) o.clear();
+  for (std::size_t k = 0; k < owned.size(); ++k) {
+    for (std::size_t r = 0; r < ranks; ++r) {
+      if (static_cast<int>(r) == rank_ || !overlap(boxes[k], &all[6 * r])) continue;
+      append(out[r], owned[k]);
+      sent_bodies[r].push_back(owned[k].body);
+    }
+  }
+  Result<std::vector<vec4>> copies = all_to_all(comm_, out, counts);
+  if (Status st = agree(comm_, status_of(copies)); !st) return st;
+  std::vector<Record> halo = parse(copies.value());
+  // The copies arrive by source rank, each source's ascending; remember which came from whom.
+  std::vector<int> source;
+  {
+    std::size_t at = 0;
+    std::vector<vec4> one;
+    for (std::size_t r = 0; r < ranks; ++r) {
+      std::size_t end = at + static_cast<std::size_t>(counts[r]);
+      while (at < end) {
+        const std::size_t n = std::bit_cast<std::uint32_t>(copies.value()[at].y);
+        source.push_back(static_cast<int>(r));
+        at += 6 + 2 * n;
+      }
+    }
+  }
+
+  // 3. The local simulation: owned bodies and copies in scene order, on the device the last one
+  // ran on (opened once per rank).
+  if (local_) spare_ = Simulation::take_device(std::move(local_));
+  local_bodies_.clear();
+  local_owned_.clear();
+  struct Entry {
+    std::uint32_t body;
+    const Record* record;
+    int from;  // -1: owned
+  };
+  std::vector<Entry> entries;
+  entries.reserve(owned.size() + halo.size());
+  for (const Record& r : owned) entries.push_back({r.body, &r, -1});
+  for (std::size_t k = 0; k < halo.size(); ++k)
+    entries.push_back({halo[k].body, &halo[k], source[k]});
+  std::sort(entries.begin(), entries.end(),
+            [](const Entry& a, const Entry& b) { return a.body < b.body; });
+  send_.assign(ranks, {});
+  receive_.assign(ranks, {});
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    local_bodies_.push_back(entries[k].body);
+    local_owned_.push_back(entries[k].from < 0 ? 1 : 0);
+    if (entries[k].from >= 0) {
+      receive_[static_cast<std::size_t>(entries[k].from)].push_back(static_cast<std::uint32_t>(k));
+    }
+  }
+  for (std::size_t r = 0; r < ranks; ++r) {
+    // sent_bodies[r] is ascending, as the local order: map scene bodies to local indices.
+    std::size_t k = 0;
+    for (std::uint32_t b : sent_bodies[r]) {
+      while (local_bodies_[k] != b) ++k;
+      send_[r].push_back(static_cast<std::uint32_t>(k));
+    }
+  }
+  Status built = Status::ok();
+  stats_.owned_bodies = owned.size();
+  stats_.halo_bodies = halo.size();
+  stats_.owned_particles = 0;
+  stats_.halo_particles = 0;
+  reference_.clear();
+  if (!entries.empty()) {
+    Result<std::unique_ptr<Device>> device =
+        spare_ ? Result<std::unique_ptr<Device>>(std::move(spare_)) : open_device_();
+    Result<std::unique_ptr<Simulation>> sim =
+        device ? Simulation::create(sub_scene(scene_, local_bodies_), std::move(device).value())
+               : Result<std::unique_ptr<Simulation>>(status_of(device));
+    if (sim) {
+      local_ = std::move(sim).value();
+      device_info_ = local_->device().info();
+      const std::vector<BodyInfo>& infos = local_->bodies();
+      Snapshot state;
+      state.step = steps_;
+      state.time = time();
+      const std::size_t n = local_->particle_count();
+      state.particle_pos.resize(n);
+      state.particle_vel.resize(n);
+      for (std::size_t k = 0; k < entries.size(); ++k) {
+        const Record& r = *entries[k].record;
+        std::copy(r.pos.begin(), r.pos.end(), state.particle_pos.begin() + infos[k].first_particle);
+        std::copy(r.vel.begin(), r.vel.end(), state.particle_vel.begin() + infos[k].first_particle);
+        state.body_pos.push_back(r.state[0]);
+        state.body_quat.push_back(r.state[1]);
+        state.body_vel.push_back(r.state[2]);
+        state.body_angmom.push_back(r.state[3]);
+        state.body_angvel.push_back(r.state[4]);
+        (entries[k].from < 0 ? stats_.owned_particles : stats_.halo_particles) += r.pos.size();
+        if (entries[k].from < 0) reference_.insert(reference_.end(), r.pos.begin(), r.pos.end());
+      }
+      built = local_->write_state(state);
+    } else {
+      built = sim.status();
+    }
+  }
+  if (Status s = agree(comm_, built); !s) return s;
+  ++stats_.partitions;
+  stats_.migrations += migrations;
+  stats_.partition_seconds += seconds_since(start);
+  return Status::ok();
+}
+
+Result<double> DistributedSimulation::exchange_halos(Status stepped) {
+  const Clock::time_point start = Clock::now();
+  const auto ranks = static_cast<std::size_t>(size_);
+  // Any failure on the way is kept and sent on as an empty part: every rank still takes part in
+  // every collective, and the last one (agree) tells them all.
+  Status status = std::move(stepped);
+  Snapshot snap;
+  if (local_ && status) {
+    Result<Snapshot> s = local_->snapshot();
+    if (s) {
+      snap = std::move(s).value();
+    } else {
+      status = s.status();
+    }
+  }
+  const bool have = local_ && status;
+  std::vector<std::vector<vec4>> out(ranks);
+  const std::vector<BodyInfo>* infos = local_ ? &local_->bodies() : nullptr;
+  const auto record_of = [&](std::uint32_t k) {
+    Record r;
+    r.body = local_bodies_[k];
+    r.state = {snap.body_pos[k], snap.body_quat[k], snap.body_vel[k], snap.body_angmom[k],
+               snap.body_angvel[k]};
+    const BodyInfo& info = (*infos)[k];
+    const auto p = snap.particle_pos.begin() + info.first_particle;
+    const auto v = snap.particle_vel.begin() + info.first_particle;
+    r.pos.assign(p, p + info.particle_count);
+    r.vel.assign(v, v + info.particle_count);
+    return r;
+  };
+  for (std::size_t r = 0; r < ranks && have; ++r) {
+    for (std::uint32_t k : send_[r]) append(out[r], record_of(k));
+    stats_.halo_bytes += out[r].size() * sizeof(vec4);
+  }
+  std::vector<int> counts;
+  Clock::time_point mpi_start = Clock::now();
+  Result<std::vector<vec4>> in = all_to_all(comm_, out, counts);
+  double mpi = seconds_since(mpi_start);
+  if (status && !in) status = in.status();
+  if (status && have) {
+    const std::vector<Record> copies = parse(in.value());
+    std::size_t next = 0;
+    for (std::size_t r = 0; r < ranks && status; ++r) {
+      for (std::uint32_t k : receive_[r]) {
+        const BodyInfo& info = (*infos)[k];
+        if (next >= copies.size() || copies[next].body != local_bodies_[k] ||
+            copies[next].pos.size() != info.particle_count) {
+          status = Status::error(fmt::format(
+              "halo update: body {}'s copy did not come from rank {}", local_bodies_[k], r));
+          break;
+        }
+        const Record& c = copies[next++];
+        std::copy(c.pos.begin(), c.pos.end(), snap.particle_pos.begin() + info.first_particle);
+        std::copy(c.vel.begin(), c.vel.end(), snap.particle_vel.begin() + info.first_particle);
+        snap.body_pos[k] = c.state[0];
+        snap.body_quat[k] = c.state[1];
+        snap.body_vel[k] = c.state[2];
+        snap.body_angmom[k] = c.state[3];
+        snap.body_angvel[k] = c.state[4];
+      }
+    }
+    if (status && next > 0) status = local_->write_state(snap);
+  }
+  // The farthest an owned particle has moved since the partition.
+  double far = 0.0;
+  if (status && have) {
+    std::size_t at = 0;
+    for (std::size_t k = 0; k < local_bodies_.size(); ++k) {
+      if (local_owned_[k] == 0) continue;
+      const BodyInfo& info = (*infos)[k];
+      for (std::uint32_t i = 0; i < info.particle_count; ++i, ++at) {
+        const vec4& p = snap.particle_pos[info.first_particle + i];
+        const vec4& q = reference_[at];
+        const double dx = static_cast<double>(p.x) - static_cast<double>(q.x);
+        const double dy = static_cast<double>(p.y) - static_cast<double>(q.y);
+        const double dz = static_cast<double>(p.z) - static_cast<double>(q.z);
+        const double d2 = dx * dx + dy * dy + dz * dz;
+        // A non-finite position forces a partition; the motion guard names it.
+        far = std::isfinite(d2) ? std::max(far, d2) : std::numeric_limits<double>::infinity();
+      }
+    }
+    far = std::sqrt(far);
+  }
+  mpi_start = Clock::now();
+  if (Status s = agree(comm_, status, &far); !s) return s;
+  mpi += seconds_since(mpi_start);
+  stats_.mpi_seconds += mpi;
+  stats_.copy_seconds += seconds_since(start) - mpi;
+  return far;
+}
+
+Status DistributedSimulation::step(std::uint64_t count) {
+  for (std::uint64_t k = 0; k < count; ++k) {
+    const Clock::time_point start = Clock::now();
+    Status stepped = local_ ? local_->step(1) : Status::ok();
+    stats_.step_seconds += seconds_since(start);
+    ++steps_;
+    if (size_ == 1) {  // one rank: no halos, nothing to migrate
+      if (!stepped) return stepped;
+      continue;
+    }
+    Result<double> far = exchange_halos(std::move(stepped));
+    if (!far) return far.status();
+    if (far.value() > margin_) {
+      Result<std::vector<Record>> records = owned_records();
+      if (Status s = agree(comm_, status_of(records)); !s) return s;
+      if (Status s = partition(std::move(records).value()); !s) return s;
+    }
+  }
+  return Status::ok();
+}
+
+Result<Snapshot> DistributedSimulation::gather(int root) {
+  Result<std::vector<Record>> records = owned_records();
+  if (Status s = agree(comm_, status_of(records)); !s) return s;
+  std::vector<vec4> mine;
+  for (const Record& r : records.value()) append(mine, r);
+  const int count = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(size_)), at(static_cast<std::size_t>(size_));
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, root, comm_);
+  std::vector<vec4> all;
+  if (rank_ == root) {
+    std::size_t total = 0;
+    for (int r = 0; r < size_; ++r) {
+      at[static_cast<std::size_t>(r)] = static_cast<int>(total);
+      total += static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]);
+    }
+    all.resize(total);
+  }
+  MPI_Gatherv(mine.data(), count, vec4_type(), all.data(), counts.data(), at.data(), vec4_type(),
+              root, comm_);
+  Snapshot s;
+  s.step = steps_;
+  s.time = time();
+  if (rank_ != root) return s;
+  const std::size_t nb = bodies_.size();
+  s.particle_pos.resize(particles_);
+  s.particle_vel.resize(particles_);
+  s.particle_body.resize(particles_);
+  s.body_pos.resize(nb);
+  s.body_quat.assign(nb, vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  s.body_vel.resize(nb);
+  s.body_angmom.resize(nb);
+  s.body_angvel.resize(nb);
+  std::vector<char> seen(nb, 0);
+  for (const Record& r : parse(all)) {
+    const BodyInfo& info = bodies_[r.body];
+    if (seen[r.body]++ != 0 || r.pos.size() != info.particle_count) {
+      return Status::error(
+          fmt::format("gather: body {} owned twice or with {} particles", r.body, r.pos.size()));
+    }
+    std::copy(r.pos.begin(), r.pos.end(), s.particle_pos.begin() + info.first_particle);
+    std::copy(r.vel.begin(), r.vel.end(), s.particle_vel.begin() + info.first_particle);
+    std::fill_n(s.particle_body.begin() + info.first_particle, info.particle_count, r.body);
+    s.body_pos[r.body] = r.state[0];
+    s.body_quat[r.body] = r.state[1];
+    s.body_vel[r.body] = r.state[2];
+    s.body_angmom[r.body] = r.state[3];
+    s.body_angvel[r.body] = r.state[4];
+  }
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (seen[b] == 0) return Status::error(fmt::format("gather: body {} has no owner", b));
+  }
+  return s;
+}
+
+}  // namespace motes

@@ -1,0 +1,34 @@
+#!/bin/sh
+# `mpirun -np 2 motes run` (docs/scale-out.md): the domino chain over two ranks writes the same
+# frames as one process, bit for bit; what cannot run over ranks yet is refused once, with exit 2.
+# Usage: cli_test.sh MPIEXEC MOTES SOURCE_DIR WORK_DIR
+set -eu
+mpiexec=$1 motes=$2 src=$3 work=$4
+rm -rf "$work" && mkdir -p "$work"
+args="run $src/examples/scenes/dominoes.json --backend openmp --steps 3000 --every 1000 --format csv"
+# shellcheck disable=SC2086
+"$motes" $args --out "$work/one" > "$work/one.log"
+shift_np() { n=$1; shift; "$mpiexec" -np "$n" --oversubscribe --bind-to none "$motes" "$@"; }
+# shellcheck disable=SC2086
+shift_np 2 $args --out "$work/two" > "$work/two.log"
+grep -q "over 2 MPI ranks (bricks 2 x 1 x 1)" "$work/two.log" || { cat "$work/two.log"; exit 1; }
+cmp "$work/one/particles.csv" "$work/two/particles.csv"
+cmp "$work/one/bodies.csv" "$work/two/bodies.csv"
+echo "2 ranks: particles.csv and bodies.csv equal to one process's"
+
+# A soft scene over two ranks: exit 2, the reason printed once (by rank 0).
+status=0
+shift_np 2 run "$src/examples/scenes/soft.json" --steps 10 --format none --backend openmp \
+  > "$work/soft.log" 2> "$work/soft.err" || status=$?
+[ "$status" -eq 2 ] || { echo "soft scene over 2 ranks: exit $status, expected 2"; cat "$work/soft.err"; exit 1; }
+[ "$(grep -c "soft bodies do not run over several MPI ranks" "$work/soft.err")" -eq 1 ] ||
+  { echo "expected the refusal once:"; cat "$work/soft.err"; exit 1; }
+echo "soft scene over 2 ranks refused once: $(head -1 "$work/soft.err")"
+
+# --decomposition that does not multiply to the rank count.
+status=0
+shift_np 2 run "$src/examples/scenes/dominoes.json" --steps 10 --format none --backend openmp \
+  --decomposition 3,1,1 > /dev/null 2> "$work/bricks.err" || status=$?
+[ "$status" -eq 2 ] && grep -q "must multiply to the 2 ranks" "$work/bricks.err" ||
+  { echo "--decomposition 3,1,1 over 2 ranks: exit $status"; cat "$work/bricks.err"; exit 1; }
+echo "wrong --decomposition refused: $(head -1 "$work/bricks.err")"

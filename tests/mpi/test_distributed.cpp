@@ -1,0 +1,228 @@
+// One scene over 1, 2 and 4 MPI ranks against the same scene on one Simulation (docs/scale-out.md):
+// ctest runs this program under mpirun at each rank count (tests/CMakeLists.txt). Backend:
+// MOTES_MPI_BACKEND (default openmp).
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <set>
+#include <string>
+#include <utility>
+
+#include "motes/decomposition.h"
+#include "motes/devices.h"
+#include "motes/distributed.h"
+#include "motes/simulation.h"
+#include "motes/workloads.h"
+
+namespace motes {
+namespace {
+
+std::string backend() {
+  const char* b = std::getenv("MOTES_MPI_BACKEND");
+  return b != nullptr && *b != '\0' ? b : "openmp";
+}
+
+DeviceOpener opener() {
+  return [] {
+    DeviceOptions options;
+    options.cpu_threads = 1;
+    return open_device(backend(), -1, options);
+  };
+}
+
+int world_rank() {
+  int r = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &r);
+  return r;
+}
+
+int world_size() {
+  int n = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &n);
+  return n;
+}
+
+/// W1's spheres given random velocities (up to 2 m/s a component, seeded): they collide with each
+/// other, the walls and the floor within a few hundred steps, across every rank boundary.
+Scene shaken_settle() {
+  Scene scene = settle_workload(12, 6, 12);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> speed(-2.0, 2.0);
+  for (BodySpec& b : scene.bodies) b.velocity = {speed(random), speed(random), speed(random)};
+  return scene;
+}
+
+/// The scene's first `count` dominoes (examples/scenes/dominoes.json): the chain falls across
+/// the rank boundaries along x within the steps the test runs.
+Scene short_domino_chain(std::size_t count) {
+  Result<Scene> scene =
+      load_scene_file(std::string(MOTES_SOURCE_DIR) + "/examples/scenes/dominoes.json");
+  EXPECT_TRUE(scene) << scene.message();
+  Scene s = scene.value();
+  std::vector<BodySpec> kept;
+  for (const BodySpec& b : s.bodies) {
+    // The floor and other static bodies stay; dynamic dominoes up to `count`.
+    if (b.kind == BodyKind::Static || kept.size() < count) kept.push_back(b);
+  }
+  s.bodies = kept;
+  return s;
+}
+
+/// Pairs of particles that touch (centre distance below the sum of the radii).
+std::set<std::pair<std::uint32_t, std::uint32_t>> touching(const Snapshot& s) {
+  std::set<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  const std::size_t n = s.particle_pos.size();
+  for (std::uint32_t i = 0; i < n; ++i) {
+    for (std::uint32_t j = i + 1; j < n; ++j) {
+      const shared::vec4& a = s.particle_pos[i];
+      const shared::vec4& b = s.particle_pos[j];
+      const double dx = static_cast<double>(a.x) - static_cast<double>(b.x);
+      const double dy = static_cast<double>(a.y) - static_cast<double>(b.y);
+      const double dz = static_cast<double>(a.z) - static_cast<double>(b.z);
+      const double r = static_cast<double>(a.w) + static_cast<double>(b.w);
+      if (dx * dx + dy * dy + dz * dz < r * r) pairs.insert({i, j});
+    }
+  }
+  return pairs;
+}
+
+struct Comparison {
+  double dx = 0.0;            ///< largest position difference (m)
+  double dv = 0.0;            ///< largest velocity difference (m/s)
+  std::size_t differing = 0;  ///< particles not bitwise equal
+};
+
+Comparison compare(const Snapshot& a, const Snapshot& b) {
+  Comparison c;
+  for (std::size_t i = 0; i < a.particle_pos.size(); ++i) {
+    const shared::vec4& p = a.particle_pos[i];
+    const shared::vec4& q = b.particle_pos[i];
+    const shared::vec4& v = a.particle_vel[i];
+    const shared::vec4& w = b.particle_vel[i];
+    c.dx = std::max({c.dx, std::abs(static_cast<double>(p.x - q.x)),
+                     std::abs(static_cast<double>(p.y - q.y)),
+                     std::abs(static_cast<double>(p.z - q.z))});
+    c.dv = std::max({c.dv, std::abs(static_cast<double>(v.x - w.x)),
+                     std::abs(static_cast<double>(v.y - w.y)),
+                     std::abs(static_cast<double>(v.z - w.z))});
+    if (std::memcmp(&p, &q, sizeof p) != 0 || std::memcmp(&v, &w, sizeof v) != 0) ++c.differing;
+  }
+  return c;
+}
+
+/// Runs `scene` for `steps` over every rank and (rank 0) on one Simulation; checks the same
+/// contacts, positions and velocities within the bounds, and every body owned once.
+/// `migrating`: bodies must change rank on the way (more than one rank).
+Snapshot expect_rank_independent(const Scene& scene, std::uint64_t steps, double max_dx,
+                                 double max_dv, bool migrating,
+                                 const DistributedOptions& options = {}) {
+  Snapshot result;
+  Result<std::unique_ptr<DistributedSimulation>> d =
+      DistributedSimulation::create(scene, MPI_COMM_WORLD, opener(), options);
+  EXPECT_TRUE(d) << d.message();
+  if (!d) return result;
+  EXPECT_EQ(d.value()->decomposition().ranks(), world_size());
+  const Status stepped = d.value()->step(steps);
+  EXPECT_TRUE(stepped) << stepped.message();
+  const Result<Snapshot> gathered = d.value()->gather(0);
+  EXPECT_TRUE(gathered) << gathered.message();
+  if (!stepped || !gathered) return result;
+  const DistributedStats stats = d.value()->stats();
+  if (world_size() > 1) {
+    // The run re-partitioned and moved bodies between ranks, and the ranks held halo copies.
+    EXPECT_GT(stats.partitions, 1u);
+    if (migrating) {
+      EXPECT_GT(stats.migrations, 0u);
+    }
+    std::uint64_t halo = stats.halo_bodies;
+    std::uint64_t total = 0;
+    MPI_Allreduce(&halo, &total, 1, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+    EXPECT_GT(total, 0u);
+  }
+  if (world_rank() != 0) return result;
+
+  DeviceOptions options1;
+  options1.cpu_threads = 1;
+  Result<std::unique_ptr<Device>> device = open_device(backend(), -1, options1);
+  EXPECT_TRUE(device) << device.message();
+  if (!device) return result;
+  Result<std::unique_ptr<Simulation>> one = Simulation::create(scene, std::move(device).value());
+  EXPECT_TRUE(one) << one.message();
+  if (!one || !one.value()->step(steps)) return result;
+  const Result<Snapshot> single = one.value()->snapshot();
+  if (!single) return result;
+  EXPECT_EQ(gathered->particle_pos.size(), single->particle_pos.size());
+  if (gathered->particle_pos.size() != single->particle_pos.size()) return result;
+  EXPECT_EQ(gathered->particle_body, single->particle_body);
+  const auto contacts = touching(single.value());
+  EXPECT_GT(contacts.size(), 0u);
+  EXPECT_EQ(touching(gathered.value()), contacts) << "the touching pairs differ";
+  const Comparison c = compare(gathered.value(), single.value());
+  EXPECT_LE(c.dx, max_dx);
+  EXPECT_LE(c.dv, max_dv);
+  std::printf(
+      "[ ranks %d ] %zu particles, %llu steps, %zu touching pairs: |dx| %.3g m, |dv| %.3g "
+      "m/s, %zu particles not bitwise equal; %llu partitions, %llu migrations\n",
+      world_size(), single->particle_pos.size(), static_cast<unsigned long long>(steps),
+      contacts.size(), c.dx, c.dv, c.differing, static_cast<unsigned long long>(stats.partitions),
+      static_cast<unsigned long long>(stats.migrations));
+  result = single.value();
+  return result;
+}
+
+TEST(Distributed, ShakenSettleMatchesOneRank) {
+  expect_rank_independent(shaken_settle(), 400, 1e-6, 1e-3, true);
+}
+
+TEST(Distributed, DominoChainMatchesOneRank) {
+  // Slabs along the chain: each domino falls onto the next across every rank boundary, the force
+  // of a contact between two ranks' dominoes computed by each owner from its halo copy.
+  DistributedOptions slabs;
+  slabs.decomposition = std::array<int, 3>{world_size(), 1, 1};
+  const Scene chain = short_domino_chain(6);
+  const Snapshot end = expect_rank_independent(chain, 20000, 1e-6, 1e-3, false, slabs);
+  if (world_rank() != 0 || end.body_quat.empty()) return;
+  // The wave reached the last domino: it has turned by more than 20 degrees.
+  std::size_t last = 0;
+  for (std::size_t b = 0; b < chain.bodies.size(); ++b) {
+    if (chain.bodies[b].kind == BodyKind::Dynamic) last = b;
+  }
+  const shared::vec4& q = end.body_quat[last];
+  const Eigen::Quaterniond turned(static_cast<double>(q.w), static_cast<double>(q.x),
+                                  static_cast<double>(q.y), static_cast<double>(q.z));
+  EXPECT_GT(turned.angularDistance(chain.bodies[last].rotation), 20.0 * 3.14159265 / 180.0);
+}
+
+TEST(Distributed, RefusesWhatItCannotSplit) {
+  Scene scene = soft_workload(2);
+  Result<std::unique_ptr<DistributedSimulation>> d =
+      DistributedSimulation::create(scene, MPI_COMM_WORLD, opener(), {});
+  ASSERT_FALSE(d);
+  EXPECT_NE(d.message().find("soft bodies do not run over several MPI ranks"), std::string::npos)
+      << d.message();
+  DistributedOptions wrong;
+  wrong.decomposition = std::array<int, 3>{world_size() + 1, 1, 1};
+  d = DistributedSimulation::create(shaken_settle(), MPI_COMM_WORLD, opener(), wrong);
+  ASSERT_FALSE(d);
+  EXPECT_NE(d.message().find("must multiply to the"), std::string::npos) << d.message();
+}
+
+TEST(Distributed, DeviceErrorOnOneRankReachesEveryRank) {
+  // Rank size-1 cannot open its device: every rank gets its message, none hangs.
+  const int last = world_size() - 1;
+  DeviceOpener failing = [last]() -> Result<std::unique_ptr<Device>> {
+    if (world_rank() == last) return Status::error("no device here");
+    return opener()();
+  };
+  Result<std::unique_ptr<DistributedSimulation>> d =
+      DistributedSimulation::create(shaken_settle(), MPI_COMM_WORLD, failing, {});
+  ASSERT_FALSE(d);
+  EXPECT_NE(d.message().find("no device here"), std::string::npos) << d.message();
+}
+
+}  // namespace
+}  // namespace motes
