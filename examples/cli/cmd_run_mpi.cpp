@@ -1,7 +1,9 @@
 // `motes run` over MPI ranks (run_mpi.h, docs/scale-out.md).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <memory>
 #include <string>
@@ -105,6 +107,56 @@ DeviceOpener device_opener(const DistributedRun& run) {
   return [backend, index, options]() { return open_device(backend, index, options); };
 }
 
+/// The motion guard of a run over ranks, on the state rank 0 gathered (docs/scale-out.md): a
+/// non-finite particle is an error naming step, body and particle (scene indices); the fastest
+/// particle's travel per substep beyond Simulation::kSafeTravel of its diameter is a warning.
+Status guard(const Snapshot& s, const DistributedSimulation& sim, double& travel,
+             std::string& warning) {
+  const Settings& settings = sim.settings();
+  const double h = settings.dt / static_cast<double>(settings.substeps);
+  travel = 0.0;
+  std::size_t fastest = 0;
+  for (std::size_t i = 0; i < s.particle_pos.size(); ++i) {
+    const shared::vec4& p = s.particle_pos[i];
+    const shared::vec4& v = s.particle_vel[i];
+    const std::uint32_t b = s.particle_body[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(v.x) ||
+        !std::isfinite(v.y) || !std::isfinite(v.z)) {
+      return Status::error(fmt::format(
+          "non-finite state at step {} (t = {:.6g} s): particle {} of body {} '{}': position "
+          "({}, {}, {}) m, velocity ({}, {}, {}) m/s; the run has gone unstable (dt {:.4g} s at "
+          "substeps {} too large for the contact stiffness?)",
+          s.step, s.time, i, b, sim.bodies()[b].name, p.x, p.y, p.z, v.x, v.y, v.z, settings.dt,
+          settings.substeps));
+    }
+    const double speed = std::sqrt(static_cast<double>(v.x) * static_cast<double>(v.x) +
+                                   static_cast<double>(v.y) * static_cast<double>(v.y) +
+                                   static_cast<double>(v.z) * static_cast<double>(v.z));
+    const double t = p.w > 0.0f ? speed * h / (2.0 * static_cast<double>(p.w)) : 0.0;
+    if (t > travel) {
+      travel = t;
+      fastest = i;
+    }
+  }
+  warning.clear();
+  if (travel > Simulation::kSafeTravel) {
+    const shared::vec4& p = s.particle_pos[fastest];
+    const std::uint32_t b = s.particle_body[fastest];
+    const double diameter = 2.0 * static_cast<double>(p.w);
+    const double speed = travel * diameter / h;
+    warning = fmt::format(
+        "step {} (t = {:.6g} s): particle {} of body {} '{}' moves {:.3g} of its diameter "
+        "({:.4g} m) per substep at {:.4g} m/s, more than the {} that contacts are resolved at: "
+        "contacts can be missed (tunnelling); the largest safe dt at this speed is {:.4g} s at "
+        "substeps {} (dt is {:.4g} s)",
+        s.step, s.time, fastest, b, sim.bodies()[b].name, travel, diameter, speed,
+        Simulation::kSafeTravel,
+        Simulation::kSafeTravel * diameter / speed * static_cast<double>(settings.substeps),
+        settings.substeps, settings.dt);
+  }
+  return Status::ok();
+}
+
 }  // namespace
 
 void run_distributed(DistributedRun run) {
@@ -168,21 +220,45 @@ void run_distributed(DistributedRun run) {
 
   double step_seconds = 0.0;
   double output_seconds = 0.0;
-  const auto frame = [&]() {
+  // At every frame and at least every Simulation::kGuardInterval steps: the state gathered on
+  // rank 0, checked by the guard, and at frames written.
+  std::uint64_t checks = 0;
+  std::uint64_t warned = 0;
+  double worst = 0.0;
+  double last_warned = 0.0;
+  const auto check = [&](bool write) {
     const Clock::time_point t = Clock::now();
     Result<Snapshot> snap = sim.gather(0);
-    Status wrote = snap ? Status::ok() : snap.status();
-    if (wrote && writer) wrote = writer->write_frame(snap.value());
-    mpi_agree_or_fail(wrote);
+    Status ok = snap ? Status::ok() : snap.status();
+    if (ok && rank == 0) {
+      double travel = 0.0;
+      std::string warning;
+      ok = guard(snap.value(), sim, travel, warning);
+      ++checks;
+      if (!warning.empty()) {
+        ++warned;
+        worst = std::max(worst, travel);
+        if (travel > 2.0 * last_warned) {
+          fmt::print(stderr, "motes: warning: {}\n", warning);
+          last_warned = travel;
+        }
+      }
+      if (ok && write && writer) ok = writer->write_frame(snap.value());
+      if (!ok && writer) (void)writer->finish();  // the frames so far stay readable
+    }
+    mpi_agree_or_fail(ok);
     output_seconds += seconds_since(t);
   };
+  const auto frame = [&]() { check(true); };
   std::unique_ptr<Progress> progress;
   if (rank == 0) progress = std::make_unique<Progress>(run.total);
   const double setup = run.setup_seconds + seconds_since(start);
   const Clock::time_point loop = Clock::now();
   frame();
   while (sim.steps() < run.total) {
-    const std::uint64_t next = std::min(run.total, (sim.steps() / run.every + 1) * run.every);
+    const std::uint64_t next_frame = (sim.steps() / run.every + 1) * run.every;
+    const std::uint64_t next =
+        std::min({run.total, next_frame, sim.steps() + Simulation::kGuardInterval});
     const Clock::time_point t = Clock::now();
     if (Status st = sim.step(next - sim.steps()); !st) {
       if (progress) progress->finish();
@@ -190,7 +266,7 @@ void run_distributed(DistributedRun run) {
       fail(st.message());
     }
     step_seconds += seconds_since(t);
-    frame();
+    check(sim.steps() == next_frame || sim.steps() == run.total);
     if (progress) progress->update(sim.steps(), sim.time());
   }
   if (progress) progress->finish();
@@ -235,6 +311,12 @@ void run_distributed(DistributedRun run) {
   } else {
     fmt::print("  {:<16}none written (--format none)\n", "frames");
   }
+  fmt::print("  {:<16}{} motion check{} on the gathered state{}\n", "guards", checks,
+             checks == 1 ? "" : "s",
+             warned == 0 ? std::string(", no warning")
+                         : fmt::format(", {} with a tunnelling warning (the worst: {:.3g} of a "
+                                       "diameter per substep)",
+                                       warned, worst));
   std::fflush(stdout);
 }
 

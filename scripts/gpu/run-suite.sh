@@ -6,8 +6,10 @@
 # slow part cannot lose the others' results. Results go to ${OUT:-gpu-out}/ (at most 8 files come
 # back from the GPU machine): conformance.txt, conformance.md, sanitize.txt, bench.txt, bench.json,
 # bench.md (scripts/gpu/bench-tables.py).
-# Usage: scripts/gpu/run-suite.sh [conformance|unit|sanitize|bench|all]...   (default all)
+# Usage: scripts/gpu/run-suite.sh [conformance|unit|sanitize|bench|mpi|all]...   (default all)
 #   unit: the unit tests' CUDA cases (checkpoint resume on CUDA, the CLI on CUDA), into unit.txt
+#   mpi: the MPI tests on CUDA and Vulkan at 1, 2 and 4 ranks (sharing the machine's GPUs), and
+#     W1 over 1, 2, 4 ranks (motes_mpi_bench, MOTES_MPI_SIZES), into mpi.txt
 #   MOTES_BENCH_RUNS="cuda:falling cuda:dominoes cuda:dense vulkan:falling ..."   what is measured
 #     (also BACKEND:huge: W1 at 67 M and 134 M particles, one short repeat; BACKEND:dominoes-1m:
 #     W2 with 1,000,000 dominoes; BACKEND:cloth: W3 at 256 x 256 and 1024 x 1024;
@@ -56,6 +58,25 @@ fi
 if want unit; then
   part "${LIMIT_UNIT:-120}" unit motes_unit_tests --gtest_brief=1 --gtest_filter='*cuda*:*Cuda*' ||
     status=1
+fi
+if want mpi; then
+  # The machine's own OpenMPI runs the ranks (run as root: its two allow variables).
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+  export OMPI_MCA_btl_vader_single_copy_mechanism=none
+  for backend in cuda vulkan; do
+    for n in 1 2 4; do
+      MOTES_MPI_BACKEND=$backend MOTES_VULKAN_VALIDATION=1 part "${LIMIT_MPI:-120}" mpi \
+        mpirun --oversubscribe --bind-to none -np "$n" motes_mpi_tests || status=1
+    done
+  done
+  for size in ${MOTES_MPI_SIZES:-1048576}; do
+    for backend in cuda vulkan; do
+      for n in 1 2 4; do
+        part "${LIMIT_MPI:-120}" mpi mpirun --oversubscribe --bind-to none -np "$n" \
+          motes_mpi_bench --backend "$backend" --size "$size" --steps 200 || status=1
+      done
+    done
+  done
 fi
 if want sanitize; then
   sanitizer=$(command -v compute-sanitizer || echo /usr/local/cuda/bin/compute-sanitizer)

@@ -32,3 +32,24 @@ shift_np 2 run "$src/examples/scenes/dominoes.json" --steps 10 --format none --b
 [ "$status" -eq 2 ] && grep -q "must multiply to the 2 ranks" "$work/bricks.err" ||
   { echo "--decomposition 3,1,1 over 2 ranks: exit $status"; cat "$work/bricks.err"; exit 1; }
 echo "wrong --decomposition refused: $(head -1 "$work/bricks.err")"
+
+# The motion guard over ranks: two balls 1 m apart (one per rank) falling at dt 1e-3 s, the second
+# thrown down at 1 m/s, which passes a quarter diameter per substep (2.5 m/s) at t = 0.153 s:
+# from the frame at step 200 (2.96 m/s) on, the warning names it (scene particle 1 of body 1, on
+# rank 1) and the largest safe dt, on the state gathered at the frames.
+cat > "$work/balls.json" <<'JSON'
+{"settings": {"dt": 1e-3, "substeps": 1, "particle_diameter": 0.01, "gravity": [0, -9.81, 0],
+  "contact": {"stiffness": 1000, "damping": 10}},
+ "bodies": [{"name": "still", "shape": {"type": "particle"}, "position": [0, 0, 0]},
+            {"name": "fast", "shape": {"type": "particle"}, "position": [1, 0, 0],
+             "velocity": [0, -1, 0]}]}
+JSON
+shift_np 2 run "$work/balls.json" --steps 400 --every 100 --format none --backend openmp \
+  > "$work/balls.log" 2> "$work/balls.err"
+grep -q "over 2 MPI ranks" "$work/balls.log" &&
+  grep -q "step 200 (t = 0.2 s): particle 1 of body 1 'fast' moves 0.296 of its diameter" "$work/balls.err" &&
+  grep -q "the largest safe dt at this speed is" "$work/balls.err" &&
+  grep -q "guards          5 motion checks on the gathered state, 3 with a tunnelling warning" \
+    "$work/balls.log" ||
+  { echo "no tunnelling warning over 2 ranks:"; cat "$work/balls.log" "$work/balls.err"; exit 1; }
+echo "tunnelling warned over 2 ranks: $(grep -m1 warning "$work/balls.err")"
