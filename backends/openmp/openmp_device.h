@@ -64,6 +64,9 @@ class OpenMPDevice final : public Device {
   void clusters_goal(const shared::StepParams& p) override;
   void impulses_compute(const shared::StepParams& p) override;
   void impulses_apply(const shared::StepParams& p) override;
+  void halo_pack(const shared::StepParams& p) override;
+  void halo_unpack(const shared::StepParams& p) override;
+  void particles_displacement(const shared::StepParams& p) override;
 
   Status synchronize() override { return Status::ok(); }
   Status check_guards() override;

@@ -92,6 +92,14 @@ const char* buffer_name(Buffer b) {
       return "MotionCheck";
     case Buffer::LinkExclusions:
       return "LinkExclusions";
+    case Buffer::HaloIndex:
+      return "HaloIndex";
+    case Buffer::HaloData:
+      return "HaloData";
+    case Buffer::PartitionRefPos:
+      return "PartitionRefPos";
+    case Buffer::PartitionCheck:
+      return "PartitionCheck";
     case Buffer::Count:
       break;
   }
@@ -128,6 +136,12 @@ const char* kernel_name(Kernel k) {
       return "impulses_apply";
     case Kernel::ParticlesCheck:
       return "particles_check";
+    case Kernel::HaloPack:
+      return "halo_pack";
+    case Kernel::HaloUnpack:
+      return "halo_unpack";
+    case Kernel::ParticlesDisplacement:
+      return "particles_displacement";
     case Kernel::Count:
       break;
   }
@@ -198,6 +212,14 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
       return {kUint, s.impulse != 0 ? std::size_t{s.rigid_particles} : 0};
     case Buffer::LinkExclusions:
       return {kUint, s.link_exclusions};
+    case Buffer::HaloIndex:
+      return {kUint, s.halo_index};
+    case Buffer::HaloData:
+      return {kVec4, s.halo_data};
+    case Buffer::PartitionRefPos:
+      return {kVec4, s.partition != 0 ? std::size_t{s.particles} : 0};
+    case Buffer::PartitionCheck:
+      return {kUint, s.partition != 0 ? std::size_t{1} : 0};
     case Buffer::Count:
       break;
   }
@@ -235,6 +257,8 @@ Sizes scale_sizes(const Sizes& sizes, std::uint32_t particles) {
   s.clusters = scale(sizes.clusters);
   s.cluster_members = scale(sizes.cluster_members);
   s.link_exclusions = scale(sizes.link_exclusions);
+  s.halo_index = scale(sizes.halo_index);
+  s.halo_data = scale(sizes.halo_data);
   s.table = grid_table_size(particles);
   return s;
 }

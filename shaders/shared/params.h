@@ -49,9 +49,9 @@ struct StepParams {
   uint constraint_count;      // constraints_solve: its number of constraints
   uint soft_first;            // Ns: particles [Ns, Nl) are soft-body particles (shape matching)
   uint cluster_count;         // S: shape-matching clusters (shared/shape_matching.h)
-  uint reserved0;             // 0
-  uint reserved1;             // 0
-  uint reserved2;             // 0: the struct has no padding (calls are compared bytewise)
+  uint halo_particles;        // halo_pack, halo_unpack: particle entries (shared/halo.h)
+  uint halo_bodies;           // halo_pack, halo_unpack: rigid body entries after them
+  uint halo_first;            // halo_pack, halo_unpack: their first word in HaloIndex
 };
 
 /// Contact law of one pair of materials (symmetric): F_n = k d - gamma_n m* v_n,
@@ -88,7 +88,7 @@ static_assert(offsetof(motes::shared::StepParams, constraint_count) == 72, "Step
 static_assert(offsetof(motes::shared::StepParams, cluster_count) == 80, "StepParams layout");
 // No padding bytes: queued calls are compared with memcmp to find the step's repeating cycle
 // (kernel_queue.cpp), and a padding byte's garbage would hide it (every flush a new graph).
-static_assert(offsetof(motes::shared::StepParams, reserved2) + sizeof(motes::shared::uint) ==
+static_assert(offsetof(motes::shared::StepParams, halo_first) + sizeof(motes::shared::uint) ==
                   sizeof(motes::shared::StepParams),
               "StepParams must have no padding");
 static_assert(sizeof(motes::shared::ContactLaw) == 32, "ContactLaw layout");

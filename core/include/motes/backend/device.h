@@ -78,6 +78,19 @@ enum class Buffer : std::uint32_t {
   /// uint (N - Nl + 1 + E): for each linked particle, where its list of the particles within
   /// two links starts, then the lists, ascending (shared/links.h, contact_listed).
   LinkExclusions,
+  // Runs over MPI ranks (motes/distributed.h, docs/scale-out.md; empty in one process). After
+  // the others: checkpoints name buffers by their number.
+  /// uint (Sizes::halo_index): the entries halo_pack and halo_unpack walk, as StepParams
+  /// halo_first, halo_particles and halo_bodies say: particle indices, then rigid body indices.
+  HaloIndex,
+  /// vec4 (Sizes::halo_data): the packed state of halo entries (shared/halo.h: particle entry k
+  /// at 2k (position) and 2k + 1 (velocity), rigid body entry j at 2 P + 5 j + 0..4).
+  HaloData,
+  /// vec4 (N when Sizes::partition, else 0): ParticlePos when the ranks last partitioned the
+  /// scene; particles_displacement measures from it.
+  PartitionRefPos,
+  /// uint (1 when Sizes::partition, else 0): particles_displacement's word (shared/halo.h).
+  PartitionCheck,
   Count
 };
 
@@ -98,6 +111,10 @@ enum class Kernel : std::uint32_t {
   ImpulsesCompute,
   ImpulsesApply,
   ParticlesCheck,  ///< not part of a step: the motion guard, at output frames and checks
+  // Not part of a step: runs over MPI ranks, between steps (motes/distributed.h).
+  HaloPack,
+  HaloUnpack,
+  ParticlesDisplacement,
   Count
 };
 
@@ -123,6 +140,10 @@ struct Sizes {
   std::uint32_t impulse = 0;             ///< 1: rigid contacts by impulses (buffers for them)
   std::uint32_t absorb = 0;  ///< 1: cloth or ropes attached to rigid bodies (ParticleMoment)
   std::uint32_t link_exclusions = 0;  ///< words of LinkExclusions: 0 without a mesh cloth
+  // Runs over MPI ranks (0 in one process): see HaloIndex, HaloData, PartitionRefPos.
+  std::uint32_t halo_index = 0;  ///< words of HaloIndex
+  std::uint32_t halo_data = 0;   ///< vec4s of HaloData
+  std::uint32_t partition = 0;   ///< 1: PartitionRefPos (N) and PartitionCheck (1) exist
 };
 
 /// Bytes of one element and number of elements of a buffer.
@@ -284,6 +305,23 @@ class Device {
   /// first particle whose position or velocity is not finite (shared/motion_check.h). Reads
   /// ParticlePos and ParticleVel only.
   virtual void particles_check(const shared::StepParams& p) = 0;
+
+  /// Halo exchange over MPI ranks (shared/halo.h, docs/scale-out.md): HaloData = the state of
+  /// the p.halo_particles particles at HaloIndex [p.halo_first, + p.halo_particles) (entry k:
+  /// ParticlePos at 2k, ParticleVel at 2k + 1), then of the p.halo_bodies rigid bodies at the next
+  /// p.halo_bodies words (entry j at 2 P + 5 j: BodyPos, BodyQuat, BodyVel, BodyAngMom,
+  /// BodyAngVel). Plain copies: the same bits on every backend.
+  virtual void halo_pack(const shared::StepParams& p) = 0;
+  /// The reverse of halo_pack with the same layout: HaloData's entries written to the particles
+  /// and bodies HaloIndex names (from p.halo_first); asks for a neighbour-list rebuild
+  /// (NeighbourState) when a particle it wrote is too far from its NeighbourRefPos
+  /// (shared/neighbours.h: neighbour_moved_too_far), as the integrators do.
+  virtual void halo_unpack(const shared::StepParams& p) = 0;
+  /// PartitionCheck[0] = the largest of shared/halo.h: displacement2_bits(ParticlePos[i],
+  /// PartitionRefPos[i]) over particles [0, p.particle_count): the float bits of the largest
+  /// squared distance a particle has moved since the partition (an infinity's bits when one is
+  /// not finite). Reads ParticlePos and PartitionRefPos only.
+  virtual void particles_displacement(const shared::StepParams& p) = 0;
 
   /// Waits for queued work; reports any error it raised.
   virtual Status synchronize() = 0;

@@ -1,0 +1,46 @@
+// halo_pack: the state a neighbour rank holds copies of, gathered into HaloData (shared/halo.h,
+// docs/scale-out.md).
+#include <chrono>
+#include <cstdint>
+
+#include "openmp_device.h"
+#include "shared/halo.h"
+
+namespace motes::openmp {
+
+using shared::uint;
+using shared::vec4;
+
+namespace {
+
+/// The body buffers of a halo body entry, in HaloData's order.
+constexpr Buffer kBodyState[MOTES_HALO_BODY_VEC4S] = {
+    Buffer::BodyPos, Buffer::BodyQuat, Buffer::BodyVel, Buffer::BodyAngMom, Buffer::BodyAngVel};
+
+}  // namespace
+
+void OpenMPDevice::halo_pack(const shared::StepParams& p) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto np = static_cast<std::int64_t>(p.halo_particles);
+  const auto nb = static_cast<std::int64_t>(p.halo_bodies);
+  const uint* index = buf<uint>(Buffer::HaloIndex) + p.halo_first;
+  const vec4* pos = buf<vec4>(Buffer::ParticlePos);
+  const vec4* vel = buf<vec4>(Buffer::ParticleVel);
+  vec4* data = buf<vec4>(Buffer::HaloData);
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(np))
+  for (std::int64_t k = 0; k < np; ++k) {
+    data[MOTES_HALO_PARTICLE_VEC4S * k] = pos[index[k]];
+    data[MOTES_HALO_PARTICLE_VEC4S * k + 1] = vel[index[k]];
+  }
+  vec4* bodies = data + MOTES_HALO_PARTICLE_VEC4S * np;
+  for (uint c = 0; c < MOTES_HALO_BODY_VEC4S; ++c) {
+    const vec4* state = buf<vec4>(kBodyState[c]);
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(nb))
+    for (std::int64_t j = 0; j < nb; ++j) {
+      bodies[MOTES_HALO_BODY_VEC4S * j + c] = state[index[np + j]];
+    }
+  }
+  record(Kernel::HaloPack, start);
+}
+
+}  // namespace motes::openmp
