@@ -62,6 +62,9 @@ class LimitedDevice final : public motes::Device {
   void clusters_goal(const StepParams& p) override { inner_->clusters_goal(p); }
   void impulses_compute(const StepParams& p) override { inner_->impulses_compute(p); }
   void impulses_apply(const StepParams& p) override { inner_->impulses_apply(p); }
+  void halo_pack(const StepParams& p) override { inner_->halo_pack(p); }
+  void halo_unpack(const StepParams& p) override { inner_->halo_unpack(p); }
+  void particles_displacement(const StepParams& p) override { inner_->particles_displacement(p); }
   Status synchronize() override { return inner_->synchronize(); }
   Status check_guards() override { return inner_->check_guards(); }
   void set_timing(bool on) override { inner_->set_timing(on); }
@@ -123,6 +126,9 @@ TEST(DeviceLimits, ScaledSizesKeepTheSceneProportions) {
   s.planes = 2;
   s.neighbour_capacity = 16;
   s.table = motes::grid_table_size(1000);
+  s.halo_index = 300;
+  s.halo_data = 800;
+  s.partition = 1;
   const Sizes half = motes::scale_sizes(s, 500);
   EXPECT_EQ(half.particles, 500u);
   EXPECT_EQ(half.rigid_particles, 270u);
@@ -135,7 +141,32 @@ TEST(DeviceLimits, ScaledSizesKeepTheSceneProportions) {
   EXPECT_EQ(half.planes, 2u);
   EXPECT_EQ(half.neighbour_capacity, 16u);
   EXPECT_EQ(half.table, motes::grid_table_size(500));
+  EXPECT_EQ(half.halo_index, 150u);
+  EXPECT_EQ(half.halo_data, 400u);
+  EXPECT_EQ(half.partition, 1u);
   EXPECT_EQ(motes::scale_sizes(s, 0).particles, 0u);
+}
+
+// The buffers of runs over MPI ranks: empty in one process (every Sizes field 0), so a scene
+// needs the same bytes as before they existed; sized by Sizes when a rank asks for them.
+TEST(DeviceLimits, HaloAndPartitionBuffersAreEmptyInOneProcess) {
+  Sizes s;
+  s.particles = 1000;
+  s.bodies = 20;
+  s.table = motes::grid_table_size(1000);
+  for (const Buffer b :
+       {Buffer::HaloIndex, Buffer::HaloData, Buffer::PartitionRefPos, Buffer::PartitionCheck}) {
+    EXPECT_EQ(motes::buffer_layout(b, s).bytes(), 0u) << motes::buffer_name(b);
+  }
+  const std::uint64_t single = motes::buffers_bytes(s);
+  s.halo_index = 300;
+  s.halo_data = 800;
+  s.partition = 1;
+  EXPECT_EQ(motes::buffer_layout(Buffer::HaloIndex, s).bytes(), 300u * 4u);
+  EXPECT_EQ(motes::buffer_layout(Buffer::HaloData, s).bytes(), 800u * 16u);
+  EXPECT_EQ(motes::buffer_layout(Buffer::PartitionRefPos, s).bytes(), 1000u * 16u);
+  EXPECT_EQ(motes::buffer_layout(Buffer::PartitionCheck, s).bytes(), 4u);
+  EXPECT_EQ(motes::buffers_bytes(s), single + 300u * 4u + 800u * 16u + 1000u * 16u + 4u);
 }
 
 // More than the device has: refused before any allocation, naming the scene, both numbers and
