@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <limits>
 #include <numbers>
@@ -22,6 +23,12 @@ namespace motes {
 using shared::vec4;
 
 namespace {
+
+/// Bytes of Sizes before its fields of runs over MPI ranks: the whole struct until they came
+/// (14 words), hashed as the setup's fingerprint (Simulation::setup_hash).
+constexpr std::size_t kSizesBeforeMpi = offsetof(Sizes, halo_index);
+static_assert(kSizesBeforeMpi == 14 * sizeof(std::uint32_t),
+              "the setup hash covers the Sizes of single-process checkpoints");
 
 vec4 to_vec4(const Eigen::Vector3d& v, double w) {
   return {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z()),
@@ -489,7 +496,13 @@ Status Simulation::upload(const Scene& scene) {
 
   // The setup's fingerprint: every fixed input of a step (checkpoints load only where it is
   // equal). Computed from the host's copies, so it is the same on every backend.
-  std::uint64_t h = fnv1a64(&sizes_, sizeof sizes_);
+  // Sizes before the fields of runs over MPI ranks, which a single process leaves 0: its hash
+  // (and so a checkpoint's) is what it was before they existed.
+  std::uint64_t h = fnv1a64(&sizes_, kSizesBeforeMpi);
+  if (sizes_.halo_index != 0 || sizes_.halo_data != 0 || sizes_.partition != 0) {
+    h = fnv1a64(reinterpret_cast<const unsigned char*>(&sizes_) + kSizesBeforeMpi,
+                sizeof sizes_ - kSizesBeforeMpi, h);
+  }
   h = fnv1a64(&params_, sizeof params_, h);
   const std::int64_t counts[2] = {settings_.substeps, settings_.constraint_iterations};
   h = fnv1a64(counts, sizeof counts, h);
