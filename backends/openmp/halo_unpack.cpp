@@ -25,7 +25,8 @@ void OpenMPDevice::halo_unpack(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
   const auto np = static_cast<std::int64_t>(p.halo_particles);
   const auto nb = static_cast<std::int64_t>(p.halo_bodies);
-  const uint* index = buf<uint>(Buffer::HaloIndex) + p.halo_first;
+  const auto first = static_cast<std::int64_t>(p.halo_first);
+  const uint* index = buf<uint>(Buffer::HaloIndex);
   const vec4* data = buf<vec4>(Buffer::HaloData);
   const vec4* ref = buf<vec4>(Buffer::NeighbourRefPos);
   vec4* pos = buf<vec4>(Buffer::ParticlePos);
@@ -35,7 +36,8 @@ void OpenMPDevice::halo_unpack(const shared::StepParams& p) {
     reduction(|                                                                   \
               : moved)
   for (std::int64_t k = 0; k < np; ++k) {
-    const uint i = index[k];
+    const uint i = index[first + k];
+    if (i >= p.particle_count) continue;  // not a particle: nothing written
     pos[i] = data[MOTES_HALO_PARTICLE_VEC4S * k];
     vel[i] = data[MOTES_HALO_PARTICLE_VEC4S * k + 1];
     moved |= shared::neighbour_moved_too_far(pos[i], ref[i], p.neighbour_skin) ? 1u : 0u;
@@ -46,7 +48,8 @@ void OpenMPDevice::halo_unpack(const shared::StepParams& p) {
     vec4* state = buf<vec4>(kBodyState[c]);
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(nb))
     for (std::int64_t j = 0; j < nb; ++j) {
-      state[index[np + j]] = bodies[MOTES_HALO_BODY_VEC4S * j + c];
+      const uint b = index[first + np + j];
+      if (b < p.body_count) state[b] = bodies[MOTES_HALO_BODY_VEC4S * j + c];
     }
   }
   record(Kernel::HaloUnpack, start);

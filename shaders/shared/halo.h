@@ -14,7 +14,9 @@ MOTES_SHARED_BEGIN
 /// HaloData: particle entry k (of StepParams.halo_particles) at MOTES_HALO_PARTICLE_VEC4S k:
 /// ParticlePos, then ParticleVel; after all of them, rigid body entry j at
 /// MOTES_HALO_PARTICLE_VEC4S halo_particles + MOTES_HALO_BODY_VEC4S j: BodyPos, BodyQuat,
-/// BodyVel, BodyAngMom, BodyAngVel.
+/// BodyVel, BodyAngMom, BodyAngVel. Entry k's particle is HaloIndex[halo_first + k], entry j's
+/// body HaloIndex[halo_first + halo_particles + j]; an index out of range (not below
+/// particle_count, or body_count) is skipped by both kernels.
 #define MOTES_HALO_PARTICLE_VEC4S 2u
 #define MOTES_HALO_BODY_VEC4S 5u
 

@@ -310,12 +310,15 @@ class Device {
   /// the p.halo_particles particles at HaloIndex [p.halo_first, + p.halo_particles) (entry k:
   /// ParticlePos at 2k, ParticleVel at 2k + 1), then of the p.halo_bodies rigid bodies at the next
   /// p.halo_bodies words (entry j at 2 P + 5 j: BodyPos, BodyQuat, BodyVel, BodyAngMom,
-  /// BodyAngVel). Plain copies: the same bits on every backend.
+  /// BodyAngVel). HaloData's entries start at its word 0 whatever p.halo_first is. Plain copies:
+  /// the same bits on every backend. An entry whose index is not below p.particle_count (a
+  /// particle) or p.body_count (a body) is skipped: its HaloData entry is left as it was.
   virtual void halo_pack(const shared::StepParams& p) = 0;
   /// The reverse of halo_pack with the same layout: HaloData's entries written to the particles
-  /// and bodies HaloIndex names (from p.halo_first); asks for a neighbour-list rebuild
-  /// (NeighbourState) when a particle it wrote is too far from its NeighbourRefPos
-  /// (shared/neighbours.h: neighbour_moved_too_far), as the integrators do.
+  /// and bodies HaloIndex names (from p.halo_first; an index out of range, as in halo_pack:
+  /// nothing written); asks for a neighbour-list rebuild (NeighbourState) when a particle it
+  /// wrote is too far from its NeighbourRefPos (shared/neighbours.h: neighbour_moved_too_far), as
+  /// the integrators do, and leaves NeighbourState as it is otherwise.
   virtual void halo_unpack(const shared::StepParams& p) = 0;
   /// PartitionCheck[0] = the largest of shared/halo.h: displacement2_bits(ParticlePos[i],
   /// PartitionRefPos[i]) over particles [0, p.particle_count): the float bits of the largest
