@@ -242,6 +242,12 @@ BodyBuffers CudaDevice::body_buffers() const {
           buf<shared::vec4>(Buffer::NeighbourRefPos), buf<shared::uint>(Buffer::NeighbourState)};
 }
 
+HaloBodies CudaDevice::halo_bodies() const {
+  return {{buf<shared::vec4>(Buffer::BodyPos), buf<shared::vec4>(Buffer::BodyQuat),
+           buf<shared::vec4>(Buffer::BodyVel), buf<shared::vec4>(Buffer::BodyAngMom),
+           buf<shared::vec4>(Buffer::BodyAngVel)}};
+}
+
 void CudaDevice::update_fusable() {
   // Bodies of up to this many particles take the fused pass (one thread per body, looping over
   // its particles). Measured on an H100: a win for free spheres (W1), a loss for 15-particle

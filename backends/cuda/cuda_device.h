@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "body_buffers.h"
+#include "halo_buffers.h"
 #include "motes/backend/device.h"
 #include "motes/backend/kernel_queue.h"
 #include "shared/common.h"
@@ -67,6 +68,11 @@ class CudaDevice final : public Device {
   }
   void impulses_apply(const shared::StepParams& p) override { enqueue(Kernel::ImpulsesApply, p); }
   void particles_check(const shared::StepParams& p) override { enqueue(Kernel::ParticlesCheck, p); }
+  void halo_pack(const shared::StepParams& p) override { enqueue(Kernel::HaloPack, p); }
+  void halo_unpack(const shared::StepParams& p) override { enqueue(Kernel::HaloUnpack, p); }
+  void particles_displacement(const shared::StepParams& p) override {
+    enqueue(Kernel::ParticlesDisplacement, p);
+  }
 
   Status synchronize() override;
   Status check_guards() override;
@@ -122,6 +128,9 @@ class CudaDevice final : public Device {
   void launch_impulses_compute(const shared::StepParams& p);
   void launch_impulses_apply(const shared::StepParams& p);
   void launch_particles_check(const shared::StepParams& p);
+  void launch_halo_pack(const shared::StepParams& p);
+  void launch_halo_unpack(const shared::StepParams& p);
+  void launch_particles_displacement(const shared::StepParams& p);
   /// bodies_reduce, bodies_integrate and particles_update in one pass (bodies_step.cu), for scenes
   /// whose bodies are small; the same arithmetic as the three kernels.
   void launch_bodies_step(const shared::StepParams& p);
@@ -131,6 +140,8 @@ class CudaDevice final : public Device {
   void launch_ids_fill(std::uint32_t n);
   /// The buffers of the three body passes.
   [[nodiscard]] BodyBuffers body_buffers() const;
+  /// The body buffers of a halo entry, in HaloData's order.
+  [[nodiscard]] HaloBodies halo_bodies() const;
 
   DeviceInfo info_;
   int ordinal_ = 0;
@@ -165,6 +176,14 @@ class CudaDevice final : public Device {
 /// Blocks for n threads of CudaDevice::kBlock.
 inline unsigned blocks_for(std::uint64_t n) {
   return static_cast<unsigned>((n + CudaDevice::kBlock - 1) / CudaDevice::kBlock);
+}
+
+/// Blocks of a grid-stride loop over n items: a thread per item up to 4,096 blocks (about four
+/// times the threads an H100's 132 SMs hold at once); beyond, each thread takes several.
+inline unsigned grid_stride_blocks(std::uint64_t n) {
+  constexpr unsigned kMaxBlocks = 4096;
+  const unsigned blocks = blocks_for(n);
+  return blocks < kMaxBlocks ? blocks : kMaxBlocks;
 }
 
 }  // namespace motes::cuda

@@ -9,6 +9,7 @@
 #include <algorithm>
 
 #include "cuda_device.h"
+#include "shared/halo.h"
 
 namespace motes::cuda {
 
@@ -68,6 +69,27 @@ void CudaDevice::enqueue(Kernel k, const shared::StepParams& p) {
         kernel_name(k)));
     return;
   }
+  // The halo entries and the partition's buffers exist only in runs over MPI ranks (Sizes).
+  if (k == Kernel::HaloPack || k == Kernel::HaloUnpack) {
+    const std::uint64_t words =
+        std::uint64_t{p.halo_first} + p.halo_particles + std::uint64_t{p.halo_bodies};
+    const std::uint64_t vec4s = std::uint64_t{MOTES_HALO_PARTICLE_VEC4S} * p.halo_particles +
+                                std::uint64_t{MOTES_HALO_BODY_VEC4S} * p.halo_bodies;
+    if (words > sizes_.halo_index || vec4s > sizes_.halo_data) {
+      error_ = Status::error(fmt::format(
+          "cuda: {} launched with {} particle and {} body entries from HaloIndex word {} ({} "
+          "words, {} vec4s of HaloData) on buffers allocated for {} words and {} vec4s",
+          kernel_name(k), p.halo_particles, p.halo_bodies, p.halo_first, words, vec4s,
+          sizes_.halo_index, sizes_.halo_data));
+      return;
+    }
+  }
+  if (k == Kernel::ParticlesDisplacement && sizes_.partition == 0) {
+    error_ = Status::error(
+        fmt::format("cuda: {} launched on buffers allocated without a partition (Sizes::partition)",
+                    kernel_name(k)));
+    return;
+  }
   pending_.push_back({k, p});
 }
 
@@ -122,6 +144,15 @@ std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t
       return 1;
     case Kernel::ParticlesCheck:
       launch_particles_check(p);
+      return 1;
+    case Kernel::HaloPack:
+      launch_halo_pack(p);
+      return 1;
+    case Kernel::HaloUnpack:
+      launch_halo_unpack(p);
+      return 1;
+    case Kernel::ParticlesDisplacement:
+      launch_particles_displacement(p);
       return 1;
     case Kernel::Count:
       break;
