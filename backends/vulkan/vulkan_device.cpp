@@ -36,16 +36,21 @@ static_assert(B_BODY_ANGVEL_START == static_cast<int>(Buffer::BodyAngVelStart));
 static_assert(B_IMPULSE_STAMP == static_cast<int>(Buffer::ImpulseStamp));
 static_assert(B_MOTION_CHECK == static_cast<int>(Buffer::MotionCheck));
 static_assert(B_LINK_EXCLUSIONS == static_cast<int>(Buffer::LinkExclusions));
+static_assert(B_HALO_INDEX == static_cast<int>(Buffer::HaloIndex));
+static_assert(B_HALO_DATA == static_cast<int>(Buffer::HaloData));
+static_assert(B_PARTITION_REF_POS == static_cast<int>(Buffer::PartitionRefPos));
+static_assert(B_PARTITION_CHECK == static_cast<int>(Buffer::PartitionCheck));
 static_assert(B_GRID_ARRIVAL == static_cast<int>(Buffer::Count));
 
 namespace {
 
 constexpr const char* kPipelineShaders[kPipelineCount] = {
-    "neighbours_decide",   "grid_build_clear",    "grid_build_count", "grid_build_scan_block",
-    "grid_build_scan_add", "grid_build_scatter",  "grid_build_place", "neighbours_begin",
-    "neighbours_build",    "contacts_compute",    "bodies_reduce",    "bodies_integrate",
-    "particles_update",    "particles_integrate", "clusters_fit",     "clusters_goal",
-    "constraints_solve",   "impulses_compute",    "impulses_apply",   "particles_check"};
+    "neighbours_decide",   "grid_build_clear",    "grid_build_count",      "grid_build_scan_block",
+    "grid_build_scan_add", "grid_build_scatter",  "grid_build_place",      "neighbours_begin",
+    "neighbours_build",    "contacts_compute",    "bodies_reduce",         "bodies_integrate",
+    "particles_update",    "particles_integrate", "clusters_fit",          "clusters_goal",
+    "constraints_solve",   "impulses_compute",    "impulses_apply",        "particles_check",
+    "halo_pack",           "halo_unpack",         "particles_displacement"};
 
 const char* binding_name(std::uint32_t binding) {
   if (binding < kBufferCount) return buffer_name(static_cast<Buffer>(binding));
@@ -692,6 +697,11 @@ void VulkanDevice::particles_integrate(const shared::StepParams& p) {
 
 void VulkanDevice::particles_check(const shared::StepParams& p) {
   enqueue(Kernel::ParticlesCheck, p);
+}
+void VulkanDevice::halo_pack(const shared::StepParams& p) { enqueue(Kernel::HaloPack, p); }
+void VulkanDevice::halo_unpack(const shared::StepParams& p) { enqueue(Kernel::HaloUnpack, p); }
+void VulkanDevice::particles_displacement(const shared::StepParams& p) {
+  enqueue(Kernel::ParticlesDisplacement, p);
 }
 void VulkanDevice::constraints_solve(const shared::StepParams& p) {
   enqueue(Kernel::ConstraintsSolve, p);

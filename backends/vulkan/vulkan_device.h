@@ -43,6 +43,9 @@ enum class Pipeline : std::uint32_t {
   ImpulsesCompute,
   ImpulsesApply,
   ParticlesCheck,
+  HaloPack,
+  HaloUnpack,
+  ParticlesDisplacement,
   Count
 };
 constexpr std::size_t kPipelineCount = static_cast<std::size_t>(Pipeline::Count);
@@ -83,6 +86,9 @@ class VulkanDevice final : public Device {
   void particles_update(const shared::StepParams& p) override;
   void particles_integrate(const shared::StepParams& p) override;
   void particles_check(const shared::StepParams& p) override;
+  void halo_pack(const shared::StepParams& p) override;
+  void halo_unpack(const shared::StepParams& p) override;
+  void particles_displacement(const shared::StepParams& p) override;
   void constraints_solve(const shared::StepParams& p) override;
   void clusters_fit(const shared::StepParams& p) override;
   void clusters_goal(const shared::StepParams& p) override;
@@ -179,6 +185,9 @@ class VulkanDevice final : public Device {
   void record_neighbours_build(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_particles_integrate(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_particles_check(VkCommandBuffer cb, const shared::StepParams& p) const;
+  void record_halo_pack(VkCommandBuffer cb, const shared::StepParams& p) const;
+  void record_halo_unpack(VkCommandBuffer cb, const shared::StepParams& p) const;
+  void record_particles_displacement(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_constraints_solve(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_clusters_fit(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_clusters_goal(VkCommandBuffer cb, const shared::StepParams& p) const;

@@ -191,6 +191,15 @@ Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool ti
       case Kernel::ParticlesCheck:
         record_particles_check(cb, p);
         break;
+      case Kernel::HaloPack:
+        record_halo_pack(cb, p);
+        break;
+      case Kernel::HaloUnpack:
+        record_halo_unpack(cb, p);
+        break;
+      case Kernel::ParticlesDisplacement:
+        record_particles_displacement(cb, p);
+        break;
       case Kernel::NeighboursUpdate:
       case Kernel::Count:
         break;

@@ -12,6 +12,7 @@
 #include "shared/body_math.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
+#include "shared/halo.h"
 
 layout(local_size_x = 64) in;
 layout(push_constant) uniform Push { StepParams p; };
@@ -38,5 +39,6 @@ void main() {
   vec4 w;
   body_integrate(body, q, v, l, w, vec4(1.0f), vec4(f, 0.0f), vec4(0.0f), p.gravity_dt, p.flags);
   vec3 x = particle_position(body, q, a) + particle_velocity(q, v, w, a);
-  result[i] = vec4(x + particle_torque(a, body, vec4(f, 0.0f)), float(bucket));
+  result[i] = vec4(x + particle_torque(a, body, vec4(f, 0.0f)),
+                   float(bucket) + uintBitsToFloat(displacement2_bits(a, b)));
 }
