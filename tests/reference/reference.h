@@ -186,6 +186,25 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
 /// shared::body_apply_impulse (static bodies: angvel from angmom only).
 void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s);
 
+/// halo_pack: for each particle entry k < p.halo_particles, the particle i = index[p.halo_first +
+/// k]: data[2k] = its position, data[2k + 1] = its velocity; then for each body entry j <
+/// p.halo_bodies, the body b = index[p.halo_first + p.halo_particles + j]: data[2 P + 5 j + 0..4]
+/// = its pos, quat, vel, angmom, angvel (shared/halo.h). An entry whose index is not below
+/// p.particle_count (p.body_count) is skipped: `data` keeps what it held there.
+void halo_pack(const Particles& particles, const Bodies& bodies, const std::vector<uint>& index,
+               const StepParams& p, std::vector<vec4>& data);
+
+/// halo_unpack: the reverse of halo_pack, the same entries (out of range: nothing written).
+/// Returns whether a particle it wrote is too far from its `ref`
+/// (shared::neighbour_moved_too_far).
+bool halo_unpack(Particles& particles, Bodies& bodies, const std::vector<uint>& index,
+                 const std::vector<vec4>& data, const StepParams& p, const std::vector<vec4>& ref);
+
+/// particles_displacement: the largest shared::displacement2_bits(pos[i], ref[i]) over particles
+/// [0, p.particle_count); 0 when there is none.
+uint particles_displacement(const std::vector<vec4>& pos, const std::vector<vec4>& ref,
+                            const StepParams& p);
+
 /// One whole step in the core's order (the grid and the lists are skipped: the brute-force
 /// contacts do not need them).
 void step(Particles& particles, Bodies& bodies, const std::vector<ContactLaw>& laws,
