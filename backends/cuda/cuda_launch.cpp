@@ -7,9 +7,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <string>
 
 #include "cuda_device.h"
-#include "shared/halo.h"
 
 namespace motes::cuda {
 
@@ -70,24 +70,8 @@ void CudaDevice::enqueue(Kernel k, const shared::StepParams& p) {
     return;
   }
   // The halo entries and the partition's buffers exist only in runs over MPI ranks (Sizes).
-  if (k == Kernel::HaloPack || k == Kernel::HaloUnpack) {
-    const std::uint64_t words =
-        std::uint64_t{p.halo_first} + p.halo_particles + std::uint64_t{p.halo_bodies};
-    const std::uint64_t vec4s = std::uint64_t{MOTES_HALO_PARTICLE_VEC4S} * p.halo_particles +
-                                std::uint64_t{MOTES_HALO_BODY_VEC4S} * p.halo_bodies;
-    if (words > sizes_.halo_index || vec4s > sizes_.halo_data) {
-      error_ = Status::error(fmt::format(
-          "cuda: {} launched with {} particle and {} body entries from HaloIndex word {} ({} "
-          "words, {} vec4s of HaloData) on buffers allocated for {} words and {} vec4s",
-          kernel_name(k), p.halo_particles, p.halo_bodies, p.halo_first, words, vec4s,
-          sizes_.halo_index, sizes_.halo_data));
-      return;
-    }
-  }
-  if (k == Kernel::ParticlesDisplacement && sizes_.partition == 0) {
-    error_ = Status::error(
-        fmt::format("cuda: {} launched on buffers allocated without a partition (Sizes::partition)",
-                    kernel_name(k)));
+  if (std::string why = halo_launch_error(k, p, sizes_); !why.empty()) {
+    error_ = Status::error("cuda: " + why);
     return;
   }
   pending_.push_back({k, p});

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <string>
 
 #include "vulkan_device.h"
 
@@ -25,6 +26,12 @@ constexpr std::size_t kSubmitBatch = 512;
 void VulkanDevice::enqueue(Kernel k, const shared::StepParams& p) {
   if (!allocated_) {
     if (error_) error_ = Status::error("vulkan: kernel launched before allocate");
+    return;
+  }
+  // The halo entries and the partition's buffers exist only in runs over MPI ranks (Sizes): a
+  // call beyond them would read and write past a buffer.
+  if (std::string why = halo_launch_error(k, p, sizes_); !why.empty()) {
+    if (error_) error_ = Status::error("vulkan: " + why);
     return;
   }
   pending_.push_back({k, p});

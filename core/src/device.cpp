@@ -9,6 +9,7 @@
 #include <limits>
 #include <vector>
 
+#include "shared/halo.h"
 #include "shared/links.h"
 #include "shared/shape_matching.h"
 
@@ -261,6 +262,33 @@ Sizes scale_sizes(const Sizes& sizes, std::uint32_t particles) {
   s.halo_data = scale(sizes.halo_data);
   s.table = grid_table_size(particles);
   return s;
+}
+
+std::string halo_launch_error(Kernel k, const shared::StepParams& p, const Sizes& sizes) {
+  if (k != Kernel::HaloPack && k != Kernel::HaloUnpack && k != Kernel::ParticlesDisplacement) {
+    return {};
+  }
+  if (p.particle_count > sizes.particles || p.body_count > sizes.bodies) {
+    return fmt::format(
+        "{} launched with {} particles and {} bodies on buffers allocated for {} "
+        "and {}",
+        kernel_name(k), p.particle_count, p.body_count, sizes.particles, sizes.bodies);
+  }
+  if (k == Kernel::ParticlesDisplacement) {
+    if (sizes.partition != 0) return {};
+    return fmt::format("{} launched on buffers allocated without a partition (Sizes::partition)",
+                       kernel_name(k));
+  }
+  const std::uint64_t words =
+      std::uint64_t{p.halo_first} + p.halo_particles + std::uint64_t{p.halo_bodies};
+  const std::uint64_t vec4s = std::uint64_t{MOTES_HALO_PARTICLE_VEC4S} * p.halo_particles +
+                              std::uint64_t{MOTES_HALO_BODY_VEC4S} * p.halo_bodies;
+  if (words <= sizes.halo_index && vec4s <= sizes.halo_data) return {};
+  return fmt::format(
+      "{} launched with {} particle and {} body entries from HaloIndex word {} ({} words, {} "
+      "vec4s of HaloData) on buffers allocated for {} words and {} vec4s",
+      kernel_name(k), p.halo_particles, p.halo_bodies, p.halo_first, words, vec4s, sizes.halo_index,
+      sizes.halo_data);
 }
 
 BufferSize Device::largest_buffer(const Sizes& sizes) const {

@@ -169,6 +169,44 @@ TEST(DeviceLimits, HaloAndPartitionBuffersAreEmptyInOneProcess) {
   EXPECT_EQ(motes::buffers_bytes(s), single + 300u * 4u + 800u * 16u + 1000u * 16u + 4u);
 }
 
+// The GPU backends' launch guard for the families of runs over MPI ranks: entries beyond
+// HaloIndex or HaloData, particles or bodies beyond theirs, a displacement without the
+// partition's buffers are named; a call that fits, and every other family, pass.
+TEST(DeviceLimits, HaloLaunchesBeyondTheirBuffersAreNamed) {
+  Sizes s;
+  s.particles = 100;
+  s.bodies = 10;
+  s.halo_index = 20;
+  s.halo_data = 2 * 8 + 5 * 4;
+  StepParams p{};
+  p.particle_count = 100;
+  p.body_count = 10;
+  p.halo_first = 8;
+  p.halo_particles = 8;
+  p.halo_bodies = 4;
+  using motes::Kernel;
+  EXPECT_EQ(motes::halo_launch_error(Kernel::HaloPack, p, s), "");  // exactly fits
+  EXPECT_EQ(motes::halo_launch_error(Kernel::HaloUnpack, p, s), "");
+  p.halo_first = 9;  // one word past HaloIndex
+  EXPECT_NE(motes::halo_launch_error(Kernel::HaloPack, p, s).find("HaloIndex word 9 (21 words"),
+            std::string::npos);
+  EXPECT_NE(motes::halo_launch_error(Kernel::HaloUnpack, p, s), "");
+  EXPECT_EQ(motes::halo_launch_error(Kernel::ContactsCompute, p, s), "");  // not its business
+  p.halo_first = 0;
+  p.halo_bodies = 5;  // 21 words fit, 41 vec4s do not
+  EXPECT_NE(motes::halo_launch_error(Kernel::HaloPack, p, s).find("41 vec4s"), std::string::npos);
+  p.halo_bodies = 4;
+  p.body_count = 11;
+  EXPECT_NE(motes::halo_launch_error(Kernel::HaloUnpack, p, s), "");
+  p.body_count = 10;
+  EXPECT_NE(motes::halo_launch_error(Kernel::ParticlesDisplacement, p, s).find("partition"),
+            std::string::npos);
+  s.partition = 1;
+  EXPECT_EQ(motes::halo_launch_error(Kernel::ParticlesDisplacement, p, s), "");
+  p.particle_count = 101;
+  EXPECT_NE(motes::halo_launch_error(Kernel::ParticlesDisplacement, p, s), "");
+}
+
 // More than the device has: refused before any allocation, naming the scene, both numbers and
 // the largest count; a scene of that many free spheres is created on the same device.
 TEST(DeviceLimits, SimulationRefusesMoreThanTheDeviceHasBeforeAllocating) {

@@ -207,6 +207,13 @@ struct KernelTimes {
   std::array<std::uint64_t, kKernelCount> launches{};
 };
 
+/// Why a call of a family of runs over MPI ranks (halo_pack, halo_unpack,
+/// particles_displacement) with these parameters would reach outside buffers allocated for
+/// `sizes`: halo entries beyond HaloIndex or HaloData, particles or bodies beyond theirs, no
+/// partition buffers; "" when it stays inside, and for every other family. The GPU backends
+/// refuse such a call before anything runs (their first error, sticky).
+std::string halo_launch_error(Kernel k, const shared::StepParams& p, const Sizes& sizes);
+
 /// One device of one backend, as listed by `motes devices`.
 struct DeviceInfo {
   std::string backend;  ///< "openmp", "cuda", "vulkan"
