@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "conformance.h"
+#include "motes/devices.h"
 #include "reference/reference.h"
 #include "shared/halo.h"
 #include "shared/neighbours.h"
@@ -359,6 +360,54 @@ TEST_P(HaloRoundTrip, Scrambled1234) { run_case("scrambled", make_halo(322, 1234
 TEST_P(HaloRoundTrip, Scrambled65536) { run_case("scrambled", make_halo(323, 65536, 65536)); }
 
 INSTANTIATE_TEST_SUITE_P(Conformance, HaloRoundTrip, testing::ValuesIn(device_params()),
+                         param_name);
+
+/// A halo call beyond the buffers allocated for it is refused before it runs (the GPU backends'
+/// launch guard, motes::halo_launch_error): synchronize() names it, and no guard word is touched.
+/// The openmp device checks no launch parameters (it has no error to report them through).
+class HaloLaunchGuard : public DeviceTest {
+ protected:
+  [[nodiscard]] bool wants_device() const override { return false; }  // it is left failed
+  void run_case(const std::string& layout, motes::Kernel kernel, const Halo& h, StepParams p) {
+    if (GetParam().backend == "openmp") GTEST_SKIP() << "openmp checks no launch parameters";
+    auto opened = motes::open_device(GetParam().backend, GetParam().index);
+    ASSERT_TRUE(opened) << opened.message();
+    motes::Device& d = *opened.value();
+    ASSERT_TRUE(d.allocate(h.sizes));
+    ASSERT_TRUE(d.write(Buffer::HaloIndex, h.index.data(), h.index.size() * sizeof(uint)));
+    if (kernel == motes::Kernel::HaloPack) d.halo_pack(p);
+    if (kernel == motes::Kernel::HaloUnpack) d.halo_unpack(p);
+    if (kernel == motes::Kernel::ParticlesDisplacement) d.particles_displacement(p);
+    const motes::Status s = d.synchronize();
+    begin_case(std::string(motes::kernel_name(kernel)) + "/" + layout, h.entries());
+    check_that("the call is refused", !s);
+    check_that("the refusal names the launch",
+               s.message().find(motes::kernel_name(kernel)) != std::string::npos);
+    end_case();
+  }
+};
+
+TEST_P(HaloLaunchGuard, PackPastHaloIndex) {
+  const Halo h = make_halo(331, 31, 31);
+  StepParams p = h.params;
+  p.halo_first = h.sizes.halo_index - p.halo_particles - p.halo_bodies + 1;
+  run_case("refused_past_halo_index", motes::Kernel::HaloPack, h, p);
+}
+
+TEST_P(HaloLaunchGuard, UnpackPastHaloData) {
+  const Halo h = make_halo(332, 31, 31);
+  StepParams p = h.params;
+  p.halo_first = 0;
+  p.halo_particles += 2;  // still within HaloIndex (junk words), not within HaloData
+  run_case("refused_past_halo_data", motes::Kernel::HaloUnpack, h, p);
+}
+
+TEST_P(HaloLaunchGuard, DisplacementWithoutPartition) {
+  const Halo h = make_halo(333, 31, 31);  // Sizes::partition = 0
+  run_case("refused_without_partition", motes::Kernel::ParticlesDisplacement, h, h.params);
+}
+
+INSTANTIATE_TEST_SUITE_P(Conformance, HaloLaunchGuard, testing::ValuesIn(device_params()),
                          param_name);
 
 }  // namespace
