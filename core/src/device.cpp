@@ -270,8 +270,7 @@ std::string halo_launch_error(Kernel k, const shared::StepParams& p, const Sizes
   }
   if (p.particle_count > sizes.particles || p.body_count > sizes.bodies) {
     return fmt::format(
-        "{} launched with {} particles and {} bodies on buffers allocated for {} "
-        "and {}",
+        "{} launched with {} particles and {} bodies on buffers allocated for {} and {}",
         kernel_name(k), p.particle_count, p.body_count, sizes.particles, sizes.bodies);
   }
   if (k == Kernel::ParticlesDisplacement) {
