@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -15,6 +16,7 @@
 #include "motes/cloth.h"
 #include "motes/soft.h"
 #include "shared/body_math.h"
+#include "shared/halo.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
 
@@ -81,7 +83,17 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene,
   if (!device) return Status::error("Simulation::create: no device");
   std::unique_ptr<Simulation> sim(new Simulation());
   sim->device_ = std::move(device);
-  if (Status s = sim->upload(scene); !s) return s;
+  if (Status s = sim->upload(scene, nullptr); !s) return s;
+  return sim;
+}
+
+Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene,
+                                                       std::unique_ptr<Device> device,
+                                                       const HaloLists& halo) {
+  if (!device) return Status::error("Simulation::create: no device");
+  std::unique_ptr<Simulation> sim(new Simulation());
+  sim->device_ = std::move(device);
+  if (Status s = sim->upload(scene, &halo); !s) return s;
   return sim;
 }
 
@@ -91,7 +103,7 @@ std::unique_ptr<Device> Simulation::take_device(std::unique_ptr<Simulation> sim)
   return std::move(sim->device_);
 }
 
-Status Simulation::upload(const Scene& scene) {
+Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
   settings_ = scene.settings;
   if (!(settings_.dt > 0.0) || !std::isfinite(settings_.dt) || settings_.substeps < 1) {
     return Status::error(fmt::format("{}: dt must be > 0 and substeps >= 1 (dt {}, substeps {})",
@@ -163,12 +175,17 @@ Status Simulation::upload(const Scene& scene) {
     return Status::error(
         fmt::format("{}: {} particles is more than motes supports (2^31)", scene.source, n));
   }
-  const double skin =
-      settings_.neighbour_skin >= 0.0 ? settings_.neighbour_skin : 0.1 * max_diameter;
+  // One rank of a run over MPI ranks builds the grid the whole scene would have (its largest
+  // diameter, hence cell and skin, and its table size), so that cells hash alike on every rank
+  // and a particle meets its partners in the same order at any rank count.
+  if (halo != nullptr) max_diameter = std::max(max_diameter, halo->scene_diameter);
+  const double skin = neighbour_skin(settings_, max_diameter);
   sizes_.particles = static_cast<std::uint32_t>(n);
   sizes_.rigid_particles = static_cast<std::uint32_t>(rigid_particles);
   sizes_.bodies = static_cast<std::uint32_t>(rigid_bodies);
-  sizes_.table = grid_table_size(sizes_.particles);
+  sizes_.table = grid_table_size(
+      halo != nullptr ? std::max<std::uint32_t>(halo->scene_particles, sizes_.particles)
+                      : sizes_.particles);
   sizes_.materials = static_cast<std::uint32_t>(scene.materials.size());
   sizes_.planes = static_cast<std::uint32_t>(scene.planes.size());
   sizes_.neighbour_capacity = static_cast<std::uint32_t>(settings_.neighbour_capacity);
@@ -287,6 +304,7 @@ Status Simulation::upload(const Scene& scene) {
                             static_cast<double>(settings_.substeps);
         soft_spec.stiffness = std::min(1.0, turn * turn);
       }
+      bodies_.back().first_cluster = static_cast<std::uint32_t>(soft.clusters.size());
       if (Status st = add_soft_body(soft_spec, world, mp.particle_mass,
                                     settings_.dt / static_cast<double>(settings_.substeps),
                                     device_index_[bi], soft);
@@ -294,6 +312,8 @@ Status Simulation::upload(const Scene& scene) {
         return Status::error(
             fmt::format("{}: body '{}': {}", scene.source, spec.name, st.message()));
       }
+      bodies_.back().cluster_count =
+          static_cast<std::uint32_t>(soft.clusters.size()) - bodies_.back().first_cluster;
       continue;
     }
     if (free) {
@@ -492,17 +512,53 @@ Status Simulation::upload(const Scene& scene) {
                                      scene.source, exclusions.size()));
   }
   sizes_.link_exclusions = static_cast<std::uint32_t>(exclusions.size());
+  // A rank of a run over MPI ranks: the halo lists as device indices (shared/halo.h).
+  std::vector<std::uint32_t> halo_index;
+  if (halo != nullptr) {
+    std::array<std::vector<std::uint32_t>, 4> parts;
+    const auto add_entries = [&](const std::vector<std::uint32_t>& list,
+                                 std::vector<std::uint32_t>& particles,
+                                 std::vector<std::uint32_t>& rigid) -> Status {
+      for (const std::uint32_t b : list) {
+        if (b >= bodies_.size()) {
+          return Status::error(
+              fmt::format("{}: halo list names body {} of {}", scene.source, b, bodies_.size()));
+        }
+        const BodyInfo& info = bodies_[b];
+        const bool body_state = !info.free_sphere && !info.linked && !info.soft;
+        const std::uint32_t first = body_state ? rigid_first_[device_index_[b]] : device_index_[b];
+        for (std::uint32_t k = 0; k < info.particle_count; ++k) particles.push_back(first + k);
+        if (body_state) rigid.push_back(device_index_[b]);
+      }
+      return Status::ok();
+    };
+    if (Status st = add_entries(halo->send, parts[0], parts[1]); !st) return st;
+    if (Status st = add_entries(halo->receive, parts[2], parts[3]); !st) return st;
+    std::uint64_t data = 0;
+    for (std::size_t k = 0; k < 4; ++k) {
+      halo_entries_[k] = static_cast<std::uint32_t>(parts[k].size());
+      halo_index.insert(halo_index.end(), parts[k].begin(), parts[k].end());
+      if (k % 2 == 1) {
+        data = std::max<std::uint64_t>(
+            data, std::uint64_t{MOTES_HALO_PARTICLE_VEC4S} * parts[k - 1].size() +
+                      std::uint64_t{MOTES_HALO_BODY_VEC4S} * parts[k].size());
+      }
+    }
+    if (data > std::numeric_limits<std::uint32_t>::max() / 2) {
+      return Status::error(fmt::format("{}: a halo of {} vec4s", scene.source, data));
+    }
+    sizes_.halo_index = static_cast<std::uint32_t>(halo_index.size());
+    sizes_.halo_data = static_cast<std::uint32_t>(data);
+    sizes_.partition = 1;
+  }
   if (Status st = check_memory(); !st) return st;
 
   // The setup's fingerprint: every fixed input of a step (checkpoints load only where it is
   // equal). Computed from the host's copies, so it is the same on every backend.
-  // Sizes before the fields of runs over MPI ranks, which a single process leaves 0: its hash
-  // (and so a checkpoint's) is what it was before they existed.
+  // Sizes before the fields of runs over MPI ranks: a single process's hash (and so a
+  // checkpoint's) is what it was before they existed, and the halo's sizes, which change with
+  // every partition of a run over MPI ranks, say nothing about the physics.
   std::uint64_t h = fnv1a64(&sizes_, kSizesBeforeMpi);
-  if (sizes_.halo_index != 0 || sizes_.halo_data != 0 || sizes_.partition != 0) {
-    h = fnv1a64(reinterpret_cast<const unsigned char*>(&sizes_) + kSizesBeforeMpi,
-                sizeof sizes_ - kSizesBeforeMpi, h);
-  }
   h = fnv1a64(&params_, sizeof params_, h);
   const std::int64_t counts[2] = {settings_.substeps, settings_.constraint_iterations};
   h = fnv1a64(counts, sizeof counts, h);
@@ -558,6 +614,8 @@ Status Simulation::upload(const Scene& scene) {
   if (s) s = write_vector(d, Buffer::ClusterFrames, frames);
   if (s) s = write_vector(d, Buffer::ClusterGather, gather);
   if (s) s = write_vector(d, Buffer::LinkExclusions, exclusions);
+  if (s) s = write_vector(d, Buffer::HaloIndex, halo_index);
+  if (s && sizes_.partition != 0) s = write_vector(d, Buffer::PartitionRefPos, ppos);
   if (s) s = clear_contact_history();
   if (!s) return s;
   // Rigid particles take their pose from the bodies with the device's own arithmetic.
@@ -741,6 +799,39 @@ Status Simulation::write_state(const Snapshot& state) {
   return Status::ok();
 }
 
+namespace {
+
+/// ContactImpulse's slot of rigid device particle i with plane q (Buffer::ContactImpulse).
+std::size_t plane_slot(const Sizes& sizes, std::uint32_t i, std::uint32_t q) {
+  return (std::size_t{sizes.neighbour_capacity} + q) * sizes.rigid_particles + i;
+}
+
+}  // namespace
+
+Status Simulation::read_plane_impulses(Snapshot& state) {
+  state.plane_impulse.clear();
+  if (sizes_.impulse == 0 || sizes_.planes == 0) return Status::ok();
+  std::vector<vec4> acc;
+  if (Status s = read_vector(*device_, Buffer::ContactImpulse, acc,
+                             buffer_layout(Buffer::ContactImpulse, sizes_).count);
+      !s) {
+    return s;
+  }
+  state.plane_impulse.assign(std::size_t{sizes_.particles} * sizes_.planes, vec4(0.0f));
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    const BodyInfo& info = bodies_[b];
+    if (info.free_sphere || info.linked || info.soft) continue;
+    const std::uint32_t first = rigid_first_[device_index_[b]];
+    for (std::uint32_t k = 0; k < info.particle_count; ++k) {
+      for (std::uint32_t q = 0; q < sizes_.planes; ++q) {
+        state.plane_impulse[(std::size_t{info.first_particle} + k) * sizes_.planes + q] =
+            acc[plane_slot(sizes_, first + k, q)];
+      }
+    }
+  }
+  return Status::ok();
+}
+
 Status Simulation::restore(const Snapshot& state, bool rebuild) {
   Device& d = *device_;
   const std::size_t n = sizes_.particles;
@@ -770,8 +861,27 @@ Status Simulation::restore(const Snapshot& state, bool rebuild) {
   if (s) s = write_vector(d, Buffer::BodyVel, bvel);
   if (s) s = write_vector(d, Buffer::BodyAngMom, bangmom);
   if (s) s = write_vector(d, Buffer::BodyAngVel, bangvel);
+  if (s && !rebuild && sizes_.partition != 0) s = write_vector(d, Buffer::PartitionRefPos, ppos);
   if (s && rebuild) s = d.write(Buffer::NeighbourState, neighbour_state, sizeof neighbour_state);
   if (s && rebuild) s = clear_contact_history();
+  if (s && sizes_.impulse != 0 && sizes_.planes > 0 &&
+      state.plane_impulse.size() == std::size_t{n} * sizes_.planes) {
+    std::vector<vec4> acc;
+    s = read_vector(d, Buffer::ContactImpulse, acc,
+                    buffer_layout(Buffer::ContactImpulse, sizes_).count);
+    for (std::size_t b = 0; s && b < bodies_.size(); ++b) {
+      const BodyInfo& info = bodies_[b];
+      if (info.free_sphere || info.linked || info.soft) continue;
+      const std::uint32_t first = rigid_first_[device_index_[b]];
+      for (std::uint32_t k = 0; k < info.particle_count; ++k) {
+        for (std::uint32_t q = 0; q < sizes_.planes; ++q) {
+          acc[plane_slot(sizes_, first + k, q)] =
+              state.plane_impulse[(std::size_t{info.first_particle} + k) * sizes_.planes + q];
+        }
+      }
+    }
+    if (s) s = write_vector(d, Buffer::ContactImpulse, acc);
+  }
   if (s && state.cluster_rotation.size() == sizes_.clusters && sizes_.clusters > 0) {
     std::vector<shared::ClusterFrame> frames;
     s = read_vector(d, Buffer::ClusterFrames, frames, sizes_.clusters);
@@ -860,7 +970,62 @@ Result<NeighbourStats> Simulation::neighbour_stats() {
   out.builds = words[MOTES_NEIGHBOUR_BUILDS];
   out.over_capacity = words[MOTES_NEIGHBOUR_OVER_CAPACITY];
   out.max_count = words[MOTES_NEIGHBOUR_MAX_COUNT];
+  out.rebuild_pending = words[MOTES_NEIGHBOUR_REBUILD] != 0;
   return out;
+}
+
+Status Simulation::halo_pack(std::vector<vec4>& out) {
+  const std::uint32_t particles = halo_entries_[0];
+  const std::uint32_t rigid = halo_entries_[1];
+  out.resize(std::size_t{MOTES_HALO_PARTICLE_VEC4S} * particles +
+             std::size_t{MOTES_HALO_BODY_VEC4S} * rigid);
+  if (out.empty()) return device_->synchronize();
+  shared::StepParams p = params_;
+  p.halo_particles = particles;
+  p.halo_bodies = rigid;
+  p.halo_first = 0;
+  device_->halo_pack(p);
+  return device_->read(Buffer::HaloData, out.data(), out.size() * sizeof(vec4));
+}
+
+Status Simulation::halo_unpack(const std::vector<vec4>& in) {
+  const std::uint32_t particles = halo_entries_[2];
+  const std::uint32_t rigid = halo_entries_[3];
+  const std::size_t want = std::size_t{MOTES_HALO_PARTICLE_VEC4S} * particles +
+                           std::size_t{MOTES_HALO_BODY_VEC4S} * rigid;
+  if (in.size() != want) {
+    return Status::error(
+        fmt::format("halo_unpack: {} vec4s for a halo of {} particles and {} "
+                    "rigid bodies ({} vec4s)",
+                    in.size(), particles, rigid, want));
+  }
+  if (in.empty()) return Status::ok();
+  if (Status s = device_->write(Buffer::HaloData, in.data(), in.size() * sizeof(vec4)); !s) {
+    return s;
+  }
+  shared::StepParams p = params_;
+  p.halo_particles = particles;
+  p.halo_bodies = rigid;
+  p.halo_first = halo_entries_[0] + halo_entries_[1];
+  device_->halo_unpack(p);
+  return Status::ok();
+}
+
+Status Simulation::request_rebuild() {
+  const std::uint32_t rebuild = 1;  // the first word, MOTES_NEIGHBOUR_REBUILD
+  static_assert(MOTES_NEIGHBOUR_REBUILD == 0u);
+  return device_->write(Buffer::NeighbourState, &rebuild, sizeof rebuild);
+}
+
+Result<double> Simulation::partition_displacement() {
+  if (sizes_.partition == 0) {
+    return Status::error("partition_displacement: a simulation without a partition reference");
+  }
+  device_->particles_displacement(params_);
+  std::uint32_t bits = 0;
+  if (Status s = device_->read(Buffer::PartitionCheck, &bits, sizeof bits); !s) return s;
+  if (bits >= MOTES_PARTITION_NOT_FINITE) return std::numeric_limits<double>::infinity();
+  return std::sqrt(static_cast<double>(std::bit_cast<float>(bits)));
 }
 
 namespace {

@@ -9,6 +9,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <unordered_map>
+
+#include "shared/halo.h"
 
 namespace motes {
 
@@ -74,27 +77,50 @@ Status status_of(const Result<T>& r) {
   return r ? Status::ok() : r.status();
 }
 
+/// A record on the wire: (body, particles, cluster rotations, plane impulses) as bits, the five
+/// body vectors, the positions, the velocities, the rotations, the plane impulses.
 void append(std::vector<vec4>& out, const Record& r) {
-  out.push_back(vec4(std::bit_cast<float>(r.body),
-                     std::bit_cast<float>(static_cast<std::uint32_t>(r.pos.size())), 0.0f, 0.0f));
+  const auto bits = [](std::size_t n) {
+    return std::bit_cast<float>(static_cast<std::uint32_t>(n));
+  };
+  out.push_back(vec4(std::bit_cast<float>(r.body), bits(r.pos.size()), bits(r.rotations.size()),
+                     bits(r.planes.size())));
   out.insert(out.end(), r.state.begin(), r.state.end());
   out.insert(out.end(), r.pos.begin(), r.pos.end());
   out.insert(out.end(), r.vel.begin(), r.vel.end());
+  out.insert(out.end(), r.rotations.begin(), r.rotations.end());
+  out.insert(out.end(), r.planes.begin(), r.planes.end());
 }
 
-std::vector<Record> parse(const std::vector<vec4>& in) {
+/// The records in `in`, as append wrote them; with `counts` (vec4s from each rank, in rank
+/// order), `source` gets each record's rank.
+std::vector<Record> parse(const std::vector<vec4>& in, const std::vector<int>* counts = nullptr,
+                          std::vector<int>* source = nullptr) {
   std::vector<Record> records;
+  std::size_t rank = 0;
+  std::size_t rank_end = counts != nullptr && !counts->empty() ? (*counts)[0] : in.size();
   for (std::size_t at = 0; at < in.size();) {
+    while (counts != nullptr && at >= rank_end && rank + 1 < counts->size()) {
+      rank_end += static_cast<std::size_t>((*counts)[++rank]);
+    }
     Record r;
     r.body = std::bit_cast<std::uint32_t>(in[at].x);
     const std::size_t n = std::bit_cast<std::uint32_t>(in[at].y);
+    const std::size_t c = std::bit_cast<std::uint32_t>(in[at].z);
+    const std::size_t q = std::bit_cast<std::uint32_t>(in[at].w);
     std::copy_n(in.begin() + static_cast<std::ptrdiff_t>(at + 1), 5, r.state.begin());
-    const auto first = in.begin() + static_cast<std::ptrdiff_t>(at + 6);
-    r.pos.assign(first, first + static_cast<std::ptrdiff_t>(n));
-    r.vel.assign(first + static_cast<std::ptrdiff_t>(n),
-                 first + static_cast<std::ptrdiff_t>(2 * n));
-    at += 6 + 2 * n;
+    auto next = in.begin() + static_cast<std::ptrdiff_t>(at + 6);
+    const auto take = [&next](std::vector<vec4>& v, std::size_t count) {
+      v.assign(next, next + static_cast<std::ptrdiff_t>(count));
+      next += static_cast<std::ptrdiff_t>(count);
+    };
+    take(r.pos, n);
+    take(r.vel, n);
+    take(r.rotations, c);
+    take(r.planes, q);
+    at += 6 + 2 * n + c + q;
     records.push_back(std::move(r));
+    if (source != nullptr) source->push_back(static_cast<int>(rank));
   }
   return records;
 }
@@ -183,42 +209,18 @@ Status agree(MPI_Comm comm, const Status& mine, double* largest) {
 }
 
 Result<std::unique_ptr<DistributedSimulation>> DistributedSimulation::create(
-    const Scene& scene, MPI_Comm comm, DeviceOpener open_device,
-    const DistributedOptions& options) {
+    Scene whole, MPI_Comm comm, DeviceOpener open_device, const DistributedOptions& options) {
   std::unique_ptr<DistributedSimulation> d(new DistributedSimulation());
   d->comm_ = comm;
   MPI_Comm_rank(comm, &d->rank_);
   MPI_Comm_size(comm, &d->size_);
   d->open_device_ = std::move(open_device);
-  d->scene_ = scene;
-
-  // What a partition cannot split yet is refused the same way on every rank.
-  Status supported = Status::ok();
-  if (scene.settings.contact_model == ContactModel::Impulses) {
-    supported = Status::error(scene.source +
-                              ": impulse contacts do not run over several MPI ranks yet "
-                              "(docs/scale-out.md); run this scene on one rank");
-  }
-  for (const BodySpec& b : scene.bodies) {
-    if (supported && b.soft) {
-      supported = Status::error(
-          fmt::format("{}: body '{}' is soft: soft bodies do not run over several MPI ranks yet "
-                      "(docs/scale-out.md); run this scene on one rank",
-                      scene.source, b.name));
-    }
-  }
-  for (const LinkedSpec& l : scene.linked) {
-    if (supported && !l.attached.empty()) {
-      supported = Status::error(fmt::format(
-          "{}: '{}' is attached to a body: attachments do not run over several MPI ranks yet "
-          "(docs/scale-out.md); run this scene on one rank",
-          scene.source, l.name));
-    }
-  }
+  d->scene_ = std::move(whole);
+  d->group_bodies();
+  const Scene& scene = d->scene_;
   const std::vector<Eigen::Vector3d> centres = body_centres(scene);
   Result<Decomposition> decomposition =
-      supported ? choose_decomposition(centres, d->size_, options.decomposition)
-                : Result<Decomposition>(supported);
+      choose_decomposition(centres, d->size_, options.decomposition);
   if (Status s = agree(comm, status_of(decomposition)); !s) return s;
   d->decomposition_ = decomposition.value();
 
@@ -246,15 +248,24 @@ Result<std::unique_ptr<DistributedSimulation>> DistributedSimulation::create(
     d->bodies_.push_back(info);
   }
   d->particles_ = first;
+  d->scene_diameter_ = diameter;
+  // Every rank's lists have the skin of one process's (Simulation: the scene's largest diameter).
+  d->skin_ = Simulation::neighbour_skin(scene.settings, diameter);
   d->margin_ = options.margin >= 0.0 ? options.margin : 0.5 * diameter;
   d->halo_width_ = 2.0 * d->margin_;
 
-  // Each rank builds the bodies whose centre starts in its brick; the first partition then sends
+  // Each rank builds the groups whose centre starts in its brick; the first partition then sends
   // any whose centre of mass lies elsewhere to its owner and chooses the halos.
   std::vector<std::uint32_t> mine;
-  for (std::uint32_t b = 0; b < centres.size(); ++b) {
-    if (d->decomposition_.owner(centres[b]) == d->rank_) mine.push_back(b);
+  for (const std::vector<std::uint32_t>& members : d->groups_) {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const std::uint32_t b : members) centre += centres[b];
+    centre /= static_cast<double>(members.size());
+    if (d->decomposition_.owner(centre) == d->rank_) {
+      mine.insert(mine.end(), members.begin(), members.end());
+    }
   }
+  std::sort(mine.begin(), mine.end());
   Status built = Status::ok();
   if (!mine.empty()) {
     Result<std::unique_ptr<Device>> device = d->open_device_();
@@ -290,6 +301,8 @@ Result<std::vector<Record>> DistributedSimulation::owned_records() {
   if (!local_) return records;
   Result<Snapshot> snap = local_->snapshot();
   if (!snap) return status_of(snap);
+  if (Status s = local_->read_plane_impulses(snap.value()); !s) return s;
+  const std::size_t planes = scene_.planes.size();
   const std::vector<BodyInfo>& infos = local_->bodies();
   for (std::size_t k = 0; k < local_bodies_.size(); ++k) {
     if (local_owned_[k] == 0) continue;
@@ -302,19 +315,88 @@ Result<std::vector<Record>> DistributedSimulation::owned_records() {
     const auto v = snap->particle_vel.begin() + info.first_particle;
     r.pos.assign(p, p + info.particle_count);
     r.vel.assign(v, v + info.particle_count);
+    const auto q = snap->cluster_rotation.begin() + info.first_cluster;
+    r.rotations.assign(q, q + info.cluster_count);
+    if (!snap->plane_impulse.empty()) {
+      const auto a = snap->plane_impulse.begin() + std::ptrdiff_t{info.first_particle} * planes;
+      r.planes.assign(a, a + std::ptrdiff_t{info.particle_count} * planes);
+    }
     records.push_back(std::move(r));
   }
   return records;
 }
 
+void DistributedSimulation::group_bodies() {
+  // Union-find over the scene's bodies (then its cloths and ropes).
+  const std::size_t rigid = scene_.bodies.size();
+  std::vector<std::uint32_t> parent(rigid + scene_.linked.size());
+  for (std::uint32_t b = 0; b < parent.size(); ++b) parent[b] = b;
+  const auto find = [&](std::uint32_t b) {
+    while (parent[b] != b) b = parent[b] = parent[parent[b]];
+    return b;
+  };
+  const auto unite = [&](std::uint32_t a, std::uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  };
+  // A cloth or rope and the bodies it is attached to: the links pull on them within a substep.
+  for (std::size_t l = 0; l < scene_.linked.size(); ++l) {
+    for (const LinkAttachment& a : scene_.linked[l].attached) {
+      for (std::uint32_t b = 0; b < rigid; ++b) {
+        if (scene_.bodies[b].name == a.body) {
+          unite(static_cast<std::uint32_t>(rigid + l), b);
+          break;
+        }
+      }
+    }
+  }
+  // With impulse contacts, every rigid body: an impulse iteration passes velocities from body to
+  // body through every contact, as far as the iterations reach.
+  if (scene_.settings.contact_model == ContactModel::Impulses) {
+    std::uint32_t first = UINT32_MAX;
+    for (std::uint32_t b = 0; b < rigid; ++b) {
+      if (scene_.bodies[b].soft) continue;
+      if (first == UINT32_MAX) first = b;
+      unite(first, b);
+    }
+  }
+  group_of_.assign(parent.size(), 0);
+  groups_.clear();
+  std::vector<std::uint32_t> index(parent.size(), UINT32_MAX);
+  for (std::uint32_t b = 0; b < parent.size(); ++b) {
+    const std::uint32_t root = find(b);
+    if (index[root] == UINT32_MAX) {
+      index[root] = static_cast<std::uint32_t>(groups_.size());
+      groups_.emplace_back();
+    }
+    group_of_[b] = index[root];
+    groups_[index[root]].push_back(b);
+  }
+}
+
 Status DistributedSimulation::partition(std::vector<Record> held) {
   const Clock::time_point start = Clock::now();
   const auto ranks = static_cast<std::size_t>(size_);
-  // 1. Every body to the rank whose brick holds its centre (of mass).
+  // 1. Every group of bodies (a body alone, or bodies that must be stepped together: the mean of
+  // its members' centres, summed in scene order) to the rank whose brick holds its centre.
+  std::sort(held.begin(), held.end(),
+            [](const Record& a, const Record& b) { return a.body < b.body; });
+  std::unordered_map<std::uint32_t, Eigen::Vector3d> sums;  // groups of several bodies
+  for (const Record& r : held) {
+    const std::uint32_t g = group_of_[r.body];
+    if (groups_[g].size() > 1) {
+      sums.try_emplace(g, Eigen::Vector3d::Zero()).first->second += centre_of(r.state[0]);
+    }
+  }
   std::vector<std::vector<vec4>> out(ranks);
   std::uint64_t moved = 0;
   for (const Record& r : held) {
-    const int to = decomposition_.owner(centre_of(r.state[0]));
+    const std::uint32_t g = group_of_[r.body];
+    const Eigen::Vector3d centre =
+        groups_[g].size() > 1 ? Eigen::Vector3d(sums.at(g) / static_cast<double>(groups_[g].size()))
+                              : centre_of(r.state[0]);
+    const int to = decomposition_.owner(centre);
     if (to != rank_) ++moved;
     append(out[static_cast<std::size_t>(to)], r);
   }
@@ -347,32 +429,34 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
   }
   std::vector<double> all(6 * ranks);
   MPI_Allgather(mine, 6, MPI_DOUBLE, all.data(), 6, MPI_DOUBLE, comm_);
+  // A group goes whole: where one member comes near, all go (grouped bodies are stepped
+  // together, also as copies).
   std::vector<std::vector<std::uint32_t>> sent_bodies(ranks);
   for (auto& o : out) o.clear();
+  std::unordered_map<std::uint32_t, std::array<double, 6>> group_boxes;  // groups of several
   for (std::size_t k = 0; k < owned.size(); ++k) {
+    const std::uint32_t g = group_of_[owned[k].body];
+    if (groups_[g].size() == 1) continue;
+    auto [it, fresh] = group_boxes.try_emplace(g, boxes[k]);
+    for (std::size_t a = 0; a < 3 && !fresh; ++a) {
+      it->second[a] = std::min(it->second[a], boxes[k][a]);
+      it->second[a + 3] = std::max(it->second[a + 3], boxes[k][a + 3]);
+    }
+  }
+  for (std::size_t k = 0; k < owned.size(); ++k) {
+    const std::uint32_t g = group_of_[owned[k].body];
+    const std::array<double, 6>& box = groups_[g].size() == 1 ? boxes[k] : group_boxes.at(g);
     for (std::size_t r = 0; r < ranks; ++r) {
-      if (static_cast<int>(r) == rank_ || !overlap(boxes[k], &all[6 * r])) continue;
+      if (static_cast<int>(r) == rank_ || !overlap(box, &all[6 * r])) continue;
       append(out[r], owned[k]);
       sent_bodies[r].push_back(owned[k].body);
     }
   }
   Result<std::vector<vec4>> copies = all_to_all(comm_, out, counts);
   if (Status st = agree(comm_, status_of(copies)); !st) return st;
-  std::vector<Record> halo = parse(copies.value());
   // The copies arrive by source rank, each source's ascending; remember which came from whom.
   std::vector<int> source;
-  {
-    std::size_t at = 0;
-    std::vector<vec4> one;
-    for (std::size_t r = 0; r < ranks; ++r) {
-      std::size_t end = at + static_cast<std::size_t>(counts[r]);
-      while (at < end) {
-        const std::size_t n = std::bit_cast<std::uint32_t>(copies.value()[at].y);
-        source.push_back(static_cast<int>(r));
-        at += 6 + 2 * n;
-      }
-    }
-  }
+  std::vector<Record> halo = parse(copies.value(), &counts, &source);
 
   // 3. The local simulation: owned bodies and copies in scene order, on the device the last one
   // ran on (opened once per rank).
@@ -413,21 +497,50 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
   stats_.halo_bodies = halo.size();
   stats_.owned_particles = 0;
   stats_.halo_particles = 0;
-  reference_.clear();
+  HaloLists lists;
+  lists.scene_particles = static_cast<std::uint32_t>(particles_);
+  lists.scene_diameter = scene_diameter_;
+  for (std::size_t r = 0; r < ranks; ++r) {
+    lists.send.insert(lists.send.end(), send_[r].begin(), send_[r].end());
+    lists.receive.insert(lists.receive.end(), receive_[r].begin(), receive_[r].end());
+  }
+  for (auto* halves : {&send_counts_, &receive_counts_}) {
+    for (std::vector<int>& c : *halves) c.assign(ranks, 0);
+  }
   if (!entries.empty()) {
     Result<std::unique_ptr<Device>> device =
         spare_ ? Result<std::unique_ptr<Device>>(std::move(spare_)) : open_device_();
     Result<std::unique_ptr<Simulation>> sim =
-        device ? Simulation::create(sub_scene(scene_, local_bodies_), std::move(device).value())
-               : Result<std::unique_ptr<Simulation>>(status_of(device));
+        !device ? Result<std::unique_ptr<Simulation>>(status_of(device))
+        : size_ > 1
+            ? Simulation::create(sub_scene(scene_, local_bodies_), std::move(device).value(), lists)
+            : Simulation::create(sub_scene(scene_, local_bodies_), std::move(device).value());
     if (sim) {
       local_ = std::move(sim).value();
       device_info_ = local_->device().info();
       const std::vector<BodyInfo>& infos = local_->bodies();
+      // Each rank's part of the packed halo, in vec4s: the particles' part, the bodies' part.
+      const auto count = [&](const std::vector<std::vector<std::uint32_t>>& by_rank,
+                             std::array<std::vector<int>, 2>& halves) {
+        for (std::size_t r = 0; r < ranks; ++r) {
+          for (const std::uint32_t k : by_rank[r]) {
+            const BodyInfo& info = infos[k];
+            halves[0][r] += static_cast<int>(MOTES_HALO_PARTICLE_VEC4S * info.particle_count);
+            if (!info.free_sphere && !info.linked && !info.soft) {
+              halves[1][r] += static_cast<int>(MOTES_HALO_BODY_VEC4S);
+            }
+          }
+        }
+      };
+      count(send_, send_counts_);
+      count(receive_, receive_counts_);
       Snapshot state;
       state.step = steps_;
       state.time = time();
+      state.cluster_rotation.resize(local_->sizes().clusters);
       const std::size_t n = local_->particle_count();
+      const std::size_t planes = local_->sizes().impulse != 0 ? scene_.planes.size() : 0;
+      state.plane_impulse.resize(n * planes);
       state.particle_pos.resize(n);
       state.particle_vel.resize(n);
       for (std::size_t k = 0; k < entries.size(); ++k) {
@@ -439,15 +552,32 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
         state.body_vel.push_back(r.state[2]);
         state.body_angmom.push_back(r.state[3]);
         state.body_angvel.push_back(r.state[4]);
+        if (r.rotations.size() != infos[k].cluster_count) {
+          built = Status::error(fmt::format("body {}: {} cluster rotations for {} clusters", r.body,
+                                            r.rotations.size(), infos[k].cluster_count));
+          break;
+        }
+        std::copy(r.rotations.begin(), r.rotations.end(),
+                  state.cluster_rotation.begin() + infos[k].first_cluster);
+        if (r.planes.size() == std::size_t{infos[k].particle_count} * planes) {
+          std::copy(r.planes.begin(), r.planes.end(),
+                    state.plane_impulse.begin() +
+                        static_cast<std::ptrdiff_t>(std::size_t{infos[k].first_particle} * planes));
+        }
         (entries[k].from < 0 ? stats_.owned_particles : stats_.halo_particles) += r.pos.size();
-        if (entries[k].from < 0) reference_.insert(reference_.end(), r.pos.begin(), r.pos.end());
       }
-      built = local_->write_state(state);
+      if (built) built = local_->write_state(state);
     } else {
       built = sim.status();
     }
   }
   if (Status s = agree(comm_, built); !s) return s;
+  // The bodies' part of the halo travels only where some rank has a rigid body in its halo.
+  int bodies_here = 0;
+  for (const int c : send_counts_[1]) bodies_here |= c != 0 ? 1 : 0;
+  int bodies_anywhere = 0;
+  MPI_Allreduce(&bodies_here, &bodies_anywhere, 1, MPI_INT, MPI_LOR, comm_);
+  halo_bodies_ = bodies_anywhere != 0;
   ++stats_.partitions;
   stats_.migrations += migrations;
   stats_.partition_seconds += seconds_since(start);
@@ -456,90 +586,75 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
 
 Result<double> DistributedSimulation::exchange_halos(Status stepped) {
   const Clock::time_point start = Clock::now();
-  const auto ranks = static_cast<std::size_t>(size_);
-  // Any failure on the way is kept and sent on as an empty part: every rank still takes part in
-  // every collective, and the last one (agree) tells them all.
+  // Any failure on the way is kept, and this rank still takes part in every collective with
+  // buffers of the agreed sizes; the last collective (agree) tells every rank.
   Status status = std::move(stepped);
-  Snapshot snap;
-  if (local_ && status) {
-    Result<Snapshot> s = local_->snapshot();
-    if (s) {
-      snap = std::move(s).value();
-    } else {
-      status = s.status();
-    }
-  }
-  const bool have = local_ && status;
-  std::vector<std::vector<vec4>> out(ranks);
-  const std::vector<BodyInfo>* infos = local_ ? &local_->bodies() : nullptr;
-  const auto record_of = [&](std::uint32_t k) {
-    Record r;
-    r.body = local_bodies_[k];
-    r.state = {snap.body_pos[k], snap.body_quat[k], snap.body_vel[k], snap.body_angmom[k],
-               snap.body_angvel[k]};
-    const BodyInfo& info = (*infos)[k];
-    const auto p = snap.particle_pos.begin() + info.first_particle;
-    const auto v = snap.particle_vel.begin() + info.first_particle;
-    r.pos.assign(p, p + info.particle_count);
-    r.vel.assign(v, v + info.particle_count);
-    return r;
+  const auto total = [](const std::vector<int>& counts) {
+    std::size_t sum = 0;
+    for (const int c : counts) sum += static_cast<std::size_t>(c);
+    return sum;
   };
-  for (std::size_t r = 0; r < ranks && have; ++r) {
-    for (std::uint32_t k : send_[r]) append(out[r], record_of(k));
-    stats_.halo_bytes += out[r].size() * sizeof(vec4);
-  }
-  std::vector<int> counts;
-  Clock::time_point mpi_start = Clock::now();
-  Result<std::vector<vec4>> in = all_to_all(comm_, out, counts);
-  double mpi = seconds_since(mpi_start);
-  if (status && !in) status = in.status();
-  if (status && have) {
-    const std::vector<Record> copies = parse(in.value());
-    std::size_t next = 0;
-    for (std::size_t r = 0; r < ranks && status; ++r) {
-      for (std::uint32_t k : receive_[r]) {
-        const BodyInfo& info = (*infos)[k];
-        if (next >= copies.size() || copies[next].body != local_bodies_[k] ||
-            copies[next].pos.size() != info.particle_count) {
-          status = Status::error(fmt::format(
-              "halo update: body {}'s copy did not come from rank {}", local_bodies_[k], r));
-          break;
-        }
-        const Record& c = copies[next++];
-        std::copy(c.pos.begin(), c.pos.end(), snap.particle_pos.begin() + info.first_particle);
-        std::copy(c.vel.begin(), c.vel.end(), snap.particle_vel.begin() + info.first_particle);
-        snap.body_pos[k] = c.state[0];
-        snap.body_quat[k] = c.state[1];
-        snap.body_vel[k] = c.state[2];
-        snap.body_angmom[k] = c.state[3];
-        snap.body_angvel[k] = c.state[4];
-      }
+  const std::size_t out_particles = total(send_counts_[0]);
+  const std::size_t in_particles = total(receive_counts_[0]);
+  if (local_ && status) status = local_->halo_pack(halo_out_);
+  halo_out_.resize(out_particles + total(send_counts_[1]));
+  halo_in_.resize(in_particles + total(receive_counts_[1]));
+  stats_.halo_bytes += halo_out_.size() * sizeof(vec4);
+  double mpi = 0.0;  // seconds in MPI calls: the transfer, and waiting for the slowest rank
+  const auto agreed = [&](double* value) {
+    const Clock::time_point t = Clock::now();
+    Status s = agree(comm_, status, value);
+    mpi += seconds_since(t);
+    return s;
+  };
+  const Clock::time_point mpi_start = Clock::now();
+  for (std::size_t part = 0; part < (halo_bodies_ ? 2u : 1u); ++part) {
+    // Particles' part from the start of each buffer, the bodies' part after it.
+    const std::vector<int>& sent = send_counts_[part];
+    const std::vector<int>& received = receive_counts_[part];
+    std::vector<int> sent_at(sent.size()), received_at(received.size());
+    int at_out = part == 0 ? 0 : static_cast<int>(out_particles);
+    int at_in = part == 0 ? 0 : static_cast<int>(in_particles);
+    for (std::size_t r = 0; r < sent.size(); ++r) {
+      sent_at[r] = at_out;
+      at_out += sent[r];
+      received_at[r] = at_in;
+      at_in += received[r];
     }
-    if (status && next > 0) status = local_->write_state(snap);
+    MPI_Alltoallv(halo_out_.data(), sent.data(), sent_at.data(), vec4_type(), halo_in_.data(),
+                  received.data(), received_at.data(), vec4_type(), comm_);
   }
-  // The farthest an owned particle has moved since the partition.
-  double far = 0.0;
-  if (status && have) {
-    std::size_t at = 0;
-    for (std::size_t k = 0; k < local_bodies_.size(); ++k) {
-      if (local_owned_[k] == 0) continue;
-      const BodyInfo& info = (*infos)[k];
-      for (std::uint32_t i = 0; i < info.particle_count; ++i, ++at) {
-        const vec4& p = snap.particle_pos[info.first_particle + i];
-        const vec4& q = reference_[at];
-        const double dx = static_cast<double>(p.x) - static_cast<double>(q.x);
-        const double dy = static_cast<double>(p.y) - static_cast<double>(q.y);
-        const double dz = static_cast<double>(p.z) - static_cast<double>(q.z);
-        const double d2 = dx * dx + dy * dy + dz * dz;
-        // A non-finite position forces a partition; the motion guard names it.
-        far = std::isfinite(d2) ? std::max(far, d2) : std::numeric_limits<double>::infinity();
-      }
-    }
-    far = std::sqrt(far);
-  }
-  mpi_start = Clock::now();
-  if (Status s = agree(comm_, status, &far); !s) return s;
   mpi += seconds_since(mpi_start);
+  if (local_ && status) status = local_->halo_unpack(halo_in_);
+  // The lists are rebuilt on every rank at the steps one process would rebuild them: when any
+  // particle anywhere has moved 0.45 skin since the last build (each rank tests its own
+  // particles and the copies it received). Only then can the ranks partition again: how far any
+  // particle has moved since the partition is measured on the devices, and until the next
+  // rebuild none moves more than 0.45 skin from where it is now (docs/scale-out.md, "Migration").
+  double pending = 0.0;
+  if (local_ && status) {
+    Result<NeighbourStats> lists = local_->neighbour_stats();
+    if (lists) {
+      pending = lists->rebuild_pending ? 1.0 : 0.0;
+    } else {
+      status = lists.status();
+    }
+  }
+  if (Status s = agreed(&pending); !s) return s;
+  double far = 0.0;
+  if (pending > 0.0) {
+    if (local_) status = local_->request_rebuild();
+    if (local_ && status) {
+      Result<double> moved = local_->partition_displacement();
+      if (moved) {
+        far = moved.value();
+      } else {
+        status = moved.status();
+      }
+    }
+    if (Status s = agreed(&far); !s) return s;
+    far += 0.45 * skin_;
+  }
   stats_.mpi_seconds += mpi;
   stats_.copy_seconds += seconds_since(start) - mpi;
   return far;

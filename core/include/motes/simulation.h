@@ -1,6 +1,7 @@
 // motes::Simulation: owns the step and the host view of the state; runs on any Device.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -34,6 +35,11 @@ struct Snapshot {
   /// Rotation of each shape-matching cluster's last fit (device order): the next fit starts
   /// from it, so a bitwise resume needs it.
   std::vector<shared::vec4> cluster_rotation;
+  /// Impulse contacts only, and only when asked for (Simulation::read_plane_impulses): each
+  /// particle's accumulated impulse with each plane, kept from substep to substep whatever the
+  /// lists do (P per particle in the scene's particle order; zero for particles that are not
+  /// rigid).
+  std::vector<shared::vec4> plane_impulse;
 };
 
 /// Static facts about a body, kept on the host.
@@ -52,6 +58,10 @@ struct BodyInfo {
   /// A soft body (shape matching): like a cloth, its body state in a Snapshot is the mean
   /// position and velocity of its particles.
   bool soft = false;
+  /// A soft body's shape-matching clusters: Snapshot::cluster_rotation [first_cluster,
+  /// + cluster_count).
+  std::uint32_t first_cluster = 0;
+  std::uint32_t cluster_count = 0;
 };
 
 /// Neighbour-list figures since the simulation was created (NeighbourState).
@@ -59,6 +69,22 @@ struct NeighbourStats {
   std::uint32_t builds = 0;         ///< list builds so far (the first at the first step)
   std::uint32_t over_capacity = 0;  ///< particles with more than K neighbours at the last build
   std::uint32_t max_count = 0;      ///< the largest neighbour count at the last build
+  bool rebuild_pending = false;     ///< the next step rebuilds the lists
+};
+
+/// A run over MPI ranks (motes/distributed.h, docs/scale-out.md): the bodies (indices in the
+/// simulation's body order) whose state this rank sends to its neighbours after every step,
+/// grouped by the rank they go to, and those whose state it receives, grouped by the rank they
+/// come from. Their state travels packed (shared/halo.h): every listed body's particles
+/// (position, velocity) in list order, then the rigid bodies' five vectors in list order.
+struct HaloLists {
+  std::vector<std::uint32_t> send;
+  std::vector<std::uint32_t> receive;
+  /// The whole scene's particle count and largest particle diameter: each rank builds the grid
+  /// one process would (table size, cell size, skin), so that cells hash alike on every rank and
+  /// a particle meets its contact partners in the same order at any rank count.
+  std::uint32_t scene_particles = 0;
+  double scene_diameter = 0.0;
 };
 
 /// What the motion guard found (Simulation::check_motion, docs/reliability.md "Guards while
@@ -86,6 +112,11 @@ class Simulation {
   /// Builds the particles and bodies of a scene and uploads them to the device.
   static Result<std::unique_ptr<Simulation>> create(const Scene& scene,
                                                     std::unique_ptr<Device> device);
+  /// The same for one rank of a run over MPI ranks: with the halo lists on the device
+  /// (halo_pack, halo_unpack) and a partition reference (partition_displacement).
+  static Result<std::unique_ptr<Simulation>> create(const Scene& scene,
+                                                    std::unique_ptr<Device> device,
+                                                    const HaloLists& halo);
 
   /// Ends a simulation and hands its device back, to be given to the next Simulation::create
   /// (which allocates anew): a new scene on the same device without opening it again (CUDA
@@ -97,6 +128,10 @@ class Simulation {
 
   /// Reads the state back (waits for the device).
   Result<Snapshot> snapshot();
+  /// With impulse contacts, fills state.plane_impulse (the contacts with the planes remember
+  /// their accumulated impulse across list rebuilds; write_state restores it); otherwise
+  /// empties it.
+  Status read_plane_impulses(Snapshot& state);
   /// 64-bit FNV-1a hash of every particle and body buffer's bytes: equal hashes = equal states.
   Result<std::uint64_t> state_hash();
   /// Checks every body and particle for NaN or infinity; the error names step, body and particle.
@@ -109,6 +144,11 @@ class Simulation {
   /// unstable. Otherwise the report, with a warning when the fastest particle travels more than
   /// kSafeTravel of its diameter per substep.
   Result<MotionReport> check_motion();
+  /// The neighbour-list skin (m) of a scene whose largest particle diameter is `diameter`:
+  /// settings.neighbour_skin, or a tenth of that diameter when it is negative (unset).
+  static double neighbour_skin(const Settings& settings, double diameter) {
+    return settings.neighbour_skin >= 0.0 ? settings.neighbour_skin : 0.1 * diameter;
+  }
   /// Half a particle radius per substep: the scene loader's limit for initial speeds.
   static constexpr double kSafeTravel = 0.25;
   static constexpr double kBlowUpFactor = 1000.0;
@@ -140,13 +180,29 @@ class Simulation {
   /// are then rebuilt at the next step.
   Status load_state(const std::string& path);
   /// Writes a state in the scene's order (as snapshot() gives it: particles' positions and
-  /// velocities, rigid bodies' poses and momenta, the soft bodies' fits when their count matches)
+  /// velocities, rigid bodies' poses and momenta, the soft bodies' fits when their count matches,
+  /// the plane contacts' accumulated impulses when given)
   /// as the start of the next step, and sets the step count and time to the state's. The
   /// neighbour lists are kept: they are rebuilt, as in any step, once a particle has moved past
   /// the skin from where the last build saw it. Wrong sizes are an error and change nothing.
-  /// With it an owner writes the halo copies of its bodies into a neighbour rank's simulation
-  /// (motes/distributed.h).
+  /// Created with HaloLists, the positions written are also the partition reference
+  /// (partition_displacement).
   Status write_state(const Snapshot& state);
+  /// Halo exchange (created with HaloLists): the send list's state packed on the device and
+  /// read into `out` (resized; shared/halo.h layout). Waits for the queued steps.
+  Status halo_pack(std::vector<shared::vec4>& out);
+  /// The receive list's state, in the same layout, written to the device and scattered there
+  /// (asks for a list rebuild where a copy moved past the skin).
+  Status halo_unpack(const std::vector<shared::vec4>& in);
+  /// Makes the next step rebuild the neighbour lists (the ranks of a run over MPI ranks rebuild
+  /// together, when any of them must).
+  Status request_rebuild();
+  /// Halo entries of the send and receive lists: particles, rigid bodies (HaloLists).
+  [[nodiscard]] std::array<std::uint32_t, 4> halo_entries() const { return halo_entries_; }
+  /// The largest distance (m) a particle has moved since the last write_state (the ranks'
+  /// partition), measured on the device (particles_displacement); infinity when one is not
+  /// finite. Created with HaloLists only.
+  Result<double> partition_displacement();
   /// Fingerprint (FNV-1a 64) of everything fixed when the simulation was created: sizes, step
   /// parameters, materials, planes, body frames, constraints, clusters, particle radii and
   /// masses. Equal on every backend; a checkpoint loads only where it is equal.
@@ -175,7 +231,7 @@ class Simulation {
 
  private:
   Simulation() = default;
-  Status upload(const Scene& scene);
+  Status upload(const Scene& scene, const HaloLists* halo);
   /// The rigid bodies' part of a substep with impulse contacts (docs/architecture.md).
   void step_impulses();
   /// Cloth and ropes attached to rigid bodies: the bodies take the constraints' pull.
@@ -209,6 +265,9 @@ class Simulation {
   /// (scene body, orientation) of the free spheres that are not at the identity orientation; a
   /// free sphere never turns.
   std::vector<std::pair<std::uint32_t, shared::vec4>> sphere_turns_;
+  /// HaloLists as halo entries (send particles, send bodies, receive particles, receive bodies);
+  /// their device indices are HaloIndex.
+  std::array<std::uint32_t, 4> halo_entries_{};
   /// setup_hash(), and the FNV-1a 64 of the particles' radii and inverse masses (the w of
   /// ParticlePos and ParticleVel, device order), which a checkpoint's particles must match.
   std::uint64_t setup_hash_ = 0;

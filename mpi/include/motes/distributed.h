@@ -60,10 +60,10 @@ struct DistributedStats {
 
 class DistributedSimulation {
  public:
-  /// Collective over `comm`: every rank passes the same scene. Refuses, on every rank with the
-  /// same message, what it cannot split yet: impulse contacts, cloth or ropes attached to bodies,
-  /// soft bodies.
-  static Result<std::unique_ptr<DistributedSimulation>> create(const Scene& scene, MPI_Comm comm,
+  /// Collective over `comm`: every rank passes the same scene. Bodies that must be stepped
+  /// together stay together, owned by one rank and copied whole (a group: a cloth or rope with
+  /// the bodies it is attached to; with impulse contacts, every rigid body of the scene).
+  static Result<std::unique_ptr<DistributedSimulation>> create(Scene scene, MPI_Comm comm,
                                                                DeviceOpener open_device,
                                                                const DistributedOptions& options);
 
@@ -97,6 +97,9 @@ class DistributedSimulation {
     std::uint32_t body = 0;               ///< scene body index
     std::array<shared::vec4, 5> state{};  ///< position, orientation, velocity, L, omega
     std::vector<shared::vec4> pos, vel;
+    std::vector<shared::vec4> rotations;  ///< a soft body's clusters' last rotations
+    /// Impulse contacts: its particles' accumulated impulses with the planes (Snapshot).
+    std::vector<shared::vec4> planes;
   };
 
  private:
@@ -104,12 +107,15 @@ class DistributedSimulation {
   /// Sends owned records to their new owners, chooses the halos and builds the local
   /// simulation from `owned` (the records this rank holds, any owner).
   Status partition(std::vector<Record> owned);
-  /// Brings every halo copy up to date from its owner; returns the largest distance (on every
-  /// rank) an owned particle has moved since the partition, or the first error of any rank
-  /// (`stepped`: this rank's step).
+  /// Brings every halo copy up to date from its owner (packed and unpacked on the devices) and
+  /// rebuilds every rank's lists when any rank's are due; returns 0, or at a rebuild a bound (the
+  /// same on every rank) on how far a particle can move from the partition before the next
+  /// rebuild; or the first error of any rank (`stepped`: this rank's step).
   Result<double> exchange_halos(Status stepped);
   /// This rank's records of its owned bodies, from the local simulation.
   Result<std::vector<Record>> owned_records();
+  /// groups_ and group_of_ from the scene.
+  void group_bodies();
 
   Scene scene_;
   MPI_Comm comm_ = MPI_COMM_NULL;
@@ -118,8 +124,13 @@ class DistributedSimulation {
   DeviceOpener open_device_;
   Decomposition decomposition_;
   double margin_ = 0.0;
+  double scene_diameter_ = 0.0;  ///< the scene's largest particle diameter
   double halo_width_ = 0.0;
   std::vector<BodyInfo> bodies_;
+  /// Bodies owned and copied together (scene body indices, ascending; a body alone is a group of
+  /// one), and each scene body's group.
+  std::vector<std::vector<std::uint32_t>> groups_;
+  std::vector<std::uint32_t> group_of_;
   std::uint64_t particles_ = 0;
   std::uint64_t steps_ = 0;
 
@@ -133,8 +144,16 @@ class DistributedSimulation {
   /// scene order); halo receives: for each rank, the local indices of its copies here.
   std::vector<std::vector<std::uint32_t>> send_;
   std::vector<std::vector<std::uint32_t>> receive_;
-  /// Owned particles' positions at the partition (local particle order, owned bodies only).
-  std::vector<shared::vec4> reference_;
+  /// Each rank's part of the packed halo (shared/halo.h) in vec4s: [0] the particles' part,
+  /// [1] the rigid bodies' part; sent to and received from each rank.
+  std::array<std::vector<int>, 2> send_counts_;
+  std::array<std::vector<int>, 2> receive_counts_;
+  /// Whether any rank's halo has rigid bodies (else their part is not exchanged).
+  bool halo_bodies_ = false;
+  /// The packed halo on the host, reused from step to step.
+  std::vector<shared::vec4> halo_out_, halo_in_;
+  /// The neighbour-list skin (the same on every rank: the scene's).
+  double skin_ = 0.0;
   DistributedStats stats_;
 };
 
