@@ -308,6 +308,20 @@ Status CudaDevice::read(Buffer b, void* dst, std::size_t bytes) {
   return check(cudaStreamSynchronize(stream_), "cudaMemcpy to the host");
 }
 
+void* CudaDevice::allocate_host(std::size_t bytes) {
+  cudaSetDevice(ordinal_);
+  void* memory = nullptr;
+  if (cudaMallocHost(&memory, std::max<std::size_t>(bytes, 1)) != cudaSuccess) {
+    (void)cudaGetLastError();  // not sticky: the caller falls back or reports it
+    return nullptr;
+  }
+  return memory;
+}
+
+void CudaDevice::free_host(void* memory) {
+  if (memory != nullptr) cudaFreeHost(memory);
+}
+
 Status CudaDevice::synchronize() {
   if (Status s = flush(); !s) return s;
   if (stream_ == nullptr) return error_;

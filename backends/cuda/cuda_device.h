@@ -75,6 +75,9 @@ class CudaDevice final : public Device {
   }
 
   Status synchronize() override;
+  /// Page-locked host memory (cudaMallocHost): read() and write() move it by DMA.
+  [[nodiscard]] void* allocate_host(std::size_t bytes) override;
+  void free_host(void* memory) override;
   Status check_guards() override;
   void set_timing(bool on) override { timing_ = on; }
   [[nodiscard]] KernelTimes kernel_times() const override { return times_; }

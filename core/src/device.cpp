@@ -7,6 +7,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <vector>
 
 #include "shared/halo.h"
@@ -288,6 +289,16 @@ std::string halo_launch_error(Kernel k, const shared::StepParams& p, const Sizes
       "vec4s of HaloData) on buffers allocated for {} words and {} vec4s",
       kernel_name(k), p.halo_particles, p.halo_bodies, p.halo_first, words, vec4s, sizes.halo_index,
       sizes.halo_data);
+}
+
+void* Device::allocate_host(std::size_t bytes) {
+  constexpr std::size_t kAlign = 64;
+  return ::operator new (std::max<std::size_t>(bytes, 1), std::align_val_t{kAlign}, std::nothrow);
+}
+
+void Device::free_host(void* memory) {
+  constexpr std::size_t kAlign = 64;
+  ::operator delete (memory, std::align_val_t{kAlign});
 }
 
 BufferSize Device::largest_buffer(const Sizes& sizes) const {

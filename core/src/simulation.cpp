@@ -100,6 +100,8 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene,
 std::unique_ptr<Device> Simulation::take_device(std::unique_ptr<Simulation> sim) {
   if (!sim) return nullptr;
   (void)sim->device_->synchronize();
+  sim->halo_out_.reset();  // freed through the device, before it goes
+  sim->halo_in_.reset();
   return std::move(sim->device_);
 }
 
@@ -550,6 +552,21 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
     sizes_.halo_index = static_cast<std::uint32_t>(halo_index.size());
     sizes_.halo_data = static_cast<std::uint32_t>(data);
     sizes_.partition = 1;
+    // The packed halo's host memory, sent and received.
+    halo_out_count_ = std::size_t{MOTES_HALO_PARTICLE_VEC4S} * halo_entries_[0] +
+                      std::size_t{MOTES_HALO_BODY_VEC4S} * halo_entries_[1];
+    halo_in_count_ = std::size_t{MOTES_HALO_PARTICLE_VEC4S} * halo_entries_[2] +
+                     std::size_t{MOTES_HALO_BODY_VEC4S} * halo_entries_[3];
+    for (auto [memory, count] :
+         {std::pair{&halo_out_, halo_out_count_}, std::pair{&halo_in_, halo_in_count_}}) {
+      *memory = HostMemory<vec4>(
+          count == 0 ? nullptr : static_cast<vec4*>(d.allocate_host(count * sizeof(vec4))),
+          HostFree{&d});
+      if (count > 0 && !*memory) {
+        return Status::error(fmt::format("{}: no host memory for a halo of {} bytes", scene.source,
+                                         count * sizeof(vec4)));
+      }
+    }
   }
   if (Status st = check_memory(); !st) return st;
 
@@ -974,38 +991,25 @@ Result<NeighbourStats> Simulation::neighbour_stats() {
   return out;
 }
 
-Status Simulation::halo_pack(std::vector<vec4>& out) {
-  const std::uint32_t particles = halo_entries_[0];
-  const std::uint32_t rigid = halo_entries_[1];
-  out.resize(std::size_t{MOTES_HALO_PARTICLE_VEC4S} * particles +
-             std::size_t{MOTES_HALO_BODY_VEC4S} * rigid);
-  if (out.empty()) return device_->synchronize();
+Status Simulation::halo_pack() {
+  if (halo_out_count_ == 0) return device_->synchronize();
   shared::StepParams p = params_;
-  p.halo_particles = particles;
-  p.halo_bodies = rigid;
+  p.halo_particles = halo_entries_[0];
+  p.halo_bodies = halo_entries_[1];
   p.halo_first = 0;
   device_->halo_pack(p);
-  return device_->read(Buffer::HaloData, out.data(), out.size() * sizeof(vec4));
+  return device_->read(Buffer::HaloData, halo_out_.get(), halo_out_count_ * sizeof(vec4));
 }
 
-Status Simulation::halo_unpack(const std::vector<vec4>& in) {
-  const std::uint32_t particles = halo_entries_[2];
-  const std::uint32_t rigid = halo_entries_[3];
-  const std::size_t want = std::size_t{MOTES_HALO_PARTICLE_VEC4S} * particles +
-                           std::size_t{MOTES_HALO_BODY_VEC4S} * rigid;
-  if (in.size() != want) {
-    return Status::error(
-        fmt::format("halo_unpack: {} vec4s for a halo of {} particles and {} "
-                    "rigid bodies ({} vec4s)",
-                    in.size(), particles, rigid, want));
-  }
-  if (in.empty()) return Status::ok();
-  if (Status s = device_->write(Buffer::HaloData, in.data(), in.size() * sizeof(vec4)); !s) {
+Status Simulation::halo_unpack() {
+  if (halo_in_count_ == 0) return Status::ok();
+  if (Status s = device_->write(Buffer::HaloData, halo_in_.get(), halo_in_count_ * sizeof(vec4));
+      !s) {
     return s;
   }
   shared::StepParams p = params_;
-  p.halo_particles = particles;
-  p.halo_bodies = rigid;
+  p.halo_particles = halo_entries_[2];
+  p.halo_bodies = halo_entries_[3];
   p.halo_first = halo_entries_[0] + halo_entries_[1];
   device_->halo_unpack(p);
   return Status::ok();

@@ -256,16 +256,19 @@ Result<std::unique_ptr<DistributedSimulation>> DistributedSimulation::create(
 
   // Each rank builds the groups whose centre starts in its brick; the first partition then sends
   // any whose centre of mass lies elsewhere to its owner and chooses the halos.
-  std::vector<std::uint32_t> mine;
-  for (const std::vector<std::uint32_t>& members : d->groups_) {
+  std::vector<int> group_owner(d->groups_.size());
+  for (std::size_t g = 0; g < d->groups_.size(); ++g) {
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (const std::uint32_t b : members) centre += centres[b];
-    centre /= static_cast<double>(members.size());
-    if (d->decomposition_.owner(centre) == d->rank_) {
-      mine.insert(mine.end(), members.begin(), members.end());
+    for (const std::uint32_t b : d->groups_[g]) centre += centres[b];
+    group_owner[g] = d->decomposition_.owner(centre / static_cast<double>(d->groups_[g].size()));
+  }
+  std::vector<std::uint32_t> mine;
+  for (std::uint32_t b = 0; b < centres.size(); ++b) {
+    const std::uint32_t g = d->group_of_[b];
+    if ((g == kAlone ? d->decomposition_.owner(centres[b]) : group_owner[g]) == d->rank_) {
+      mine.push_back(b);
     }
   }
-  std::sort(mine.begin(), mine.end());
   Status built = Status::ok();
   if (!mine.empty()) {
     Result<std::unique_ptr<Device>> device = d->open_device_();
@@ -361,12 +364,16 @@ void DistributedSimulation::group_bodies() {
       unite(first, b);
     }
   }
-  group_of_.assign(parent.size(), 0);
+  // Bodies alone stay kAlone (most bodies of a large scene: no list each).
+  std::vector<std::uint32_t> size(parent.size(), 0);
+  for (std::uint32_t b = 0; b < parent.size(); ++b) ++size[find(b)];
+  group_of_.assign(parent.size(), kAlone);
   groups_.clear();
-  std::vector<std::uint32_t> index(parent.size(), UINT32_MAX);
+  std::vector<std::uint32_t> index(parent.size(), kAlone);
   for (std::uint32_t b = 0; b < parent.size(); ++b) {
     const std::uint32_t root = find(b);
-    if (index[root] == UINT32_MAX) {
+    if (size[root] < 2) continue;
+    if (index[root] == kAlone) {
       index[root] = static_cast<std::uint32_t>(groups_.size());
       groups_.emplace_back();
     }
@@ -385,26 +392,32 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
   std::unordered_map<std::uint32_t, Eigen::Vector3d> sums;  // groups of several bodies
   for (const Record& r : held) {
     const std::uint32_t g = group_of_[r.body];
-    if (groups_[g].size() > 1) {
+    if (g != kAlone) {
       sums.try_emplace(g, Eigen::Vector3d::Zero()).first->second += centre_of(r.state[0]);
     }
   }
+  // Bodies that stay are kept as they are; only those that move travel.
   std::vector<std::vector<vec4>> out(ranks);
+  std::vector<Record> owned;
   std::uint64_t moved = 0;
-  for (const Record& r : held) {
+  for (Record& r : held) {
     const std::uint32_t g = group_of_[r.body];
     const Eigen::Vector3d centre =
-        groups_[g].size() > 1 ? Eigen::Vector3d(sums.at(g) / static_cast<double>(groups_[g].size()))
-                              : centre_of(r.state[0]);
+        g == kAlone ? centre_of(r.state[0])
+                    : Eigen::Vector3d(sums.at(g) / static_cast<double>(groups_[g].size()));
     const int to = decomposition_.owner(centre);
-    if (to != rank_) ++moved;
-    append(out[static_cast<std::size_t>(to)], r);
+    if (to == rank_) {
+      owned.push_back(std::move(r));
+    } else {
+      ++moved;
+      append(out[static_cast<std::size_t>(to)], r);
+    }
   }
   held.clear();
   std::vector<int> counts;
   Result<std::vector<vec4>> arrived = all_to_all(comm_, out, counts);
   if (Status st = agree(comm_, status_of(arrived)); !st) return st;
-  std::vector<Record> owned = parse(arrived.value());
+  for (Record& r : parse(arrived.value())) owned.push_back(std::move(r));
   std::sort(owned.begin(), owned.end(),
             [](const Record& a, const Record& b) { return a.body < b.body; });
   std::uint64_t migrations = 0;
@@ -436,7 +449,7 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
   std::unordered_map<std::uint32_t, std::array<double, 6>> group_boxes;  // groups of several
   for (std::size_t k = 0; k < owned.size(); ++k) {
     const std::uint32_t g = group_of_[owned[k].body];
-    if (groups_[g].size() == 1) continue;
+    if (g == kAlone) continue;
     auto [it, fresh] = group_boxes.try_emplace(g, boxes[k]);
     for (std::size_t a = 0; a < 3 && !fresh; ++a) {
       it->second[a] = std::min(it->second[a], boxes[k][a]);
@@ -445,7 +458,7 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
   }
   for (std::size_t k = 0; k < owned.size(); ++k) {
     const std::uint32_t g = group_of_[owned[k].body];
-    const std::array<double, 6>& box = groups_[g].size() == 1 ? boxes[k] : group_boxes.at(g);
+    const std::array<double, 6>& box = g == kAlone ? boxes[k] : group_boxes.at(g);
     for (std::size_t r = 0; r < ranks; ++r) {
       if (static_cast<int>(r) == rank_ || !overlap(box, &all[6 * r])) continue;
       append(out[r], owned[k]);
@@ -596,10 +609,16 @@ Result<double> DistributedSimulation::exchange_halos(Status stepped) {
   };
   const std::size_t out_particles = total(send_counts_[0]);
   const std::size_t in_particles = total(receive_counts_[0]);
-  if (local_ && status) status = local_->halo_pack(halo_out_);
-  halo_out_.resize(out_particles + total(send_counts_[1]));
-  halo_in_.resize(in_particles + total(receive_counts_[1]));
-  stats_.halo_bytes += halo_out_.size() * sizeof(vec4);
+  // The packed halo in the local simulation's host memory (page-locked on CUDA), sent and
+  // received in place; a rank without bodies has none to send or receive.
+  const vec4* out = nullptr;
+  vec4* in = nullptr;
+  if (local_) {
+    if (status) status = local_->halo_pack();
+    out = local_->halo_sent().data();
+    in = local_->halo_received().data();
+  }
+  stats_.halo_bytes += (out_particles + total(send_counts_[1])) * sizeof(vec4);
   double mpi = 0.0;  // seconds in MPI calls: the transfer, and waiting for the slowest rank
   const auto agreed = [&](double* value) {
     const Clock::time_point t = Clock::now();
@@ -621,11 +640,11 @@ Result<double> DistributedSimulation::exchange_halos(Status stepped) {
       received_at[r] = at_in;
       at_in += received[r];
     }
-    MPI_Alltoallv(halo_out_.data(), sent.data(), sent_at.data(), vec4_type(), halo_in_.data(),
-                  received.data(), received_at.data(), vec4_type(), comm_);
+    MPI_Alltoallv(out, sent.data(), sent_at.data(), vec4_type(), in, received.data(),
+                  received_at.data(), vec4_type(), comm_);
   }
   mpi += seconds_since(mpi_start);
-  if (local_ && status) status = local_->halo_unpack(halo_in_);
+  if (local_ && status) status = local_->halo_unpack();
   // The lists are rebuilt on every rank at the steps one process would rebuild them: when any
   // particle anywhere has moved 0.45 skin since the last build (each rank tests its own
   // particles and the copies it received). Only then can the ranks partition again: how far any

@@ -12,5 +12,8 @@ export LD_LIBRARY_PATH=$PWD/gpu-bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 export PATH=$PWD/gpu-bundle/bin:$PATH
 # The tests were built in /work/main and look for examples/ there.
 if [ ! -e /work/main ]; then mkdir -p /work && ln -s "$PWD" /work/main; fi
-# The unit tests run the command line from the build directory it was built in.
-if [ ! -e build-gpu/bin/motes ]; then mkdir -p build-gpu/bin && ln -s "$PWD/gpu-bundle/bin/motes" build-gpu/bin/motes; fi
+# The unit tests run the command line from the build directory it was built in (bundle.sh's
+# default build-gpu, or the quick start's build).
+for dir in build-gpu build; do
+  if [ ! -e $dir/bin/motes ]; then mkdir -p $dir/bin && ln -s "$PWD/gpu-bundle/bin/motes" $dir/bin/motes; fi
+done

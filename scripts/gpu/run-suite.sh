@@ -6,10 +6,14 @@
 # slow part cannot lose the others' results. Results go to ${OUT:-gpu-out}/ (at most 8 files come
 # back from the GPU machine): conformance.txt, conformance.md, sanitize.txt, bench.txt, bench.json,
 # bench.md (scripts/gpu/bench-tables.py).
-# Usage: scripts/gpu/run-suite.sh [conformance|unit|sanitize|bench|mpi|all]...   (default all)
+# Usage: scripts/gpu/run-suite.sh [conformance|unit|sanitize|bench|mpi|scaling|all]...
+#   (default all but scaling, which needs several GPUs)
 #   unit: the unit tests' CUDA cases (checkpoint resume on CUDA, the CLI on CUDA), into unit.txt
 #   mpi: the MPI tests on CUDA and Vulkan at 1, 2 and 4 ranks (sharing the machine's GPUs), and
 #     W1 over 1, 2, 4 ranks (motes_mpi_bench, MOTES_MPI_SIZES), into mpi.txt
+#   scaling: W1 over 1 and N GPUs, a rank each (motes_mpi_bench), into scaling.txt:
+#     MOTES_SCALING_RUNS="BACKEND:SIZE:RANKS ..." (default CUDA at 67 M on 1 and 2 GPUs, 134 M
+#     on 2), MOTES_SCALING_STEPS, LIMIT_SCALING_RUN seconds each
 #   MOTES_BENCH_RUNS="cuda:falling cuda:dominoes cuda:dense vulkan:falling ..."   what is measured
 #     (also BACKEND:huge: W1 at 67 M and 134 M particles, one short repeat; BACKEND:dominoes-1m:
 #     W2 with 1,000,000 dominoes; BACKEND:cloth: W3 at 256 x 256 and 1024 x 1024;
@@ -25,7 +29,7 @@ parts=${*:-all}
 out=${OUT:-gpu-out}
 mkdir -p "$out"
 . "$(dirname "$0")/prelude.sh"
-want() { [[ " $parts " == *" all "* || " $parts " == *" $1 "* ]]; }
+want() { [[ (" $parts " == *" all "* && $1 != scaling) || " $parts " == *" $1 "* ]]; }
 # The device list heads the conformance log.
 { nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader; motes devices; } \
   2>&1 | tee -a "$out/conformance.txt"
@@ -76,6 +80,20 @@ if want mpi; then
           motes_mpi_bench --backend "$backend" --size "$size" --steps 200 || status=1
       done
     done
+  done
+fi
+if want scaling; then
+  # W1 over the machine's GPUs, one rank each (docs/benchmarks.md, "Scale-out"): strong scaling
+  # (the same size on 1 and N GPUs) and weak scaling (the size per GPU kept). The MPI library's
+  # CUDA awareness and the GPUs' links head the log.
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+  { nvidia-smi topo -m; ompi_info --parsable --all | grep -i 'cuda_support' ; } \
+    >>"$out/scaling.txt" 2>&1
+  for run in ${MOTES_SCALING_RUNS:-cuda:67108864:1 cuda:67108864:2 cuda:134217728:2}; do
+    IFS=: read -r backend size n <<<"$run"
+    part "${LIMIT_SCALING_RUN:-280}" scaling mpirun --bind-to none -np "$n" motes_mpi_bench \
+      --backend "$backend" --size "$size" --steps "${MOTES_SCALING_STEPS:-200}" --warmup 20 ||
+      status=1
   done
 fi
 if want sanitize; then

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -188,12 +189,18 @@ class Simulation {
   /// Created with HaloLists, the positions written are also the partition reference
   /// (partition_displacement).
   Status write_state(const Snapshot& state);
-  /// Halo exchange (created with HaloLists): the send list's state packed on the device and
-  /// read into `out` (resized; shared/halo.h layout). Waits for the queued steps.
-  Status halo_pack(std::vector<shared::vec4>& out);
-  /// The receive list's state, in the same layout, written to the device and scattered there
-  /// (asks for a list rebuild where a copy moved past the skin).
-  Status halo_unpack(const std::vector<shared::vec4>& in);
+  /// Halo exchange (created with HaloLists): the send list's state packed on the device and read
+  /// into halo_sent(), host memory the device copies to fastest (Device::allocate_host;
+  /// shared/halo.h layout). Waits for the queued steps.
+  Status halo_pack();
+  [[nodiscard]] std::span<const shared::vec4> halo_sent() const {
+    return {halo_out_.get(), halo_out_count_};
+  }
+  /// Where the receive list's state goes, in the same layout, before halo_unpack.
+  [[nodiscard]] std::span<shared::vec4> halo_received() { return {halo_in_.get(), halo_in_count_}; }
+  /// Writes halo_received() to the device and scatters it there (asks for a list rebuild where a
+  /// copy moved past the skin).
+  Status halo_unpack();
   /// Makes the next step rebuild the neighbour lists (the ranks of a run over MPI ranks rebuild
   /// together, when any of them must).
   Status request_rebuild();
@@ -268,6 +275,11 @@ class Simulation {
   /// HaloLists as halo entries (send particles, send bodies, receive particles, receive bodies);
   /// their device indices are HaloIndex.
   std::array<std::uint32_t, 4> halo_entries_{};
+  /// Host memory of the packed halo, sent and received (Device::allocate_host), freed through the
+  /// device (before take_device hands it on).
+  HostMemory<shared::vec4> halo_out_, halo_in_;
+  std::size_t halo_out_count_ = 0;
+  std::size_t halo_in_count_ = 0;
   /// setup_hash(), and the FNV-1a 64 of the particles' radii and inverse masses (the w of
   /// ParticlePos and ParticleVel, device order), which a checkpoint's particles must match.
   std::uint64_t setup_hash_ = 0;

@@ -127,8 +127,9 @@ class DistributedSimulation {
   double scene_diameter_ = 0.0;  ///< the scene's largest particle diameter
   double halo_width_ = 0.0;
   std::vector<BodyInfo> bodies_;
-  /// Bodies owned and copied together (scene body indices, ascending; a body alone is a group of
-  /// one), and each scene body's group.
+  /// Bodies owned and copied together (scene body indices, ascending), and each scene body's
+  /// group (kAlone: a body on its own).
+  static constexpr std::uint32_t kAlone = UINT32_MAX;
   std::vector<std::vector<std::uint32_t>> groups_;
   std::vector<std::uint32_t> group_of_;
   std::uint64_t particles_ = 0;
@@ -150,8 +151,6 @@ class DistributedSimulation {
   std::array<std::vector<int>, 2> receive_counts_;
   /// Whether any rank's halo has rigid bodies (else their part is not exchanged).
   bool halo_bodies_ = false;
-  /// The packed halo on the host, reused from step to step.
-  std::vector<shared::vec4> halo_out_, halo_in_;
   /// The neighbour-list skin (the same on every rank: the scene's).
   double skin_ = 0.0;
   DistributedStats stats_;

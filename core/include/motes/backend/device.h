@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "motes/api.h"
@@ -340,11 +341,28 @@ class Device {
   /// when one was overwritten (the conformance suite calls this after every case).
   virtual Status check_guards() = 0;
 
+  /// Host memory that read() and write() copy to and from fastest, for what crosses between host
+  /// and device every step (the halo of a run over MPI ranks): page-locked on CUDA (a DMA
+  /// transfer instead of a staged one); ordinary aligned memory by default. Freed by
+  /// free_host(); nullptr when none can be had.
+  [[nodiscard]] virtual void* allocate_host(std::size_t bytes);
+  virtual void free_host(void* memory);
+
   /// Per-kernel timing (may cost a synchronization per kernel while on).
   virtual void set_timing(bool on) = 0;
   [[nodiscard]] virtual KernelTimes kernel_times() const = 0;
   virtual void reset_kernel_times() = 0;
 };
+
+/// Frees Device::allocate_host memory through the device that gave it.
+struct HostFree {
+  Device* device = nullptr;
+  void operator()(void* memory) const {
+    if (device != nullptr) device->free_host(memory);
+  }
+};
+template <typename T>
+using HostMemory = std::unique_ptr<T, HostFree>;
 
 }  // namespace motes
 MOTES_API_END
