@@ -157,6 +157,46 @@ bool overlap(const std::array<double, 6>& a, const double* b) {
   return true;
 }
 
+/// Lower and upper corners that hold a body's particles wherever the scene turns it: its centre
+/// of mass (BodySpec::position) plus or minus the largest distance of a particle from the
+/// shape's centre of mass (the mean of its points) and its radius; `reach` caches that per
+/// shape.
+std::array<double, 6> spec_box(const BodySpec& b,
+                               std::unordered_map<const ParticleSet*, double>& reach) {
+  auto [it, fresh] = reach.try_emplace(b.shape.get(), 0.0);
+  if (fresh && b.shape && !b.shape->points.empty()) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3f& p : b.shape->points) mean += p.cast<double>();
+    mean /= static_cast<double>(b.shape->points.size());
+    double far = 0.0;
+    for (const Eigen::Vector3f& p : b.shape->points) {
+      far = std::max(far, (p.cast<double>() - mean).norm());
+    }
+    // A little more than the float particles' rounding can add.
+    it->second = far * (1.0 + 1e-6) + 0.5 * b.shape->diameter;
+  }
+  return {b.position.x() - it->second, b.position.y() - it->second, b.position.z() - it->second,
+          b.position.x() + it->second, b.position.y() + it->second, b.position.z() + it->second};
+}
+
+/// The same for a cloth or rope: its points' bounds grown by their radius.
+std::array<double, 6> spec_box(const LinkedSpec& l) {
+  std::array<double, 6> box{};
+  for (int a = 0; a < 3; ++a) {
+    box[static_cast<std::size_t>(a)] = std::numeric_limits<double>::infinity();
+    box[static_cast<std::size_t>(a + 3)] = -std::numeric_limits<double>::infinity();
+  }
+  for (const Eigen::Vector3d& p : l.points) {
+    for (int a = 0; a < 3; ++a) {
+      box[static_cast<std::size_t>(a)] =
+          std::min(box[static_cast<std::size_t>(a)], p[a] - 0.5 * l.diameter);
+      box[static_cast<std::size_t>(a + 3)] =
+          std::max(box[static_cast<std::size_t>(a + 3)], p[a] + 0.5 * l.diameter);
+    }
+  }
+  return box;
+}
+
 /// The scene with only `bodies` (ascending scene body indices; cloths and ropes after the
 /// scene's bodies).
 Scene sub_scene(const Scene& scene, const std::vector<std::uint32_t>& bodies) {
@@ -254,41 +294,73 @@ Result<std::unique_ptr<DistributedSimulation>> DistributedSimulation::create(
   d->margin_ = options.margin >= 0.0 ? options.margin : 0.5 * diameter;
   d->halo_width_ = 2.0 * d->margin_;
 
-  // Each rank builds the groups whose centre starts in its brick; the first partition then sends
-  // any whose centre of mass lies elsewhere to its owner and chooses the halos.
-  std::vector<int> group_owner(d->groups_.size());
-  for (std::size_t g = 0; g < d->groups_.size(); ++g) {
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (const std::uint32_t b : d->groups_[g]) centre += centres[b];
-    group_owner[g] = d->decomposition_.owner(centre / static_cast<double>(d->groups_[g].size()));
-  }
-  std::vector<std::uint32_t> mine;
-  for (std::uint32_t b = 0; b < centres.size(); ++b) {
-    const std::uint32_t g = d->group_of_[b];
-    if ((g == kAlone ? d->decomposition_.owner(centres[b]) : group_owner[g]) == d->rank_) {
-      mine.push_back(b);
-    }
-  }
-  Status built = Status::ok();
-  if (!mine.empty()) {
-    Result<std::unique_ptr<Device>> device = d->open_device_();
-    Result<std::unique_ptr<Simulation>> start =
-        device ? Simulation::create(sub_scene(scene, mine), std::move(device).value())
-               : Result<std::unique_ptr<Simulation>>(status_of(device));
-    if (start) {
-      d->local_ = std::move(start).value();
-      d->local_bodies_ = mine;
-      d->local_owned_.assign(mine.size(), 1);
-    } else {
-      built = start.status();
-    }
-  }
-  if (Status s = agree(comm, built); !s) return s;
-  Result<std::vector<Record>> records = d->owned_records();
-  if (Status s = agree(comm, status_of(records)); !s) return s;
-  if (Status s = d->partition(std::move(records).value()); !s) return s;
-  d->stats_.migrations = 0;  // the start's moves from the scene's centres are not migrations
+  if (Status s = d->first_partition(centres); !s) return s;
   return d;
+}
+
+Status DistributedSimulation::first_partition(const std::vector<Eigen::Vector3d>& centres) {
+  // The first partition from the scene alone, the same on every rank: each group belongs to the
+  // rank whose brick holds its centre, and its copies go where its particles, as the scene places
+  // them (within a sphere about each body's centre that holds its shape in any orientation), come
+  // within two margins of another rank's. No state travels: each rank builds its bodies and
+  // copies from the scene.
+  const auto ranks = static_cast<std::size_t>(size_);
+  const std::size_t count = centres.size();
+  std::vector<int> group_owner(groups_.size());
+  for (std::size_t g = 0; g < groups_.size(); ++g) {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const std::uint32_t b : groups_[g]) centre += centres[b];
+    group_owner[g] = decomposition_.owner(centre / static_cast<double>(groups_[g].size()));
+  }
+  std::vector<int> owner(count);
+  std::vector<std::array<double, 6>> boxes(count);
+  std::unordered_map<const ParticleSet*, double> reach;  // per shape
+  const std::size_t rigid = scene_.bodies.size();
+  std::vector<double> regions(6 * ranks);
+  for (std::size_t r = 0; r < ranks; ++r) {
+    for (int a = 0; a < 3; ++a) {
+      regions[6 * r + a] = std::numeric_limits<double>::infinity();
+      regions[6 * r + a + 3] = -std::numeric_limits<double>::infinity();
+    }
+  }
+  for (std::uint32_t b = 0; b < count; ++b) {
+    const std::uint32_t g = group_of_[b];
+    owner[b] = g == kAlone ? decomposition_.owner(centres[b]) : group_owner[g];
+    boxes[b] = b < rigid ? spec_box(scene_.bodies[b], reach) : spec_box(scene_.linked[b - rigid]);
+    double* region = &regions[6 * static_cast<std::size_t>(owner[b])];
+    for (std::size_t a = 0; a < 3; ++a) {
+      region[a] = std::min(region[a], boxes[b][a] - halo_width_);
+      region[a + 3] = std::max(region[a + 3], boxes[b][a + 3] + halo_width_);
+    }
+  }
+  for (const std::vector<std::uint32_t>& members : groups_) {
+    std::array<double, 6> box = boxes[members.front()];
+    for (const std::uint32_t b : members) {
+      for (std::size_t a = 0; a < 3; ++a) {
+        box[a] = std::min(box[a], boxes[b][a]);
+        box[a + 3] = std::max(box[a + 3], boxes[b][a + 3]);
+      }
+    }
+    for (const std::uint32_t b : members) boxes[b] = box;
+  }
+  std::vector<LocalEntry> entries;
+  std::vector<std::vector<std::uint32_t>> sent_bodies(ranks);
+  for (std::uint32_t b = 0; b < count; ++b) {
+    if (owner[b] == rank_) {
+      entries.push_back({b, nullptr, -1});
+      for (std::size_t r = 0; r < ranks; ++r) {
+        if (static_cast<int>(r) != rank_ && overlap(boxes[b], &regions[6 * r])) {
+          sent_bodies[r].push_back(b);
+        }
+      }
+    } else if (overlap(boxes[b], &regions[6 * static_cast<std::size_t>(rank_)])) {
+      entries.push_back({b, nullptr, owner[b]});
+    }
+  }
+  const Clock::time_point start = Clock::now();
+  if (Status s = build_local(std::move(entries), sent_bodies); !s) return s;
+  stats_.partition_seconds += seconds_since(start);
+  return Status::ok();
 }
 
 std::vector<std::uint32_t> DistributedSimulation::owned() const {
@@ -471,30 +543,39 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
   std::vector<int> source;
   std::vector<Record> halo = parse(copies.value(), &counts, &source);
 
-  // 3. The local simulation: owned bodies and copies in scene order, on the device the last one
-  // ran on (opened once per rank).
+  // 3. The local simulation of the owned bodies and the copies.
+  std::vector<LocalEntry> entries;
+  entries.reserve(owned.size() + halo.size());
+  for (const Record& r : owned) entries.push_back({r.body, &r, -1});
+  for (std::size_t k = 0; k < halo.size(); ++k) {
+    entries.push_back({halo[k].body, &halo[k], source[k]});
+  }
+  if (Status s = build_local(std::move(entries), sent_bodies); !s) return s;
+  stats_.migrations += migrations;
+  stats_.partition_seconds += seconds_since(start);
+  return Status::ok();
+}
+
+Status DistributedSimulation::build_local(
+    std::vector<LocalEntry> entries, const std::vector<std::vector<std::uint32_t>>& sent_bodies) {
+  const auto ranks = static_cast<std::size_t>(size_);
+  // Owned bodies and copies in scene order, on the device the last simulation ran on (opened
+  // once per rank).
   if (local_) spare_ = Simulation::take_device(std::move(local_));
   local_bodies_.clear();
   local_owned_.clear();
-  struct Entry {
-    std::uint32_t body;
-    const Record* record;
-    int from;  // -1: owned
-  };
-  std::vector<Entry> entries;
-  entries.reserve(owned.size() + halo.size());
-  for (const Record& r : owned) entries.push_back({r.body, &r, -1});
-  for (std::size_t k = 0; k < halo.size(); ++k)
-    entries.push_back({halo[k].body, &halo[k], source[k]});
   std::sort(entries.begin(), entries.end(),
-            [](const Entry& a, const Entry& b) { return a.body < b.body; });
+            [](const LocalEntry& a, const LocalEntry& b) { return a.body < b.body; });
   send_.assign(ranks, {});
   receive_.assign(ranks, {});
+  std::uint64_t owned_bodies = 0;
   for (std::size_t k = 0; k < entries.size(); ++k) {
     local_bodies_.push_back(entries[k].body);
     local_owned_.push_back(entries[k].from < 0 ? 1 : 0);
     if (entries[k].from >= 0) {
       receive_[static_cast<std::size_t>(entries[k].from)].push_back(static_cast<std::uint32_t>(k));
+    } else {
+      ++owned_bodies;
     }
   }
   for (std::size_t r = 0; r < ranks; ++r) {
@@ -506,8 +587,8 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
     }
   }
   Status built = Status::ok();
-  stats_.owned_bodies = owned.size();
-  stats_.halo_bodies = halo.size();
+  stats_.owned_bodies = owned_bodies;
+  stats_.halo_bodies = entries.size() - owned_bodies;
   stats_.owned_particles = 0;
   stats_.halo_particles = 0;
   HaloLists lists;
@@ -523,11 +604,12 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
   if (!entries.empty()) {
     Result<std::unique_ptr<Device>> device =
         spare_ ? Result<std::unique_ptr<Device>>(std::move(spare_)) : open_device_();
+    // One rank holds the whole scene: no copy of it is needed.
     Result<std::unique_ptr<Simulation>> sim =
         !device ? Result<std::unique_ptr<Simulation>>(status_of(device))
         : size_ > 1
             ? Simulation::create(sub_scene(scene_, local_bodies_), std::move(device).value(), lists)
-            : Simulation::create(sub_scene(scene_, local_bodies_), std::move(device).value());
+            : Simulation::create(scene_, std::move(device).value());
     if (sim) {
       local_ = std::move(sim).value();
       device_info_ = local_->device().info();
@@ -547,39 +629,12 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
       };
       count(send_, send_counts_);
       count(receive_, receive_counts_);
-      Snapshot state;
-      state.step = steps_;
-      state.time = time();
-      state.cluster_rotation.resize(local_->sizes().clusters);
-      const std::size_t n = local_->particle_count();
-      const std::size_t planes = local_->sizes().impulse != 0 ? scene_.planes.size() : 0;
-      state.plane_impulse.resize(n * planes);
-      state.particle_pos.resize(n);
-      state.particle_vel.resize(n);
       for (std::size_t k = 0; k < entries.size(); ++k) {
-        const Record& r = *entries[k].record;
-        std::copy(r.pos.begin(), r.pos.end(), state.particle_pos.begin() + infos[k].first_particle);
-        std::copy(r.vel.begin(), r.vel.end(), state.particle_vel.begin() + infos[k].first_particle);
-        state.body_pos.push_back(r.state[0]);
-        state.body_quat.push_back(r.state[1]);
-        state.body_vel.push_back(r.state[2]);
-        state.body_angmom.push_back(r.state[3]);
-        state.body_angvel.push_back(r.state[4]);
-        if (r.rotations.size() != infos[k].cluster_count) {
-          built = Status::error(fmt::format("body {}: {} cluster rotations for {} clusters", r.body,
-                                            r.rotations.size(), infos[k].cluster_count));
-          break;
-        }
-        std::copy(r.rotations.begin(), r.rotations.end(),
-                  state.cluster_rotation.begin() + infos[k].first_cluster);
-        if (r.planes.size() == std::size_t{infos[k].particle_count} * planes) {
-          std::copy(r.planes.begin(), r.planes.end(),
-                    state.plane_impulse.begin() +
-                        static_cast<std::ptrdiff_t>(std::size_t{infos[k].first_particle} * planes));
-        }
-        (entries[k].from < 0 ? stats_.owned_particles : stats_.halo_particles) += r.pos.size();
+        (entries[k].from < 0 ? stats_.owned_particles : stats_.halo_particles) +=
+            infos[k].particle_count;
       }
-      if (built) built = local_->write_state(state);
+      // The bodies' state: the scene's at the start, else their records'.
+      if (entries.front().record != nullptr) built = write_records(entries);
     } else {
       built = sim.status();
     }
@@ -592,9 +647,42 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
   MPI_Allreduce(&bodies_here, &bodies_anywhere, 1, MPI_INT, MPI_LOR, comm_);
   halo_bodies_ = bodies_anywhere != 0;
   ++stats_.partitions;
-  stats_.migrations += migrations;
-  stats_.partition_seconds += seconds_since(start);
   return Status::ok();
+}
+
+Status DistributedSimulation::write_records(const std::vector<LocalEntry>& entries) {
+  const std::vector<BodyInfo>& infos = local_->bodies();
+  Snapshot state;
+  state.step = steps_;
+  state.time = time();
+  state.cluster_rotation.resize(local_->sizes().clusters);
+  const std::size_t n = local_->particle_count();
+  const std::size_t planes = local_->sizes().impulse != 0 ? scene_.planes.size() : 0;
+  state.plane_impulse.resize(n * planes);
+  state.particle_pos.resize(n);
+  state.particle_vel.resize(n);
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    const Record& r = *entries[k].record;
+    std::copy(r.pos.begin(), r.pos.end(), state.particle_pos.begin() + infos[k].first_particle);
+    std::copy(r.vel.begin(), r.vel.end(), state.particle_vel.begin() + infos[k].first_particle);
+    state.body_pos.push_back(r.state[0]);
+    state.body_quat.push_back(r.state[1]);
+    state.body_vel.push_back(r.state[2]);
+    state.body_angmom.push_back(r.state[3]);
+    state.body_angvel.push_back(r.state[4]);
+    if (r.rotations.size() != infos[k].cluster_count) {
+      return Status::error(fmt::format("body {}: {} cluster rotations for {} clusters", r.body,
+                                       r.rotations.size(), infos[k].cluster_count));
+    }
+    std::copy(r.rotations.begin(), r.rotations.end(),
+              state.cluster_rotation.begin() + infos[k].first_cluster);
+    if (r.planes.size() == std::size_t{infos[k].particle_count} * planes) {
+      std::copy(r.planes.begin(), r.planes.end(),
+                state.plane_impulse.begin() +
+                    static_cast<std::ptrdiff_t>(std::size_t{infos[k].first_particle} * planes));
+    }
+  }
+  return local_->write_state(state);
 }
 
 Result<double> DistributedSimulation::exchange_halos(Status stepped) {

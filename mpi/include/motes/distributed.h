@@ -114,6 +114,22 @@ class DistributedSimulation {
   Result<double> exchange_halos(Status stepped);
   /// This rank's records of its owned bodies, from the local simulation.
   Result<std::vector<Record>> owned_records();
+  /// A body of the local simulation: its scene index, its state (nullptr: the scene's start) and
+  /// the rank it is copied from (-1: owned here).
+  struct LocalEntry {
+    std::uint32_t body = 0;
+    const Record* record = nullptr;
+    int from = -1;
+  };
+  /// Collective: the local simulation of `entries` (all with records, or none) on this rank's
+  /// device, the halo lists (`sent_bodies`: the scene bodies sent to each rank, ascending) and
+  /// their counts.
+  Status build_local(std::vector<LocalEntry> entries,
+                     const std::vector<std::vector<std::uint32_t>>& sent_bodies);
+  /// Collective: the partition at create, from the scene (`centres`: body_centres).
+  Status first_partition(const std::vector<Eigen::Vector3d>& centres);
+  /// Writes the entries' records into the local simulation (build_local).
+  Status write_records(const std::vector<LocalEntry>& entries);
   /// groups_ and group_of_ from the scene.
   void group_bodies();
 
