@@ -1,8 +1,9 @@
 // W1 over MPI ranks (docs/scale-out.md, docs/benchmarks.md "Scale-out"): the falling phase of
 // settle_workload at a docs/benchmarks.md size, stepped over every rank of mpirun; rank 0 prints
 // one JSON line: ms per step and the slowest rank's seconds per part (its own steps, halo copies,
-// MPI, partitions), halo copies at the end.
+// MPI, partitions), halo copies at the end, and the setup's seconds (scene and first partition).
 // Usage: mpirun -np N motes_mpi_bench [--backend B] [--size N] [--steps S] [--warmup W]
+//                                     [--margin M]
 #include <fmt/format.h>
 #include <mpi.h>
 
@@ -24,6 +25,8 @@ int main(int argc, char** argv) {
   std::uint64_t size = 1048576;
   std::uint64_t steps = 200;
   std::uint64_t warmup = 20;
+  motes::DistributedOptions
+      options;  // --margin M: the partition margin (m); default half a diameter
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     const std::string value = argv[i + 1];
@@ -35,6 +38,8 @@ int main(int argc, char** argv) {
       steps = std::stoull(value);
     } else if (key == "--warmup") {
       warmup = std::stoull(value);
+    } else if (key == "--margin") {
+      options.margin = std::stod(value);
     }
   }
   int nx = 0, ny = 0, nz = 0;
@@ -43,16 +48,26 @@ int main(int argc, char** argv) {
     MPI_Finalize();
     return 2;
   }
+  // One GPU per rank: the rank's index on its host, modulo the backend's devices.
   const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_RANK");
-  const int device = backend == "openmp" || local == nullptr ? -1 : std::atoi(local);
+  int device = -1;
+  for (const motes::BackendReport& r : motes::list_backends()) {
+    if (r.backend == backend && backend != "openmp" && local != nullptr && !r.devices.empty()) {
+      device = std::atoi(local) % static_cast<int>(r.devices.size());
+    }
+  }
   motes::DeviceOpener opener = [&]() { return motes::open_device(backend, device); };
+  const auto setup_start = std::chrono::steady_clock::now();
   auto sim = motes::DistributedSimulation::create(motes::settle_workload(nx, ny, nz),
-                                                  MPI_COMM_WORLD, opener, {});
+                                                  MPI_COMM_WORLD, opener, options);
   if (!sim) {
     if (rank == 0) fmt::print(stderr, "mpi_bench: {}\n", sim.message());
     MPI_Finalize();
     return 2;
   }
+  MPI_Barrier(MPI_COMM_WORLD);
+  const double setup =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
   motes::Status s = sim.value()->step(warmup);
   const motes::DistributedStats before = sim.value()->stats();
   MPI_Barrier(MPI_COMM_WORLD);
@@ -81,10 +96,10 @@ int main(int argc, char** argv) {
         "{{\"ranks\": {}, \"backend\": \"{}\", \"device\": \"{}\", \"particles\": {}, "
         "\"bricks\": \"{}\", \"steps\": {}, \"ms_per_step\": {:.4f}, \"own_step_ms\": {:.4f}, "
         "\"halo_copy_ms\": {:.4f}, \"mpi_ms\": {:.4f}, \"partition_ms\": {:.4f}, "
-        "\"partitions\": {}, \"halo_particles\": {}}}\n",
+        "\"partitions\": {}, \"halo_particles\": {}, \"setup_s\": {:.1f}}}\n",
         ranks, backend, sim.value()->device_info().name, sim.value()->particle_count(),
         sim.value()->decomposition().describe(), steps, seconds * per, most[0] * per, most[1] * per,
-        most[2] * per, most[3] * per, after.partitions - before.partitions, halo_total);
+        most[2] * per, most[3] * per, after.partitions - before.partitions, halo_total, setup);
   }
   sim.value().reset();
   MPI_Finalize();

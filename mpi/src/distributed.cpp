@@ -459,8 +459,10 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
   const auto ranks = static_cast<std::size_t>(size_);
   // 1. Every group of bodies (a body alone, or bodies that must be stepped together: the mean of
   // its members' centres, summed in scene order) to the rank whose brick holds its centre.
-  std::sort(held.begin(), held.end(),
-            [](const Record& a, const Record& b) { return a.body < b.body; });
+  const auto by_body = [](const Record& a, const Record& b) { return a.body < b.body; };
+  if (!std::is_sorted(held.begin(), held.end(), by_body)) {
+    std::sort(held.begin(), held.end(), by_body);
+  }
   std::unordered_map<std::uint32_t, Eigen::Vector3d> sums;  // groups of several bodies
   for (const Record& r : held) {
     const std::uint32_t g = group_of_[r.body];
@@ -489,9 +491,11 @@ Status DistributedSimulation::partition(std::vector<Record> held) {
   std::vector<int> counts;
   Result<std::vector<vec4>> arrived = all_to_all(comm_, out, counts);
   if (Status st = agree(comm_, status_of(arrived)); !st) return st;
+  // The bodies that stayed are in order; the arrivals are sorted and merged in.
+  const auto stayed = static_cast<std::ptrdiff_t>(owned.size());
   for (Record& r : parse(arrived.value())) owned.push_back(std::move(r));
-  std::sort(owned.begin(), owned.end(),
-            [](const Record& a, const Record& b) { return a.body < b.body; });
+  std::sort(owned.begin() + stayed, owned.end(), by_body);
+  std::inplace_merge(owned.begin(), owned.begin() + stayed, owned.end(), by_body);
   std::uint64_t migrations = 0;
   MPI_Allreduce(&moved, &migrations, 1, MPI_UINT64_T, MPI_SUM, comm_);
 
