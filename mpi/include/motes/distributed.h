@@ -34,9 +34,11 @@ struct DistributedOptions {
   /// Bricks along x, y, z (their product = the rank count); none: choose_decomposition.
   std::optional<std::array<int, 3>> decomposition;
   /// How far (m) a particle may move before bodies are re-partitioned (migration) and the halos
-  /// chosen again; < 0: half the largest particle diameter. The halo holds every body with a
-  /// particle within the largest diameter + 2 margins of what a rank owns, so no contact is missed
-  /// in between.
+  /// chosen again; < 0: half the largest particle diameter. The ranks re-partition at a list
+  /// rebuild where the largest displacement since the last partition plus 0.45 skin exceeds it.
+  /// The halo holds every body with a particle within 2 margins (particles grown by their radii)
+  /// of what a rank owns, so no contact is missed in between. Larger: rarer partitions, a wider
+  /// halo.
   double margin = -1.0;
 };
 
