@@ -5,9 +5,11 @@
 //   header (96 bytes): magic "MOTESCK1", version, header bytes, file bytes, step, time, setup hash,
 //     scene hash, particles, scene bodies, rigid bodies, rigid particles, hash table size T,
 //     neighbour capacity K, clusters, section count, run record bytes;
-//   run record: the backend, then CheckpointRun (strings as u32 length + bytes);
+//   run record: the backend, then CheckpointRun (strings as u32 length + bytes; the extension, as
+//     u64 length + bytes, only when it is not empty);
 //   sections: {u32 buffer, u32 element bytes, u64 bytes, the buffer's first `bytes` bytes}, one per
-//     buffer of state_buffers(), in that order, in the device's order (the same on every backend);
+//     buffer of state_buffers(), in that order, in the device's order (the same on every backend):
+//     17, and an 18th (PartitionRefPos) for one rank of a run over MPI ranks;
 //   checksum: FNV-1a 64 of every byte before it.
 // Version 1 (still read by load_state): a 48-byte header {magic, version, particles, bodies,
 // reserved, step, time, payload bytes}, the scene-ordered body and particle arrays of a Snapshot,
@@ -69,6 +71,16 @@ static_assert(kStateBuffers[kPosSection] == Buffer::ParticlePos &&
               kStateBuffers[kCountSection] == Buffer::NeighbourCount &&
               kStateBuffers[kOrderSection] == Buffer::GridOrder &&
               kStateBuffers[kStartSection] == Buffer::GridCellStart);
+
+/// The sections of a simulation's checkpoint: kStateBuffers, then, for one rank of a run over MPI
+/// ranks (Sizes::partition), PartitionRefPos: the positions at the ranks' last partition, from
+/// which particles_displacement decides the next one. A single process's checkpoint has no such
+/// section, so its format is what it was before runs over ranks.
+std::vector<Buffer> state_buffers(const Sizes& sizes) {
+  std::vector<Buffer> out(kStateBuffers.begin(), kStateBuffers.end());
+  if (sizes.partition != 0) out.push_back(Buffer::PartitionRefPos);
+  return out;
+}
 
 /// The fixed part of a version 2 file.
 struct Header {
@@ -180,6 +192,11 @@ std::vector<unsigned char> encode_record(const std::string& backend, const Check
   w.u64(run.series.bodies_csv_bytes);
   w.u64(run.series.frame_times.size());
   for (const double t : run.series.frame_times) w.f64(t);
+  // Only when there is one: a single process's record is what it was before extensions.
+  if (!run.extension.empty()) {
+    w.u64(run.extension.size());
+    w.raw(run.extension.data(), run.extension.size());
+  }
   return std::move(w.bytes);
 }
 
@@ -202,6 +219,12 @@ bool decode_record(const unsigned char* p, std::size_t n, CheckpointInfo& info) 
   if (r.bad || frames > r.left() / sizeof(double)) return false;
   run.series.frame_times.resize(frames);
   for (double& t : run.series.frame_times) t = r.f64();
+  if (!r.bad && r.left() > 0) {
+    const std::uint64_t extension = r.u64();
+    if (r.bad || extension > r.left()) return false;
+    run.extension.resize(static_cast<std::size_t>(extension));
+    r.raw(run.extension.data(), run.extension.size());
+  }
   return !r.bad && r.left() == 0;
 }
 
@@ -271,6 +294,7 @@ Result<Parsed> parse(const std::string& path, const std::vector<unsigned char>& 
     out.info.time = h.time;
     out.info.particles = h.particles;
     out.info.bodies = h.bodies;
+    out.info.checksum = stored;
     return out;
   }
   if (version != kCheckpointVersion) {
@@ -334,6 +358,7 @@ Result<Parsed> parse(const std::string& path, const std::vector<unsigned char>& 
   out.info.particles = h.particles;
   out.info.bodies = h.bodies;
   out.info.setup_hash = h.setup_hash;
+  out.info.checksum = stored;
   out.info.run.scene_hash = h.scene_hash;
   return out;
 }
@@ -438,6 +463,20 @@ Result<std::uint64_t> scene_file_hash(const std::string& path) {
   return h;
 }
 
+std::vector<unsigned char> encode_checkpoint_run(const std::string& backend,
+                                                 const CheckpointRun& run) {
+  return encode_record(backend, run);
+}
+
+bool decode_checkpoint_run(const unsigned char* data, std::size_t bytes, std::string& backend,
+                           CheckpointRun& run) {
+  CheckpointInfo info;
+  if (!decode_record(data, bytes, info)) return false;
+  backend = std::move(info.backend);
+  run = std::move(info.run);
+  return true;
+}
+
 Result<CheckpointInfo> read_checkpoint_info(const std::string& path) {
   Result<std::vector<unsigned char>> bytes = read_whole_file(path);
   if (!bytes) return bytes.status();
@@ -466,10 +505,11 @@ Status Simulation::save_state(const std::string& path, const CheckpointRun& run)
   h.table = sizes_.table;
   h.neighbour_capacity = sizes_.neighbour_capacity;
   h.clusters = sizes_.clusters;
-  h.section_count = static_cast<std::uint32_t>(kStateBuffers.size());
+  const std::vector<Buffer> buffers = state_buffers(sizes_);
+  h.section_count = static_cast<std::uint32_t>(buffers.size());
   h.record_bytes = record.size();
   std::uint64_t file_bytes = kHeaderBytes + record.size() + 8;
-  for (const Buffer b : kStateBuffers) {
+  for (const Buffer b : buffers) {
     file_bytes += kSectionHeaderBytes + buffer_layout(b, sizes_).bytes();
   }
   h.file_bytes = file_bytes;
@@ -482,7 +522,7 @@ Status Simulation::save_state(const std::string& path, const CheckpointRun& run)
     if (Status st = file.write(&h, sizeof h); !st) return st;
     if (Status st = file.write(record.data(), record.size()); !st) return st;
     std::vector<unsigned char> data;
-    for (const Buffer b : kStateBuffers) {
+    for (const Buffer b : buffers) {
       const BufferLayout layout = buffer_layout(b, sizes_);
       const std::uint32_t section[2] = {static_cast<std::uint32_t>(b),
                                         static_cast<std::uint32_t>(layout.element_bytes)};
@@ -540,20 +580,39 @@ Status Simulation::load_state(const std::string& path) {
   const auto corrupt = [&](const std::string& what) {
     return Status::error(fmt::format("{}: corrupt checkpoint ({})", path, what));
   };
-  if (sections.size() != kStateBuffers.size() && sections.size() != kSectionsBeforeImpulses) {
+  // A rank's checkpoint of a run over MPI ranks ends with the partition reference; a single
+  // process's has none.
+  const std::vector<Buffer> expected = state_buffers(sizes_);
+  const bool with_reference =
+      sections.size() == kStateBuffers.size() + 1 &&
+      sections.back().buffer == static_cast<std::uint32_t>(Buffer::PartitionRefPos);
+  if (sizes_.partition != 0 && !with_reference) {
+    return Status::error(fmt::format(
+        "{}: a single process's checkpoint: this simulation is one rank of a run over MPI ranks, "
+        "whose checkpoint also holds the positions at the last partition (PartitionRefPos)",
+        path));
+  }
+  if (sizes_.partition == 0 && with_reference) {
+    return Status::error(fmt::format(
+        "{}: one rank's checkpoint of a run over MPI ranks: it loads only into that rank's "
+        "simulation (DistributedSimulation::resume of its checkpoint set)",
+        path));
+  }
+  if (sections.size() != expected.size() &&
+      (sizes_.partition != 0 || sections.size() != kSectionsBeforeImpulses)) {
     return corrupt("section count");
   }
-  for (std::size_t k = sections.size(); k < kStateBuffers.size(); ++k) {
-    if (buffer_layout(kStateBuffers[k], sizes_).bytes() != 0) {
-      return corrupt(fmt::format("no section for {}", buffer_name(kStateBuffers[k])));
+  for (std::size_t k = sections.size(); k < expected.size(); ++k) {
+    if (buffer_layout(expected[k], sizes_).bytes() != 0) {
+      return corrupt(fmt::format("no section for {}", buffer_name(expected[k])));
     }
   }
   for (std::size_t k = 0; k < sections.size(); ++k) {
-    const BufferLayout layout = buffer_layout(kStateBuffers[k], sizes_);
-    if (sections[k].buffer != static_cast<std::uint32_t>(kStateBuffers[k]) ||
+    const BufferLayout layout = buffer_layout(expected[k], sizes_);
+    if (sections[k].buffer != static_cast<std::uint32_t>(expected[k]) ||
         sections[k].element_bytes != layout.element_bytes || sections[k].bytes != layout.bytes()) {
-      return corrupt(fmt::format("section {} is not {} of {} bytes", k,
-                                 buffer_name(kStateBuffers[k]), layout.bytes()));
+      return corrupt(fmt::format("section {} is not {} of {} bytes", k, buffer_name(expected[k]),
+                                 layout.bytes()));
     }
   }
   // Values a step uses as indices must be in range, whatever a file made to pass the checksum
@@ -606,8 +665,7 @@ Status Simulation::load_state(const std::string& path) {
   Device& d = *device_;
   for (std::size_t k = 0; k < sections.size(); ++k) {
     if (sections[k].bytes == 0) continue;
-    if (Status s = d.write(kStateBuffers[k], bytes.data() + sections[k].offset, sections[k].bytes);
-        !s) {
+    if (Status s = d.write(expected[k], bytes.data() + sections[k].offset, sections[k].bytes); !s) {
       return s;
     }
   }

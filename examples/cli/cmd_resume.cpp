@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "motes/output.h"
 #include "motes/scene.h"
 #include "motes/simulation.h"
+#include "run_mpi.h"
 #include "run_session.h"
 
 namespace motes::cli {
@@ -40,10 +42,25 @@ struct ResumeArgs {
 void resume(const ResumeArgs& args) {
   const Clock::time_point start = Clock::now();
   const std::string& path = args.checkpoint;
+  std::error_code ec;
+  if (mpi_ranks() > 1 || std::filesystem::is_directory(path, ec)) {
+    // A checkpoint set of a run over MPI ranks (or anything under mpirun -np N): run_mpi.h.
+    DistributedResume d;
+    d.path = path;
+    d.backend = args.backend;
+    d.device = args.device;
+    d.threads = args.threads;
+    if (args.steps_option->count() > 0) d.steps = args.steps;
+    if (args.duration_option->count() > 0) d.duration = args.duration;
+    if (args.checkpoint_every_option->count() > 0) d.checkpoint_every = args.checkpoint_every;
+    resume_distributed(d);
+    return;
+  }
   Result<CheckpointInfo> read = read_checkpoint_info(path);
   if (!read) fail(read.message());
   const CheckpointInfo& info = read.value();
   const CheckpointRun& run = info.run;
+  if (!run.extension.empty()) fail(rank_file_refusal(path));
   if (info.version < kCheckpointVersion) {
     fail(fmt::format(
         "{}: a version {} checkpoint (motes bench's, or an older motes's) holds no record of "
@@ -146,8 +163,10 @@ void resume(const ResumeArgs& args) {
 void add_resume_command(CLI::App& app) {
   auto args = std::make_shared<ResumeArgs>();
   CLI::App* sub = app.add_subcommand(
-      "resume", "Go on with a run from a checkpoint of motes run --checkpoint-every");
-  sub->add_option("CHECKPOINT", args->checkpoint, "checkpoint file (checkpoint-<step>.mck)")
+      "resume", "Go on with a run from a checkpoint (or set) of motes run --checkpoint-every");
+  sub->add_option("CHECKPOINT", args->checkpoint,
+                  "checkpoint file (checkpoint-<step>.mck), or under mpirun a checkpoint set "
+                  "(checkpoint-<step>.mckset)")
       ->required();
   sub->add_option("--backend", args->backend,
                   "backend to go on with (default: the one that wrote the checkpoint)")

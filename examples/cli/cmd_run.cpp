@@ -89,14 +89,27 @@ void run(const RunArgs& args) {
   plan.every = output_every(args, scene->settings);
   plan.checkpoint_every = args.checkpoint_every;
 
+  // What each checkpoint records, so that `motes resume` can go on with the same series.
+  CheckpointRun& record = plan.record;
+  if (!args.scene.empty()) {
+    record.scene_path = args.scene;
+    record.scene_file = absolute_path(args.scene);
+    Result<std::uint64_t> hash = scene_file_hash(args.scene);
+    mpi_agree_or_fail(hash ? Status::ok() : hash.status());
+    record.scene_hash = hash.value();
+  }
+  record.output_dir = absolute_path(args.out);
+  record.output_format = output_format_name(format.value());
+  record.every = plan.every;
+  record.total_steps = plan.total;
+  record.checkpoint_every = args.checkpoint_every;
+  record.checkpoint_dir = absolute_path(
+      args.checkpoint_dir.empty() ? (std::filesystem::path(args.out) / "checkpoints").string()
+                                  : args.checkpoint_dir);
+
   if (mpi_ranks() > 1 || !args.decomposition.empty()) {
-    // Over MPI ranks (docs/scale-out.md): what a distributed run cannot do yet is refused.
+    // Over MPI ranks (docs/scale-out.md).
     if (mpi_ranks() == 1) fail("--decomposition needs several MPI ranks: mpirun -np N motes run");
-    if (args.checkpoint_every > 0 || !args.checkpoint_dir.empty() || !args.render_dir.empty()) {
-      fail(
-          "--checkpoint-every, --checkpoint-dir and --render do not run over several MPI ranks "
-          "yet (docs/scale-out.md): render the frames afterwards with motes render");
-    }
     DistributedRun d;
     if (!args.decomposition.empty()) {
       Result<std::array<int, 3>> cells = parse_decomposition(args.decomposition);
@@ -112,28 +125,14 @@ void run(const RunArgs& args) {
     d.every = plan.every;
     d.format = format.value();
     d.out = args.out;
+    d.checkpoint_every = args.checkpoint_every;
+    d.record = record;
+    d.render_dir = args.render_dir;
+    d.render = args.render;
     d.setup_seconds = seconds_since(start);
     run_distributed(std::move(d));
     return;
   }
-
-  // What each checkpoint records, so that `motes resume` can go on with the same series.
-  CheckpointRun& record = plan.record;
-  if (!args.scene.empty()) {
-    record.scene_path = args.scene;
-    record.scene_file = absolute_path(args.scene);
-    Result<std::uint64_t> hash = scene_file_hash(args.scene);
-    if (!hash) fail(hash.message());
-    record.scene_hash = hash.value();
-  }
-  record.output_dir = absolute_path(args.out);
-  record.output_format = output_format_name(format.value());
-  record.every = plan.every;
-  record.total_steps = plan.total;
-  record.checkpoint_every = args.checkpoint_every;
-  record.checkpoint_dir = absolute_path(
-      args.checkpoint_dir.empty() ? (std::filesystem::path(args.out) / "checkpoints").string()
-                                  : args.checkpoint_dir);
 
   DeviceOptions options;
   options.cpu_threads = args.threads;

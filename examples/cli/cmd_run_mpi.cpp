@@ -1,23 +1,27 @@
-// `motes run` over MPI ranks (run_mpi.h, docs/scale-out.md).
+// `motes run` and `motes resume` over MPI ranks (run_mpi.h, docs/scale-out.md): MPI's start and
+// end, and the setup of a run or a resume; run_mpi_session.cpp steps it.
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "cli_util.h"
+#include "motes/checkpoint.h"
 #include "motes/devices.h"
-#include "progress.h"
+#include "motes/render.h"
+#include "motes/scene.h"
+#include "render_args.h"
 #include "run_mpi.h"
 
 #ifdef MOTES_HAVE_MPI
 #include <mpi.h>
 
 #include "motes/distributed.h"
+#include "run_mpi_session.h"
 #endif
 
 namespace motes::cli {
@@ -88,9 +92,7 @@ double seconds_since(Clock::time_point start) {
 
 /// The device this rank opens: --device, or the rank's index on its host among the backend's
 /// devices (one GPU per rank); the CPU backend has one device.
-DeviceOpener device_opener(const DistributedRun& run) {
-  std::string backend = run.backend;
-  int index = run.device;
+DeviceOpener device_opener(std::string backend, int index, int threads) {
   if (backend == "auto") {
     Result<std::unique_ptr<Device>> probe = open_device("auto");
     if (probe) backend = probe.value()->info().backend;
@@ -103,88 +105,14 @@ DeviceOpener device_opener(const DistributedRun& run) {
     }
   }
   DeviceOptions options;
-  options.cpu_threads = run.threads;
+  options.cpu_threads = threads;
   return [backend, index, options]() { return open_device(backend, index, options); };
 }
 
-/// The motion guard of a run over ranks, on the state rank 0 gathered (docs/scale-out.md): a
-/// non-finite particle is an error naming step, body and particle (scene indices); the fastest
-/// particle's travel per substep beyond Simulation::kSafeTravel of its diameter is a warning.
-Status guard(const Snapshot& s, const DistributedSimulation& sim, double& travel,
-             std::string& warning) {
-  const Settings& settings = sim.settings();
-  const double h = settings.dt / static_cast<double>(settings.substeps);
-  travel = 0.0;
-  std::size_t fastest = 0;
-  for (std::size_t i = 0; i < s.particle_pos.size(); ++i) {
-    const shared::vec4& p = s.particle_pos[i];
-    const shared::vec4& v = s.particle_vel[i];
-    const std::uint32_t b = s.particle_body[i];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(v.x) ||
-        !std::isfinite(v.y) || !std::isfinite(v.z)) {
-      return Status::error(fmt::format(
-          "non-finite state at step {} (t = {:.6g} s): particle {} of body {} '{}': position "
-          "({}, {}, {}) m, velocity ({}, {}, {}) m/s; the run has gone unstable (dt {:.4g} s at "
-          "substeps {} too large for the contact stiffness?)",
-          s.step, s.time, i, b, sim.bodies()[b].name, p.x, p.y, p.z, v.x, v.y, v.z, settings.dt,
-          settings.substeps));
-    }
-    const double speed = std::sqrt(static_cast<double>(v.x) * static_cast<double>(v.x) +
-                                   static_cast<double>(v.y) * static_cast<double>(v.y) +
-                                   static_cast<double>(v.z) * static_cast<double>(v.z));
-    const double t = p.w > 0.0f ? speed * h / (2.0 * static_cast<double>(p.w)) : 0.0;
-    if (t > travel) {
-      travel = t;
-      fastest = i;
-    }
-  }
-  warning.clear();
-  if (travel > Simulation::kSafeTravel) {
-    const shared::vec4& p = s.particle_pos[fastest];
-    const std::uint32_t b = s.particle_body[fastest];
-    const double diameter = 2.0 * static_cast<double>(p.w);
-    const double speed = travel * diameter / h;
-    warning = fmt::format(
-        "step {} (t = {:.6g} s): particle {} of body {} '{}' moves {:.3g} of its diameter "
-        "({:.4g} m) per substep at {:.4g} m/s, more than the {} that contacts are resolved at: "
-        "contacts can be missed (tunnelling); the largest safe dt at this speed is {:.4g} s at "
-        "substeps {} (dt is {:.4g} s)",
-        s.step, s.time, fastest, b, sim.bodies()[b].name, travel, diameter, speed,
-        Simulation::kSafeTravel,
-        Simulation::kSafeTravel * diameter / speed * static_cast<double>(settings.substeps),
-        settings.substeps, settings.dt);
-  }
-  return Status::ok();
-}
-
-}  // namespace
-
-void run_distributed(DistributedRun run) {
-  const Clock::time_point start = Clock::now();
+/// Collective: every rank's device, as "rank R: device ..." lines (rank 0; empty elsewhere).
+std::string device_lines(const DistributedSimulation& sim) {
   const int rank = mpi_rank();
   const int ranks = mpi_ranks();
-  DistributedOptions options;
-  options.decomposition = run.decomposition;
-  Result<std::unique_ptr<DistributedSimulation>> created =
-      DistributedSimulation::create(run.scene, MPI_COMM_WORLD, device_opener(run), options);
-  if (!created) fail(created.message());  // the same message on every rank, printed by rank 0
-  DistributedSimulation& sim = *created.value();
-
-  std::unique_ptr<FrameWriter> writer;
-  Status opened = Status::ok();
-  if (rank == 0 && run.format != OutputFormat::None) {
-    std::vector<std::string> names;
-    for (const BodyInfo& b : sim.bodies()) names.push_back(b.name);
-    Result<std::unique_ptr<FrameWriter>> w = open_frame_writer(run.format, run.out, names);
-    if (w) {
-      writer = std::move(w).value();
-    } else {
-      opened = w.status();
-    }
-  }
-  mpi_agree_or_fail(opened);
-
-  // Every rank's device, for the header.
   const DeviceInfo& info = sim.device_info();
   const std::string mine = fmt::format("{} {}: {}", info.backend, info.index, info.name);
   int length = static_cast<int>(mine.size());
@@ -201,123 +129,218 @@ void run_distributed(DistributedRun run) {
   }
   MPI_Gatherv(mine.data(), length, MPI_CHAR, all.data(), lengths.data(), at.data(), MPI_CHAR, 0,
               MPI_COMM_WORLD);
+  std::string lines;
+  for (int r = 0; rank == 0 && r < ranks; ++r) {
+    lines +=
+        fmt::format("motes: rank {}: device {}\n", r,
+                    all.substr(static_cast<std::size_t>(at[static_cast<std::size_t>(r)]),
+                               static_cast<std::size_t>(lengths[static_cast<std::size_t>(r)])));
+  }
+  return lines;
+}
+
+/// The frame writer's names: the scene's bodies.
+std::vector<std::string> body_names(const DistributedSimulation& sim) {
+  std::vector<std::string> names;
+  names.reserve(sim.bodies().size());
+  for (const BodyInfo& b : sim.bodies()) names.push_back(b.name);
+  return names;
+}
+
+template <typename T>
+Status status_of(const Result<T>& r) {
+  return r ? Status::ok() : r.status();
+}
+
+}  // namespace
+
+void run_distributed(DistributedRun run) {
+  const Clock::time_point start = Clock::now();
+  const int ranks = mpi_ranks();
+  DistributedOptions options;
+  options.decomposition = run.decomposition;
+  Result<std::unique_ptr<DistributedSimulation>> created = DistributedSimulation::create(
+      run.scene, MPI_COMM_WORLD, device_opener(run.backend, run.device, run.threads), options);
+  if (!created) fail(created.message());  // the same message on every rank, printed by rank 0
+  DistributedPlan plan;
+  plan.sim = std::move(created).value();
+  DistributedSimulation& sim = *plan.sim;
+  plan.scene_name = run.scene_name;
+  plan.total = run.total;
+  plan.every = run.every;
+  plan.checkpoint_every = run.checkpoint_every;
+  plan.record = run.record;
+  on_rank0([&] {
+    if (run.format == OutputFormat::None) return;
+    Result<std::unique_ptr<FrameWriter>> w =
+        open_frame_writer(run.format, run.out, body_names(sim));
+    if (!w) fail(w.message());
+    plan.writer = std::move(w).value();
+  });
+
+  const std::string devices = device_lines(sim);
   const Settings& s = sim.settings();
-  if (rank == 0) {
+  on_rank0([&] {
     fmt::print("motes: {}: {} particles in {} bod{} over {} MPI ranks (bricks {})\n",
                run.scene_name, sim.particle_count(), sim.bodies().size(),
                sim.bodies().size() == 1 ? "y" : "ies", ranks, sim.decomposition().describe());
-    for (int r = 0; r < ranks; ++r) {
-      fmt::print("motes: rank {}: device {}\n", r,
-                 all.substr(static_cast<std::size_t>(at[static_cast<std::size_t>(r)]),
-                            static_cast<std::size_t>(lengths[static_cast<std::size_t>(r)])));
+    fmt::print("{}", devices);
+    fmt::print("motes: {} steps of {} s = {:.6g} s simulated; a frame every {} steps{}\n",
+               run.total, s.dt, static_cast<double>(run.total) * s.dt, run.every,
+               plan.writer ? fmt::format(" to {}", plan.writer->main_path())
+                           : " (not written: --format none)");
+    if (run.checkpoint_every > 0) {
+      fmt::print("motes: a checkpoint set every {} steps in {} (the last two kept)\n",
+                 run.checkpoint_every, run.record.checkpoint_dir);
     }
-    fmt::print(
-        "motes: {} steps of {} s = {:.6g} s simulated; a frame every {} steps{}\n", run.total, s.dt,
-        static_cast<double>(run.total) * s.dt, run.every,
-        writer ? fmt::format(" to {}", writer->main_path()) : " (not written: --format none)");
     std::fflush(stdout);
+  });
+  if (!run.render_dir.empty()) {
+    // Pictures of every frame, drawn by rank 0 from the gathered state as one process draws them:
+    // the scene's camera or one fitted to the initial particles.
+    Result<Snapshot> first = sim.gather(0);
+    if (!first) fail(first.message());
+    on_rank0([&] {
+      render::RenderSettings settings = render_settings(
+          run.render, render::look_from_scene(run.scene), run.scene.camera, first->particle_pos);
+      const double interval = static_cast<double>(run.every) * s.dt;
+      plan.render = open_render_output(run.render, std::move(settings), run.render_dir, interval,
+                                       run.scene.camera.has_value());
+    });
   }
+  plan.setup_seconds = run.setup_seconds + seconds_since(start);
+  run_distributed_session(std::move(plan));
+}
 
-  double step_seconds = 0.0;
-  double output_seconds = 0.0;
-  // At every frame and at least every Simulation::kGuardInterval steps: the state gathered on
-  // rank 0, checked by the guard, and at frames written.
-  std::uint64_t checks = 0;
-  std::uint64_t warned = 0;
-  double worst = 0.0;
-  double last_warned = 0.0;
-  const auto check = [&](bool write) {
-    const Clock::time_point t = Clock::now();
-    Result<Snapshot> snap = sim.gather(0);
-    Status ok = snap ? Status::ok() : snap.status();
-    if (ok && rank == 0) {
-      double travel = 0.0;
-      std::string warning;
-      ok = guard(snap.value(), sim, travel, warning);
-      ++checks;
-      if (!warning.empty()) {
-        ++warned;
-        worst = std::max(worst, travel);
-        if (travel > 2.0 * last_warned) {
-          fmt::print(stderr, "motes: warning: {}\n", warning);
-          last_warned = travel;
-        }
-      }
-      if (ok && write && writer) ok = writer->write_frame(snap.value());
-      if (!ok && writer) (void)writer->finish();  // the frames so far stay readable
-    }
-    mpi_agree_or_fail(ok);
-    output_seconds += seconds_since(t);
-  };
-  const auto frame = [&]() { check(true); };
-  std::unique_ptr<Progress> progress;
-  if (rank == 0) progress = std::make_unique<Progress>(run.total);
-  const double setup = run.setup_seconds + seconds_since(start);
-  const Clock::time_point loop = Clock::now();
-  frame();
-  while (sim.steps() < run.total) {
-    const std::uint64_t next_frame = (sim.steps() / run.every + 1) * run.every;
-    const std::uint64_t next =
-        std::min({run.total, next_frame, sim.steps() + Simulation::kGuardInterval});
-    const Clock::time_point t = Clock::now();
-    if (Status st = sim.step(next - sim.steps()); !st) {
-      if (progress) progress->finish();
-      if (writer) (void)writer->finish();
-      fail(st.message());
-    }
-    step_seconds += seconds_since(t);
-    check(sim.steps() == next_frame || sim.steps() == run.total);
-    if (progress) progress->update(sim.steps(), sim.time());
+void resume_distributed(const DistributedResume& args) {
+  const Clock::time_point start = Clock::now();
+  const std::string& path = args.path;
+  const int ranks = mpi_ranks();
+  std::error_code ec;
+  if (!std::filesystem::is_directory(path, ec)) {
+    // A file: a single process's checkpoint, or one rank's file of a set.
+    Result<CheckpointInfo> file = read_checkpoint_info(path);
+    mpi_agree_or_fail(status_of(file));
+    if (!file->run.extension.empty()) fail(rank_file_refusal(path));
+    fail(fmt::format(
+        "{}: a checkpoint of one process; this run has {} MPI ranks: resume it in one process "
+        "(motes resume {}, without mpirun)",
+        path, ranks, path));
   }
-  if (progress) progress->finish();
-  Status finished = writer ? writer->finish() : Status::ok();
-  mpi_agree_or_fail(finished);
+  Result<CheckpointSetInfo> read = read_checkpoint_set(path);
+  mpi_agree_or_fail(status_of(read));
+  const CheckpointSetInfo& info = read.value();
+  if (info.ranks != ranks || !mpi_started) {
+    fail(fmt::format(
+        "{}: a checkpoint set of {} MPI rank{}; this run has {}: resume it with mpirun -np {} "
+        "motes resume {}",
+        path, info.ranks, info.ranks == 1 ? "" : "s", ranks, info.ranks, path));
+  }
+  const CheckpointRun& run = info.run;
 
-  // Totals over the ranks for the summary.
-  const DistributedStats st = sim.stats();
-  const std::uint64_t mine_counts[3] = {st.halo_bodies, st.halo_particles, st.halo_bytes};
-  std::uint64_t sums[3] = {0, 0, 0};
-  MPI_Reduce(mine_counts, sums, 3, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
-  // The busiest rank's seconds in each part.
-  const double mine_seconds[4] = {st.copy_seconds, st.mpi_seconds, st.partition_seconds,
-                                  st.step_seconds};
-  double most[4] = {0.0, 0.0, 0.0, 0.0};
-  MPI_Reduce(mine_seconds, most, 4, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
-  const double wall = seconds_since(loop);
-  if (rank != 0) return;
-  const double rate = step_seconds > 0.0 ? static_cast<double>(sim.steps()) / step_seconds : 0.0;
-  fmt::print("motes: done\n");
-  fmt::print("  {:<16}{} ranks, bricks {}\n", "ranks", ranks, sim.decomposition().describe());
-  fmt::print("  {:<16}{}\n", "particles", sim.particle_count());
-  fmt::print("  {:<16}{}\n", "bodies", sim.bodies().size());
-  fmt::print("  {:<16}{} of {}\n", "steps", sim.steps(), run.total);
-  fmt::print("  {:<16}{:.6g} s\n", "simulated time", sim.time());
-  fmt::print(
-      "  {:<16}{} partitions, {} bodies migrated; at the end {} halo copies ({} particles)\n",
-      "decomposition", st.partitions, st.migrations, sums[0], sums[1]);
-  fmt::print("  {:<16}the slowest rank's own steps {}\n", "ranks' steps", format_seconds(most[3]));
-  fmt::print(
-      "  {:<16}{}B sent; a rank's most: {} copying state, {} in MPI (transfer and waiting "
-      "for the slowest rank), {} partitioning\n",
-      "halos", format_si(static_cast<double>(sums[2])), format_seconds(most[0]),
-      format_seconds(most[1]), format_seconds(most[2]));
-  fmt::print("  {:<16}{} (scene, devices and first partition)\n", "setup", format_seconds(setup));
-  fmt::print("  {:<16}{} (stepping {}, gathering and output {})\n", "wall time",
-             format_seconds(wall), format_seconds(step_seconds), format_seconds(output_seconds));
-  fmt::print("  {:<16}{} steps/s, {} particle-steps/s (stepping, halos included)\n", "speed",
-             format_si(rate), format_si(rate * static_cast<double>(sim.particle_count())));
-  if (writer) {
-    fmt::print("  {:<16}{} written to {}\n", "frames", writer->frames(), writer->main_path());
+  // The scene it came from, unchanged.
+  Result<Scene> scene = Status::error("no scene");
+  std::string scene_name;
+  if (run.scene_file.empty()) {
+    scene = builtin_default_scene();
+    scene_name = "built-in default scene (examples/scenes/dominoes.json)";
   } else {
-    fmt::print("  {:<16}none written (--format none)\n", "frames");
+    Result<std::uint64_t> hash = scene_file_hash(run.scene_file);
+    mpi_agree_or_fail(hash ? Status::ok()
+                           : Status::error(fmt::format("{}: cannot reload the run's scene: {}",
+                                                       path, hash.message())));
+    if (hash.value() != run.scene_hash) {
+      fail(fmt::format(
+          "{}: the scene file '{}' has changed since the checkpoint set was written (FNV-1a "
+          "{:016x} then, {:016x} now): it would not continue the same run",
+          path, run.scene_file, run.scene_hash, hash.value()));
+    }
+    scene = load_scene_file(run.scene_file);
+    scene_name = run.scene_path;
   }
-  fmt::print("  {:<16}{} motion check{} on the gathered state{}\n", "guards", checks,
-             checks == 1 ? "" : "s",
-             warned == 0 ? std::string(", no warning")
-                         : fmt::format(", {} with a tunnelling warning (the worst: {:.3g} of a "
-                                       "diameter per substep)",
-                                       warned, worst));
-  std::fflush(stdout);
+  mpi_agree_or_fail(status_of(scene));
+
+  const std::string backend = args.backend.empty() ? info.backend : args.backend;
+  Result<std::unique_ptr<DistributedSimulation>> resumed = DistributedSimulation::resume(
+      scene.value(), MPI_COMM_WORLD, device_opener(backend, args.device, args.threads), path);
+  if (!resumed) fail(resumed.message());
+  DistributedPlan plan;
+  plan.sim = std::move(resumed).value();
+  DistributedSimulation& sim = *plan.sim;
+  plan.scene_name = scene_name;
+  plan.resumed = true;
+  plan.every = run.every > 0 ? run.every : 1;
+  const std::uint64_t at = sim.steps();
+  if (args.steps) {
+    plan.total = at + checked_steps(*args.steps, "--steps");
+  } else if (args.duration) {
+    plan.total = at + steps_of_duration(*args.duration, sim.settings().dt);
+  } else {
+    plan.total = run.total_steps;
+  }
+  if (plan.total <= at) {
+    on_rank0([&] {
+      fmt::print(
+          "motes: {} is at step {}, the end of its run ({} steps): nothing to do (give --steps "
+          "or --duration to go on)\n",
+          path, at, run.total_steps);
+    });
+    return;
+  }
+  plan.checkpoint_every = args.checkpoint_every ? *args.checkpoint_every : run.checkpoint_every;
+  plan.record = run;
+  plan.record.total_steps = plan.total;
+  plan.record.checkpoint_every = plan.checkpoint_every;
+
+  Result<OutputFormat> format = parse_output_format(run.output_format);
+  if (!format) fail(fmt::format("{}: {}", path, format.message()));
+  // Every check is done: only now is the series continued (a CSV cut to its size at the set).
+  on_rank0([&] {
+    if (format.value() == OutputFormat::None) return;
+    Result<std::unique_ptr<FrameWriter>> writer =
+        continue_frame_writer(format.value(), run.output_dir, body_names(sim), run.series);
+    if (!writer) fail(fmt::format("{}: {}", path, writer.message()));
+    plan.writer = std::move(writer).value();
+  });
+
+  const std::string devices = device_lines(sim);
+  const std::string now = sim.device_info().backend;
+  on_rank0([&] {
+    fmt::print(
+        "motes: resuming {} from {}: step {} of {} (t = {:.6g} s) over {} MPI ranks (bricks {}), "
+        "written on {}\n",
+        scene_name, path, at, plan.total, sim.time(), ranks, sim.decomposition().describe(),
+        info.backend);
+    fmt::print("{}", devices);
+    fmt::print("motes: {} more steps; a frame every {} steps{}, after the {} already written\n",
+               plan.total - at, plan.every,
+               plan.writer ? fmt::format(" to {}", plan.writer->main_path()) : "",
+               run.series.frame_times.size());
+    if (!now.empty() && now != info.backend) {
+      fmt::print(
+          "motes: note: the set was written on {}; on {} the run goes on within the backends' "
+          "tolerances (docs/conformance.md), not bitwise as on {}\n",
+          info.backend, now, info.backend);
+    }
+    std::fflush(stdout);
+  });
+  plan.setup_seconds = seconds_since(start);
+  run_distributed_session(std::move(plan));
+}
+
+std::string rank_file_refusal(const std::string& path) {
+  const std::string set = std::filesystem::path(path).parent_path().string();
+  Result<CheckpointSetInfo> info = read_checkpoint_set(set.empty() ? "." : set);
+  if (!info) {
+    return fmt::format(
+        "{}: one rank's file of a checkpoint set over MPI ranks, whose set cannot be read ({}): a "
+        "set is resumed whole, with mpirun -np N motes resume SET",
+        path, info.message());
+  }
+  return fmt::format(
+      "{}: one rank's file of the checkpoint set {} of {} MPI ranks: resume the whole set with "
+      "mpirun -np {} motes resume {}",
+      path, set, info->ranks, info->ranks, set);
 }
 
 #else  // built without MPI
@@ -344,6 +367,20 @@ void mpi_agree_or_fail(const Status& mine) {
 
 void run_distributed(DistributedRun /*run*/) {
   fail("this motes was built without MPI (docs/scale-out.md)");
+}
+
+void resume_distributed(const DistributedResume& resume) {
+  fail(
+      fmt::format("{}: a checkpoint set of a run over MPI ranks: this motes was built without MPI "
+                  "(docs/scale-out.md)",
+                  resume.path));
+}
+
+std::string rank_file_refusal(const std::string& path) {
+  return fmt::format(
+      "{}: one rank's file of a checkpoint set over MPI ranks: resume the whole set with mpirun "
+      "(this motes was built without MPI; docs/scale-out.md)",
+      path);
 }
 
 #endif

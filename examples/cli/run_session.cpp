@@ -45,10 +45,6 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-const char* signal_name(int signal) {
-  return signal == SIGINT ? "SIGINT (Ctrl-C)" : signal == SIGTERM ? "SIGTERM" : "a signal";
-}
-
 /// The step of a checkpoint file's name, or nothing; `tmp`: the name of one being written.
 bool checkpoint_step(const std::string& name, std::uint64_t& step, bool& tmp) {
   const std::string prefix = kCheckpointPrefix;
@@ -178,9 +174,7 @@ class Session {
   }
 
   void loop() {
-    g_signal = 0;
-    const auto previous_int = std::signal(SIGINT, on_signal);
-    const auto previous_term = std::signal(SIGTERM, on_signal);
+    const InterruptSignals signals;
     const Clock::time_point start = Clock::now();
     Progress progress(p_.total, p_.sim->steps());
     progress_ = &progress;
@@ -199,11 +193,9 @@ class Session {
     if (p_.render) {
       if (Status s = p_.render->finish(); !s) fail(s.message());
     }
-    if (signal_ == 0 && g_signal != 0) signal_ = g_signal;  // came during the last chunk
+    if (signal_ == 0) signal_ = InterruptSignals::caught();  // came during the last chunk
     if (signal_ != 0 || p_.checkpoint_every > 0) save_checkpoint();
     wall_seconds_ = seconds_since(start);
-    std::signal(SIGINT, previous_int);
-    std::signal(SIGTERM, previous_term);
     if (signal_ != 0) {
       Simulation& sim = *p_.sim;
       fmt::print(stderr,
@@ -237,8 +229,8 @@ class Session {
         ck > 0 ? (first / ck + 1) * ck : std::numeric_limits<std::uint64_t>::max();
     std::uint64_t chunk = 1;
     while (sim.steps() < p_.total) {
-      if (g_signal != 0) {
-        signal_ = g_signal;
+      if (InterruptSignals::caught() != 0) {
+        signal_ = InterruptSignals::caught();
         break;
       }
       const std::uint64_t done = sim.steps();
@@ -338,6 +330,23 @@ class Session {
 };
 
 }  // namespace
+
+InterruptSignals::InterruptSignals() {
+  g_signal = 0;
+  previous_int_ = std::signal(SIGINT, on_signal);
+  previous_term_ = std::signal(SIGTERM, on_signal);
+}
+
+InterruptSignals::~InterruptSignals() {
+  std::signal(SIGINT, previous_int_);
+  std::signal(SIGTERM, previous_term_);
+}
+
+int InterruptSignals::caught() { return g_signal; }
+
+const char* signal_name(int signal) {
+  return signal == SIGINT ? "SIGINT (Ctrl-C)" : signal == SIGTERM ? "SIGTERM" : "a signal";
+}
 
 std::string checkpoint_file_name(std::uint64_t step) {
   return fmt::format("{}{:012}{}", kCheckpointPrefix, step, kCheckpointSuffix);

@@ -31,6 +31,26 @@ struct SessionPlan {
   double setup_seconds = 0.0;
 };
 
+/// SIGINT and SIGTERM while a run goes on (docs/cli.md): from construction to destruction the
+/// first one is noted (caught()) instead of ending the process, so that the run stops at a step
+/// boundary with a last checkpoint; a second one ends the process at once.
+class InterruptSignals {
+ public:
+  InterruptSignals();
+  ~InterruptSignals();
+  InterruptSignals(const InterruptSignals&) = delete;
+  InterruptSignals& operator=(const InterruptSignals&) = delete;
+  /// The signal caught since construction, or 0.
+  [[nodiscard]] static int caught();
+
+ private:
+  void (*previous_int_)(int) = nullptr;
+  void (*previous_term_)(int) = nullptr;
+};
+
+/// "SIGINT (Ctrl-C)", "SIGTERM".
+const char* signal_name(int signal);
+
 /// Checkpoint files in a directory: checkpoint-<step, 12 digits>.mck, the last two kept.
 std::string checkpoint_file_name(std::uint64_t step);
 

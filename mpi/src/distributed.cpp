@@ -11,6 +11,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "distributed_internal.h"
 #include "shared/halo.h"
 
 namespace motes {
@@ -197,25 +198,7 @@ std::array<double, 6> spec_box(const LinkedSpec& l) {
   return box;
 }
 
-/// The scene with only `bodies` (ascending scene body indices; cloths and ropes after the
-/// scene's bodies).
-Scene sub_scene(const Scene& scene, const std::vector<std::uint32_t>& bodies) {
-  Scene sub;
-  sub.source = scene.source;
-  sub.settings = scene.settings;
-  sub.materials = scene.materials;
-  sub.planes = scene.planes;
-  sub.camera = scene.camera;
-  const std::size_t rigid = scene.bodies.size();
-  for (std::uint32_t b : bodies) {
-    if (b < rigid) {
-      sub.bodies.push_back(scene.bodies[b]);
-    } else {
-      sub.linked.push_back(scene.linked[b - rigid]);
-    }
-  }
-  return sub;
-}
+using detail::sub_scene;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();

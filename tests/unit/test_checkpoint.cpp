@@ -491,6 +491,151 @@ TEST(Checkpoint, HashCorrectButImpossibleContentIsRefused) {
   expect_refused(*s.sim, tmp / "list.mck", "neighbour list entry out of range", true);
 }
 
+/// A version 2 run record by the documented layout (docs/reliability.md): strings as a u32
+/// length and the bytes, counts as u64, frame times as doubles.
+std::vector<unsigned char> record_by_hand(const std::string& backend,
+                                          const motes::CheckpointRun& run) {
+  std::vector<unsigned char> out;
+  const auto raw = [&out](const void* p, std::size_t n) {
+    const auto* c = static_cast<const unsigned char*>(p);
+    out.insert(out.end(), c, c + n);
+  };
+  const auto str = [&](const std::string& s) {
+    const auto n = static_cast<std::uint32_t>(s.size());
+    raw(&n, 4);
+    raw(s.data(), s.size());
+  };
+  const auto u64 = [&](std::uint64_t v) { raw(&v, 8); };
+  str(backend);
+  str(run.scene_path);
+  str(run.scene_file);
+  u64(run.scene_hash);
+  str(run.output_dir);
+  str(run.output_format);
+  u64(run.every);
+  u64(run.total_steps);
+  u64(run.checkpoint_every);
+  str(run.checkpoint_dir);
+  u64(run.series.particles_csv_bytes);
+  u64(run.series.bodies_csv_bytes);
+  u64(run.series.frame_times.size());
+  for (const double t : run.series.frame_times) raw(&t, 8);
+  return out;
+}
+
+// A single process's run record ends where it did before extensions existed (so its checkpoints
+// keep their bytes); an extension follows it as a u64 length and its bytes, and reads back.
+TEST(Checkpoint, RunRecordExtensionOnlyWhenGiven) {
+  TempDir tmp;
+  const Saved s = saved_at_60(tmp);
+  auto info = motes::read_checkpoint_info(s.path);
+  ASSERT_TRUE(info) << info.message();
+  EXPECT_TRUE(info->run.extension.empty());
+  const std::vector<unsigned char> plain = record_by_hand("openmp", info->run);
+  EXPECT_EQ(motes::encode_checkpoint_run("openmp", info->run), plain);
+  const std::vector<unsigned char> bytes = read_bytes(s.path);
+  std::uint64_t record = 0;
+  std::uint32_t sections = 0;
+  std::memcpy(&record, bytes.data() + 88, 8);
+  std::memcpy(&sections, bytes.data() + 84, 4);
+  EXPECT_EQ(record, plain.size());
+  EXPECT_EQ(sections, 17u);
+  EXPECT_TRUE(std::equal(plain.begin(), plain.end(), bytes.begin() + 96));
+  std::uint64_t last = 0;
+  std::memcpy(&last, bytes.data() + bytes.size() - 8, 8);
+  EXPECT_EQ(info->checksum, last);
+
+  motes::CheckpointRun run = info->run;
+  run.extension = {1, 2, 3, 0, 255};
+  std::vector<unsigned char> extended = plain;
+  const std::uint64_t n = run.extension.size();
+  extended.insert(extended.end(), reinterpret_cast<const unsigned char*>(&n),
+                  reinterpret_cast<const unsigned char*>(&n) + 8);
+  extended.insert(extended.end(), run.extension.begin(), run.extension.end());
+  EXPECT_EQ(motes::encode_checkpoint_run("openmp", run), extended);
+  std::string backend;
+  motes::CheckpointRun back;
+  ASSERT_TRUE(motes::decode_checkpoint_run(extended.data(), extended.size(), backend, back));
+  EXPECT_EQ(backend, "openmp");
+  EXPECT_EQ(back.extension, run.extension);
+  EXPECT_EQ(back.series.frame_times, run.series.frame_times);
+  // A cut extension, or bytes after it, is not a record.
+  EXPECT_FALSE(motes::decode_checkpoint_run(extended.data(), extended.size() - 1, backend, back));
+  extended.push_back(0);
+  EXPECT_FALSE(motes::decode_checkpoint_run(extended.data(), extended.size(), backend, back));
+
+  // Saved with it, the file holds it and loads as before.
+  const std::string path = tmp / "extended.mck";
+  ASSERT_TRUE(s.sim->save_state(path, run));
+  auto with = motes::read_checkpoint_info(path);
+  ASSERT_TRUE(with) << with.message();
+  EXPECT_EQ(with->run.extension, run.extension);
+  EXPECT_EQ(with->file_bytes, bytes.size() + 8 + run.extension.size());
+  auto other = make("openmp");
+  ASSERT_TRUE(other);
+  ASSERT_TRUE(other->load_state(path));
+  EXPECT_EQ(hash_of(*other), hash_of(*s.sim));
+}
+
+// One rank's simulation of a run over MPI ranks (created with HaloLists) has a partition
+// reference, from which particles_displacement decides the next partition: its checkpoint holds
+// it as an 18th section, a resume gets the same displacements, and the two kinds of checkpoint do
+// not load into each other's simulations.
+TEST(Checkpoint, ARanksCheckpointKeepsThePartitionReference) {
+  TempDir tmp;
+  const motes::Scene scene = test_scene(kMixedScene);
+  motes::HaloLists lists;  // no halo: a rank that holds the whole scene
+  const auto rank_sim = [&]() -> std::unique_ptr<motes::Simulation> {
+    auto sim = motes::Simulation::create(scene, motes::open_device("openmp").value(), lists);
+    EXPECT_TRUE(sim) << sim.message();
+    return sim ? std::move(sim).value() : nullptr;
+  };
+  auto a = rank_sim();
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->sizes().partition, 1u);
+  ASSERT_TRUE(a->step(30));
+  // A partition at step 30: the reference becomes the positions there.
+  auto at30 = a->snapshot();
+  ASSERT_TRUE(at30);
+  ASSERT_TRUE(a->write_state(at30.value()));
+  ASSERT_TRUE(a->step(30));
+  const std::string path = tmp / "rank.mck";
+  ASSERT_TRUE(a->save_state(path));
+  const std::vector<unsigned char> bytes = read_bytes(path);
+  std::uint32_t sections = 0;
+  std::memcpy(&sections, bytes.data() + 84, 4);
+  EXPECT_EQ(sections, 18u);
+
+  // The same 60 steps without the partition: displacements from the start.
+  auto unpartitioned = rank_sim();
+  ASSERT_TRUE(unpartitioned);
+  ASSERT_TRUE(unpartitioned->step(60));
+  EXPECT_EQ(hash_of(*unpartitioned), hash_of(*a));
+  auto from_start = unpartitioned->partition_displacement();
+
+  auto b = rank_sim();
+  ASSERT_TRUE(b);
+  ASSERT_TRUE(b->load_state(path)) << path;
+  auto da = a->partition_displacement();
+  auto db = b->partition_displacement();
+  ASSERT_TRUE(da && db && from_start);
+  EXPECT_GT(da.value(), 0.0);
+  EXPECT_EQ(da.value(), db.value());
+  EXPECT_NE(from_start.value(), db.value()) << "the reference is the start's, not step 30's";
+  ASSERT_TRUE(a->step(40));
+  ASSERT_TRUE(b->step(40));
+  EXPECT_EQ(hash_of(*a), hash_of(*b));
+  EXPECT_EQ(a->partition_displacement().value(), b->partition_displacement().value());
+
+  auto plain = make("openmp");
+  ASSERT_TRUE(plain);
+  expect_refused(*plain, path, "one rank's checkpoint of a run over MPI ranks", true);
+  const Saved s = saved_at_60(tmp);
+  auto c = rank_sim();
+  ASSERT_TRUE(c);
+  expect_refused(*c, s.path, "a single process's checkpoint", true);
+}
+
 TEST(Checkpoint, Version1FilesStillLoad) {
   // motes bench's cached states: the scene-ordered body and particle arrays (no lists, no cluster
   // rotations); the lists are rebuilt at the next step.

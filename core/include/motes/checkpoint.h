@@ -32,6 +32,10 @@ struct CheckpointRun {
   std::uint64_t checkpoint_every = 0;  ///< 0: only the last checkpoint of an interrupted run
   std::string checkpoint_dir;          ///< absolute directory of the checkpoints
   SeriesState series;                  ///< the frames written before this checkpoint
+  /// Bytes the caller keeps with the state: one rank's part of a checkpoint set over MPI ranks
+  /// (motes/distributed.h). Empty in a single process's checkpoint, whose run record then ends,
+  /// byte for byte, where it ended before this field existed.
+  std::vector<unsigned char> extension;
 };
 
 /// What a checkpoint file says, from its header and run record (read_checkpoint_info).
@@ -44,6 +48,7 @@ struct CheckpointInfo {
   std::uint64_t setup_hash = 0;  ///< Simulation's fingerprint of everything fixed at creation
   std::string backend;           ///< the backend that wrote it ("openmp", "vulkan", "cuda")
   std::uint64_t file_bytes = 0;  ///< the file's size
+  std::uint64_t checksum = 0;    ///< its last 8 bytes: FNV-1a 64 of every byte before them
   CheckpointRun run;
 };
 
@@ -51,6 +56,15 @@ struct CheckpointInfo {
 /// header and run record. Errors name the file and the reason: not a checkpoint, another
 /// version, truncated, corrupt (checksum).
 Result<CheckpointInfo> read_checkpoint_info(const std::string& path);
+
+/// A run record as a checkpoint stores it: `backend` (the backend that wrote the state), then
+/// `run`. For files that describe a run beside checkpoints (the manifest of a checkpoint set over
+/// MPI ranks).
+std::vector<unsigned char> encode_checkpoint_run(const std::string& backend,
+                                                 const CheckpointRun& run);
+/// Reads what encode_checkpoint_run wrote; false unless the bytes are exactly one record.
+bool decode_checkpoint_run(const unsigned char* data, std::size_t bytes, std::string& backend,
+                           CheckpointRun& run);
 
 /// FNV-1a 64 of a file's bytes (the scene hash of a checkpoint); errors name the file.
 Result<std::uint64_t> scene_file_hash(const std::string& path);

@@ -166,8 +166,9 @@ class Simulation {
 
   /// Writes a checkpoint (motes/checkpoint.h, docs/reliability.md): the step, the time, and every
   /// device buffer that a later step reads before writing it, as raw bits (particles, bodies,
-  /// the soft bodies' last fits, the neighbour lists with the grid of their build), with the
-  /// setup's fingerprint and `run` (the caller's description of the run). Atomic: the file is
+  /// the soft bodies' last fits, the neighbour lists with the grid of their build; created with
+  /// HaloLists, also the partition reference of partition_displacement), with the setup's
+  /// fingerprint and `run` (the caller's description of the run). Atomic: the file is
   /// written beside `path` as `path`.tmp, flushed to the disk (fsync), renamed over `path`, and
   /// the directory is flushed; a crash at any moment leaves the old `path` or the new one.
   Status save_state(const std::string& path);

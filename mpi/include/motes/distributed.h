@@ -11,9 +11,11 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "motes/backend/device.h"
+#include "motes/checkpoint.h"
 #include "motes/decomposition.h"
 #include "motes/scene.h"
 #include "motes/simulation.h"
@@ -60,6 +62,8 @@ struct DistributedStats {
   double partition_seconds = 0.0;
 };
 
+struct CheckpointSetInfo;  // below
+
 class DistributedSimulation {
  public:
   /// Collective over `comm`: every rank passes the same scene. Bodies that must be stepped
@@ -103,6 +107,29 @@ class DistributedSimulation {
     /// Impulse contacts: its particles' accumulated impulses with the planes (Snapshot).
     std::vector<shared::vec4> planes;
   };
+
+  /// Collective: writes the run at this step as a checkpoint set, the directory `set`
+  /// (docs/reliability.md, "Checkpoints over MPI ranks"): each rank holding bodies writes its
+  /// simulation (Simulation::save_state, its partition reference included) with what this rank
+  /// needs to go on (its bodies, which it owns, its halo lists) as rank-RRRRR.mck, then rank 0
+  /// writes the manifest (rank count, step, the bricks, the margin, every rank file's size and
+  /// checksum, and `run`, rank 0's description of the run). Atomic as a whole: everything is
+  /// written into `set`.tmp and flushed to the disk (fsync) before rank 0 renames it to `set`
+  /// (exchanging it with a set already there) and flushes the parent directory, so a crash at any
+  /// moment leaves the old `set` or the new one.
+  Status save_checkpoint(const std::string& set, const CheckpointRun& run);
+  /// Collective: the run of `scene` (the scene of the run that wrote it) going on from the
+  /// checkpoint set `set`, over as many ranks as wrote it: stepping on gives bitwise the state of
+  /// the uninterrupted run at the same rank count on the same backend. Every rank checks the
+  /// manifest and its own file; a missing, truncated, corrupt (checksum) or other-version
+  /// manifest or rank file, a set of another rank count or of another scene, or files of
+  /// different sets are refused on every rank with one message naming the file and the reason.
+  /// The counters of stats() go on from the set's; its seconds count from the resume. (It
+  /// creates the run as create() does, over the set's bricks and margin, then replaces each
+  /// rank's simulation with the set's: one simulation of the scene's start is built and dropped.)
+  static Result<std::unique_ptr<DistributedSimulation>> resume(Scene scene, MPI_Comm comm,
+                                                               DeviceOpener open_device,
+                                                               const std::string& set);
 
  private:
   DistributedSimulation() = default;
@@ -172,6 +199,50 @@ class DistributedSimulation {
   /// The neighbour-list skin (the same on every rank: the scene's).
   double skin_ = 0.0;
   DistributedStats stats_;
+
+  // Checkpoint sets (distributed_checkpoint.cpp).
+  /// What this rank needs to go on from its checkpoint (CheckpointRun::extension of its file).
+  [[nodiscard]] std::vector<unsigned char> rank_record() const;
+  /// resume() after create(): this rank's file of `set` (described by `info`) replaces the state.
+  Status load_checkpoint(const std::string& set, const CheckpointSetInfo& info);
 };
+
+/// What a checkpoint set's manifest says (read_checkpoint_set).
+struct CheckpointSetInfo {
+  std::uint32_t version = 0;
+  int ranks = 0;
+  std::uint64_t step = 0;
+  double time = 0.0;
+  std::string backend;  ///< the backend of the ranks that wrote it
+  /// The run as rank 0 described it (the motes command: scene, outputs, series so far).
+  CheckpointRun run;
+  Decomposition decomposition;
+  double margin = 0.0;
+  bool halo_bodies = false;  ///< whether the rigid bodies' part of the halo travels
+  std::uint64_t partitions = 0;
+  std::uint64_t migrations = 0;
+  /// Per rank: its file (none when it held no body), and its counters of DistributedStats.
+  struct Rank {
+    bool has_file = false;
+    std::uint64_t file_bytes = 0;
+    std::uint64_t checksum = 0;  ///< the file's own checksum (its last 8 bytes)
+    std::uint64_t owned_bodies = 0;
+    std::uint64_t halo_bodies = 0;
+    std::uint64_t owned_particles = 0;
+    std::uint64_t halo_particles = 0;
+    std::uint64_t halo_bytes = 0;
+  };
+  std::vector<Rank> rank;
+};
+
+/// The format of checkpoint sets this motes writes and reads.
+constexpr std::uint32_t kCheckpointSetVersion = 1;
+/// The manifest's name in a set.
+constexpr const char* kCheckpointSetManifest = "manifest.mcks";
+/// Rank `rank`'s file in the set `set`: `set`/rank-RRRRR.mck.
+std::string checkpoint_set_rank_file(const std::string& set, int rank);
+/// Reads and checks a set's manifest (not collective; no rank file is read). Errors name the
+/// manifest and the reason: missing, not a manifest, another version, truncated, corrupt.
+Result<CheckpointSetInfo> read_checkpoint_set(const std::string& set);
 
 }  // namespace motes

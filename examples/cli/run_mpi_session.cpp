@@ -1,0 +1,440 @@
+// The stepping loop of `motes run` and `motes resume` over MPI ranks (run_mpi_session.h): every
+// rank steps its part in the same chunks; at frames and guards rank 0 gathers and checks the state
+// and writes it; checkpoint sets every C steps (the last two kept); a signal on any rank stops
+// every rank at the same step with a last set.
+#ifdef MOTES_HAVE_MPI
+
+#include "run_mpi_session.h"
+
+#include <fmt/format.h>
+#include <mpi.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "cli_util.h"
+#include "progress.h"
+#include "render_args.h"
+#include "run_mpi.h"
+#include "run_session.h"
+
+namespace motes::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// Steps are handed to the ranks in chunks of about this long (the slowest rank's), so that
+// progress and signals are seen promptly; each chunk ends with one small collective.
+constexpr double kChunkSeconds = 0.1;
+constexpr std::uint64_t kMaxChunk = std::uint64_t{1} << 20;
+
+constexpr const char* kSetPrefix = "checkpoint-";
+constexpr const char* kSetSuffix = ".mckset";
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// The step of a set's directory name, or nothing; `tmp`: a set being written (or left by a
+/// kill while it was).
+bool set_step(const std::string& name, std::uint64_t& step, bool& tmp) {
+  const std::string prefix = kSetPrefix;
+  const std::string suffix = kSetSuffix;
+  if (name.rfind(prefix, 0) != 0) return false;
+  std::string rest = name.substr(prefix.size());
+  tmp = rest.size() > 4 && rest.compare(rest.size() - 4, 4, ".tmp") == 0;
+  if (tmp) rest.resize(rest.size() - 4);
+  if (rest.size() <= suffix.size() ||
+      rest.compare(rest.size() - suffix.size(), suffix.size(), suffix) != 0) {
+    return false;
+  }
+  rest.resize(rest.size() - suffix.size());
+  if (rest.empty() || rest.size() > 19 ||
+      !std::all_of(rest.begin(), rest.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    return false;
+  }
+  step = std::stoull(rest);
+  return true;
+}
+
+/// After set `newest` is in place: keeps it and the newest older one, removes the other older
+/// ones and what kills left of sets being written (*.mckset.tmp). Later sets (of a run this one
+/// was resumed from an earlier point of) are left alone; so are single-process checkpoints.
+void prune_sets(const fs::path& dir, std::uint64_t newest) {
+  std::vector<std::pair<std::uint64_t, fs::path>> older;
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    std::uint64_t step = 0;
+    bool tmp = false;
+    if (!e.is_directory(ec) || !set_step(e.path().filename().string(), step, tmp)) continue;
+    if (tmp) {
+      fs::remove_all(e.path(), ec);
+    } else if (step < newest) {
+      older.emplace_back(step, e.path());
+    }
+  }
+  std::sort(older.begin(), older.end(), [](const auto& a, const auto& b) { return a > b; });
+  for (std::size_t k = 1; k < older.size(); ++k) fs::remove_all(older[k].second, ec);
+}
+
+/// The motion guard of a run over ranks, on the state rank 0 gathered (docs/scale-out.md): a
+/// non-finite particle is an error naming step, body and particle (scene indices); the fastest
+/// particle's travel per substep beyond Simulation::kSafeTravel of its diameter is a warning.
+Status guard(const Snapshot& s, const DistributedSimulation& sim, double& travel,
+             std::string& warning) {
+  const Settings& settings = sim.settings();
+  const double h = settings.dt / static_cast<double>(settings.substeps);
+  travel = 0.0;
+  std::size_t fastest = 0;
+  for (std::size_t i = 0; i < s.particle_pos.size(); ++i) {
+    const shared::vec4& p = s.particle_pos[i];
+    const shared::vec4& v = s.particle_vel[i];
+    const std::uint32_t b = s.particle_body[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(v.x) ||
+        !std::isfinite(v.y) || !std::isfinite(v.z)) {
+      return Status::error(fmt::format(
+          "non-finite state at step {} (t = {:.6g} s): particle {} of body {} '{}': position "
+          "({}, {}, {}) m, velocity ({}, {}, {}) m/s; the run has gone unstable (dt {:.4g} s at "
+          "substeps {} too large for the contact stiffness?)",
+          s.step, s.time, i, b, sim.bodies()[b].name, p.x, p.y, p.z, v.x, v.y, v.z, settings.dt,
+          settings.substeps));
+    }
+    const double speed = std::sqrt(static_cast<double>(v.x) * static_cast<double>(v.x) +
+                                   static_cast<double>(v.y) * static_cast<double>(v.y) +
+                                   static_cast<double>(v.z) * static_cast<double>(v.z));
+    const double t = p.w > 0.0f ? speed * h / (2.0 * static_cast<double>(p.w)) : 0.0;
+    if (t > travel) {
+      travel = t;
+      fastest = i;
+    }
+  }
+  warning.clear();
+  if (travel > Simulation::kSafeTravel) {
+    const shared::vec4& p = s.particle_pos[fastest];
+    const std::uint32_t b = s.particle_body[fastest];
+    const double diameter = 2.0 * static_cast<double>(p.w);
+    const double speed = travel * diameter / h;
+    warning = fmt::format(
+        "step {} (t = {:.6g} s): particle {} of body {} '{}' moves {:.3g} of its diameter "
+        "({:.4g} m) per substep at {:.4g} m/s, more than the {} that contacts are resolved at: "
+        "contacts can be missed (tunnelling); the largest safe dt at this speed is {:.4g} s at "
+        "substeps {} (dt is {:.4g} s)",
+        s.step, s.time, fastest, b, sim.bodies()[b].name, travel, diameter, speed,
+        Simulation::kSafeTravel,
+        Simulation::kSafeTravel * diameter / speed * static_cast<double>(settings.substeps),
+        settings.substeps, settings.dt);
+  }
+  return Status::ok();
+}
+
+class DistributedSession {
+ public:
+  explicit DistributedSession(DistributedPlan plan)
+      : p_(std::move(plan)),
+        frame_times_(p_.record.series.frame_times),
+        rank_(mpi_rank()),
+        ranks_(mpi_ranks()) {}
+
+  void run() {
+    loop();
+    summary();
+    if (signal_ != 0) {
+      // mpirun ends the job when the first rank exits with an error: every rank's work and
+      // output is done first.
+      MPI_Barrier(MPI_COMM_WORLD);
+      throw CLI::RuntimeError(128 + signal_);
+    }
+  }
+
+ private:
+  /// The state gathered on rank 0 and checked by the motion guard; with `frame`, written as the
+  /// next frame (and drawn). A guard or output error stops the run on every rank.
+  void check(bool frame) {
+    const Clock::time_point start = Clock::now();
+    DistributedSimulation& sim = *p_.sim;
+    last_guard_step_ = sim.steps();
+    ++guards_;
+    Result<Snapshot> snap = sim.gather(0);
+    if (!snap) stop(snap.message());  // the same error on every rank
+    Status ok = Status::ok();
+    if (rank_ == 0) {
+      double travel = 0.0;
+      std::string warning;
+      ok = guard(snap.value(), sim, travel, warning);
+      if (!warning.empty()) {
+        ++warned_checks_;
+        worst_travel_ = std::max(worst_travel_, travel);
+        if (travel > 2.0 * last_warned_travel_) {
+          if (progress_ != nullptr) progress_->finish();
+          fmt::print(stderr, "motes: warning: {}\n", warning);
+          last_warned_travel_ = travel;
+        }
+      }
+      if (ok && frame && p_.writer) ok = p_.writer->write_frame(snap.value());
+      if (ok && frame && p_.render) ok = p_.render->add_frame(snap.value());
+    }
+    if (Status agreed = agree(MPI_COMM_WORLD, ok); !agreed) stop(agreed.message());
+    if (frame) {
+      frame_times_.push_back(sim.time());
+      last_frame_step_ = sim.steps();
+    }
+    output_seconds_ += seconds_since(start);
+  }
+
+  /// Ends a run that cannot go on, on every rank: the frames so far are finished (their series
+  /// stays readable), the message names the last good set, the exit code is 2.
+  [[noreturn]] void stop(const std::string& message) {
+    if (progress_ != nullptr) progress_->finish();
+    if (p_.writer) (void)p_.writer->finish();
+    if (p_.render) (void)p_.render->finish();
+    const std::string frames = fmt::format(
+        "{} frame{} written{}", frame_times_.size(), frame_times_.size() == 1 ? "" : "s",
+        p_.writer ? fmt::format(" ({})", p_.writer->main_path()) : "");
+    fail(fmt::format(
+        "{}\nmotes: run stopped; {}; {}", message, frames,
+        last_checkpoint_.empty()
+            ? std::string("no checkpoint set was written (--checkpoint-every N keeps one)")
+            : fmt::format("the last good checkpoint set is {}", last_checkpoint_)));
+  }
+
+  /// Writes the set checkpoint-<step>.mckset (atomically) and removes all but the last two;
+  /// only a state the guard has passed.
+  void save_checkpoint() {
+    const Clock::time_point start = Clock::now();
+    DistributedSimulation& sim = *p_.sim;
+    if (last_guard_step_ != sim.steps()) check(false);
+    const fs::path dir = p_.record.checkpoint_dir;
+    CheckpointRun record = p_.record;
+    record.series.frame_times = frame_times_;
+    Status ready = Status::ok();
+    if (rank_ == 0) {
+      ready = create_output_directory(dir.string(), "checkpoint");
+      if (ready && record.output_format == "csv") {
+        ready = csv_series_sizes(record.output_dir, record.series);
+      }
+    }
+    mpi_agree_or_fail(ready);
+    const std::string set = (dir / checkpoint_set_name(sim.steps())).string();
+    if (Status s = sim.save_checkpoint(set, record); !s) fail(s.message());
+    if (rank_ == 0) prune_sets(dir, sim.steps());
+    last_checkpoint_ = set;
+    ++checkpoints_;
+    output_seconds_ += seconds_since(start);
+  }
+
+  /// The signal any rank has caught (0: none), the same on every rank.
+  static int agreed_signal() {
+    int caught = InterruptSignals::caught();
+    MPI_Allreduce(MPI_IN_PLACE, &caught, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    return caught;
+  }
+
+  void loop() {
+    const InterruptSignals signals;
+    const Clock::time_point start = Clock::now();
+    DistributedSimulation& sim = *p_.sim;
+    std::unique_ptr<Progress> progress;
+    if (rank_ == 0) progress = std::make_unique<Progress>(p_.total, sim.steps());
+    progress_ = progress.get();
+    first_step_ = sim.steps();
+    run_steps();
+    if (progress_ != nullptr) progress_->finish();
+    progress_ = nullptr;
+    Status finished = Status::ok();
+    if (p_.writer) finished = p_.writer->finish();
+    if (finished && p_.render) finished = p_.render->finish();
+    mpi_agree_or_fail(finished);
+    if (signal_ == 0) signal_ = agreed_signal();  // came during the last chunk
+    if (signal_ != 0 || p_.checkpoint_every > 0) save_checkpoint();
+    wall_seconds_ = seconds_since(start);
+    if (signal_ != 0 && rank_ == 0) {
+      fmt::print(stderr,
+                 "motes: interrupted by {} at step {} of {} (t = {:.6g} s); {} frame{} written{}; "
+                 "checkpoint set {}\n"
+                 "motes: continue with: mpirun -np {} motes resume {}\n",
+                 signal_name(signal_), sim.steps(), p_.total, sim.time(), frame_times_.size(),
+                 frame_times_.size() == 1 ? "" : "s",
+                 p_.writer ? fmt::format(" ({})", p_.writer->main_path()) : "", last_checkpoint_,
+                 ranks_, last_checkpoint_);
+      std::fflush(stderr);
+    }
+  }
+
+  /// Frame 0 (not for a resumed run), the steps with a frame every `every` steps and a set every
+  /// `checkpoint_every`, and the final state.
+  void run_steps() {
+    DistributedSimulation& sim = *p_.sim;
+    const std::uint64_t first = sim.steps();
+    const std::uint64_t every = p_.every;
+    const std::uint64_t ck = p_.checkpoint_every;
+    if (!p_.resumed) {
+      check(true);
+    } else {
+      check(false);  // the set's state, before the first step
+      if (!frame_times_.empty() && frame_times_.back() == sim.time()) {
+        last_frame_step_ = first;  // the set's step already has its frame
+      }
+    }
+    std::uint64_t next_frame = (first / every + 1) * every;
+    std::uint64_t next_checkpoint =
+        ck > 0 ? (first / ck + 1) * ck : std::numeric_limits<std::uint64_t>::max();
+    std::uint64_t chunk = 1;
+    double took = 0.0;
+    while (sim.steps() < p_.total) {
+      // One collective per chunk: a signal caught by any rank stops every rank here, at the same
+      // step, and the next chunk's size follows the slowest rank (the same on every rank).
+      const double mine[2] = {static_cast<double>(InterruptSignals::caught()), took};
+      double all[2] = {0.0, 0.0};
+      MPI_Allreduce(mine, all, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+      if (all[0] != 0.0) {
+        signal_ = static_cast<int>(all[0]);
+        break;
+      }
+      if (all[1] > 0.0) {  // after the first chunk
+        if (all[1] < kChunkSeconds / 2 && chunk < kMaxChunk) chunk *= 2;
+        if (all[1] > kChunkSeconds * 2 && chunk > 1) chunk /= 2;
+      }
+      const std::uint64_t done = sim.steps();
+      // > done: a guard runs at the start and whenever a chunk reaches it.
+      const std::uint64_t next_guard = last_guard_step_ + Simulation::kGuardInterval;
+      const std::uint64_t n = std::min(
+          {chunk, p_.total - done, next_frame - done, next_checkpoint - done, next_guard - done});
+      const Clock::time_point t0 = Clock::now();
+      if (Status s = sim.step(n); !s) stop(s.message());  // the same error on every rank
+      took = seconds_since(t0);
+      step_seconds_ += took;
+      if (sim.steps() == next_frame) {
+        check(true);
+        next_frame += every;
+      } else if (sim.steps() >= next_guard) {
+        check(false);
+      }
+      if (sim.steps() == next_checkpoint) {
+        // The one at the end comes after the final frame (loop()).
+        if (sim.steps() < p_.total) save_checkpoint();
+        next_checkpoint += ck;
+      }
+      if (progress_ != nullptr) progress_->update(sim.steps(), sim.time());
+    }
+    // The final state is always a frame, also when the step count is not a multiple of --every.
+    if (sim.steps() >= p_.total && last_frame_step_ != sim.steps()) check(true);
+  }
+
+  void summary() const {
+    DistributedSimulation& sim = *p_.sim;
+    // Totals over the ranks.
+    const DistributedStats st = sim.stats();
+    const std::uint64_t mine_counts[3] = {st.halo_bodies, st.halo_particles, st.halo_bytes};
+    std::uint64_t sums[3] = {0, 0, 0};
+    MPI_Reduce(mine_counts, sums, 3, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
+    // The busiest rank's seconds in each part.
+    const double mine_seconds[4] = {st.copy_seconds, st.mpi_seconds, st.partition_seconds,
+                                    st.step_seconds};
+    double most[4] = {0.0, 0.0, 0.0, 0.0};
+    MPI_Reduce(mine_seconds, most, 4, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+    if (rank_ != 0) return;
+    const std::uint64_t steps = sim.steps() - first_step_;
+    const double rate = step_seconds_ > 0.0 ? static_cast<double>(steps) / step_seconds_ : 0.0;
+    fmt::print("motes: {}\n",
+               signal_ != 0 ? fmt::format("interrupted ({})", signal_name(signal_)) : "done");
+    fmt::print("  {:<16}{} ranks, bricks {}\n", "ranks", ranks_, sim.decomposition().describe());
+    fmt::print("  {:<16}{}\n", "particles", sim.particle_count());
+    fmt::print("  {:<16}{}\n", "bodies", sim.bodies().size());
+    if (p_.resumed) {
+      fmt::print("  {:<16}{} of {} (resumed at step {})\n", "steps", sim.steps(), p_.total,
+                 first_step_);
+    } else {
+      fmt::print("  {:<16}{} of {}\n", "steps", sim.steps(), p_.total);
+    }
+    fmt::print("  {:<16}{:.6g} s\n", "simulated time", sim.time());
+    fmt::print(
+        "  {:<16}{} partitions, {} bodies migrated; at the end {} halo copies ({} particles)\n",
+        "decomposition", st.partitions, st.migrations, sums[0], sums[1]);
+    fmt::print("  {:<16}the slowest rank's own steps {}\n", "ranks' steps",
+               format_seconds(most[3]));
+    fmt::print(
+        "  {:<16}{}B sent; a rank's most: {} copying state, {} in MPI (transfer and waiting "
+        "for the slowest rank), {} partitioning\n",
+        "halos", format_si(static_cast<double>(sums[2])), format_seconds(most[0]),
+        format_seconds(most[1]), format_seconds(most[2]));
+    fmt::print("  {:<16}{} ({})\n", "setup", format_seconds(p_.setup_seconds),
+               p_.resumed ? "scene, devices and the set's state"
+                          : "scene, devices and first "
+                            "partition");
+    fmt::print("  {:<16}{} (stepping {}, gathering, checks and output {})\n", "wall time",
+               format_seconds(wall_seconds_), format_seconds(step_seconds_),
+               format_seconds(output_seconds_));
+    fmt::print("  {:<16}{} steps/s, {} particle-steps/s (stepping, halos included)\n", "speed",
+               format_si(rate), format_si(rate * static_cast<double>(sim.particle_count())));
+    if (p_.writer) {
+      fmt::print("  {:<16}{} written to {}\n", "frames", p_.writer->frames(),
+                 p_.writer->main_path());
+    } else {
+      fmt::print("  {:<16}none written (--format none)\n", "frames");
+    }
+    if (p_.render) fmt::print("  {:<16}{}\n", "pictures", render_summary(*p_.render));
+    if (checkpoints_ > 0) {
+      fmt::print("  {:<16}{} set{} written, the last {}\n", "checkpoints", checkpoints_,
+                 checkpoints_ == 1 ? "" : "s", last_checkpoint_);
+    }
+    fmt::print("  {:<16}{} motion check{} on the gathered state{}\n", "guards", guards_,
+               guards_ == 1 ? "" : "s",
+               warned_checks_ == 0
+                   ? std::string(", no warning")
+                   : fmt::format(", {} with a tunnelling warning (the worst: {:.3g} of a "
+                                 "diameter per substep)",
+                                 warned_checks_, worst_travel_));
+    std::fflush(stdout);
+  }
+
+  DistributedPlan p_;
+  std::vector<double> frame_times_;
+  int rank_ = 0;
+  int ranks_ = 1;
+  std::uint64_t first_step_ = 0;
+  std::uint64_t last_frame_step_ = std::numeric_limits<std::uint64_t>::max();
+  std::uint64_t checkpoints_ = 0;
+  std::string last_checkpoint_;
+  Progress* progress_ = nullptr;  // rank 0, while the loop runs
+  std::uint64_t last_guard_step_ = 0;
+  std::uint64_t guards_ = 0;
+  std::uint64_t warned_checks_ = 0;
+  double worst_travel_ = 0.0;
+  double last_warned_travel_ = 0.0;
+  int signal_ = 0;
+  double wall_seconds_ = 0.0;
+  double step_seconds_ = 0.0;
+  double output_seconds_ = 0.0;
+};
+
+}  // namespace
+
+std::string checkpoint_set_name(std::uint64_t step) {
+  return fmt::format("{}{:012}{}", kSetPrefix, step, kSetSuffix);
+}
+
+void on_rank0(const std::function<void()>& work) {
+  int failed = 0;
+  if (mpi_rank() == 0) {
+    try {
+      work();
+    } catch (const CLI::RuntimeError&) {
+      failed = 1;  // fail() has printed the message
+    }
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  if (failed != 0) throw CLI::RuntimeError(kErrorExit);
+}
+
+void run_distributed_session(DistributedPlan plan) { DistributedSession(std::move(plan)).run(); }
+
+}  // namespace motes::cli
+
+#endif  // MOTES_HAVE_MPI
