@@ -4,8 +4,13 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${MOTES_TEST_BUILD:-$root/build-test}
+# Each stage says when it starts (seconds since the start), so a slow CI run shows where it went.
+stage() { echo "== test.sh: $1 (at ${SECONDS} s)"; }
+stage "set-up and build"
 "$root/scripts/setup.sh" "$build" -DMOTES_WERROR=ON
+stage "format check"
 "$root/scripts/check-format.sh"
+stage "tests"
 cd "$build"
 # Tests run side by side: OpenMP threads that spin while waiting would starve each other.
 export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
@@ -18,6 +23,7 @@ ctest --output-on-failure -j "${JOBS:-$(nproc)}" --timeout 900 --no-tests=error 
 
 # The installed package as another project uses it (examples/embed, find_package and
 # pkg-config): static from this build, shared from a lean second build (no CUDA, no tests).
+stage "installed package"
 MOTES_SKIP_INSTALL=1 "$root/scripts/check-package.sh" "$build"
 
 # The sanitizer stage: every test again, built with AddressSanitizer and UndefinedBehaviorSanitizer
@@ -29,10 +35,12 @@ MOTES_SKIP_INSTALL=1 "$root/scripts/check-package.sh" "$build"
 # CUDA is left out of this build: its kernels run only on a GPU, where compute-sanitizer's
 # memcheck and racecheck check them (scripts/gpu/run-suite.sh sanitize).
 if [ "${MOTES_SANITIZER_STAGE:-1}" = 1 ]; then
+  stage "sanitizer build"
   MOTES_SKIP_INSTALL=1 "$root/scripts/setup.sh" "$build-sanitize" -DMOTES_WERROR=ON \
     -DMOTES_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMOTES_TEST_VULKAN_VALIDATION=OFF \
     -DMOTES_WITH_CUDA=OFF
   cd "$build-sanitize"
+  stage "sanitizer tests"
   MOTES_VULKAN_VALIDATION=0 \
     LSAN_OPTIONS=suppressions=$root/tests/sanitizers/lsan.supp:print_suppressions=0 \
     UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
@@ -47,5 +55,7 @@ fi
 # UBSan); any crash, leak, timeout or sanitizer report fails it and names the reproducer.
 # MOTES_FUZZ_STAGE=0 skips it.
 if [ "${MOTES_FUZZ_STAGE:-1}" = 1 ]; then
+  stage "fuzzing"
   MOTES_FUZZ_BUILD="$build-fuzz" "$root/scripts/fuzz.sh" all 60
 fi
+stage "done"

@@ -90,6 +90,7 @@ class Reader {
       bad = true;
       return;
     }
+    if (n == 0) return;  // an empty list's data() may be null, which memcpy may not be given
     std::memcpy(out, p_ + at_, n);
     at_ += n;
   }
