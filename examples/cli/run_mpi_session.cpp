@@ -42,48 +42,6 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-/// The step of a set's directory name, or nothing; `tmp`: a set being written (or left by a
-/// kill while it was).
-bool set_step(const std::string& name, std::uint64_t& step, bool& tmp) {
-  const std::string prefix = kSetPrefix;
-  const std::string suffix = kSetSuffix;
-  if (name.rfind(prefix, 0) != 0) return false;
-  std::string rest = name.substr(prefix.size());
-  tmp = rest.size() > 4 && rest.compare(rest.size() - 4, 4, ".tmp") == 0;
-  if (tmp) rest.resize(rest.size() - 4);
-  if (rest.size() <= suffix.size() ||
-      rest.compare(rest.size() - suffix.size(), suffix.size(), suffix) != 0) {
-    return false;
-  }
-  rest.resize(rest.size() - suffix.size());
-  if (rest.empty() || rest.size() > 19 ||
-      !std::all_of(rest.begin(), rest.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-    return false;
-  }
-  step = std::stoull(rest);
-  return true;
-}
-
-/// After set `newest` is in place: keeps it and the newest older one, removes the other older
-/// ones and what kills left of sets being written (*.mckset.tmp). Later sets (of a run this one
-/// was resumed from an earlier point of) are left alone; so are single-process checkpoints.
-void prune_sets(const fs::path& dir, std::uint64_t newest) {
-  std::vector<std::pair<std::uint64_t, fs::path>> older;
-  std::error_code ec;
-  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
-    std::uint64_t step = 0;
-    bool tmp = false;
-    if (!e.is_directory(ec) || !set_step(e.path().filename().string(), step, tmp)) continue;
-    if (tmp) {
-      fs::remove_all(e.path(), ec);
-    } else if (step < newest) {
-      older.emplace_back(step, e.path());
-    }
-  }
-  std::sort(older.begin(), older.end(), [](const auto& a, const auto& b) { return a > b; });
-  for (std::size_t k = 1; k < older.size(); ++k) fs::remove_all(older[k].second, ec);
-}
-
 /// The motion guard of a run over ranks, on the state rank 0 gathered (docs/scale-out.md): a
 /// non-finite particle is an error naming step, body and particle (scene indices); the fastest
 /// particle's travel per substep beyond Simulation::kSafeTravel of its diameter is a warning.
@@ -223,7 +181,7 @@ class DistributedSession {
     mpi_agree_or_fail(ready);
     const std::string set = (dir / checkpoint_set_name(sim.steps())).string();
     if (Status s = sim.save_checkpoint(set, record); !s) fail(s.message());
-    if (rank_ == 0) prune_sets(dir, sim.steps());
+    if (rank_ == 0) prune_numbered(dir, sim.steps(), kSetPrefix, kSetSuffix, true);
     last_checkpoint_ = set;
     ++checkpoints_;
     output_seconds_ += seconds_since(start);

@@ -45,13 +45,12 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-/// The step of a checkpoint file's name, or nothing; `tmp`: the name of one being written.
-bool checkpoint_step(const std::string& name, std::uint64_t& step, bool& tmp) {
-  const std::string prefix = kCheckpointPrefix;
-  std::string rest;
+/// The step of a name PREFIX<digits>SUFFIX, or nothing; `tmp`: the name of one being written
+/// (SUFFIX.tmp).
+bool numbered_step(const std::string& name, const std::string& prefix, const std::string& suffix,
+                   std::uint64_t& step, bool& tmp) {
   if (name.rfind(prefix, 0) != 0) return false;
-  rest = name.substr(prefix.size());
-  const std::string suffix = kCheckpointSuffix;
+  std::string rest = name.substr(prefix.size());
   tmp = rest.size() > 4 && rest.compare(rest.size() - 4, 4, ".tmp") == 0;
   if (tmp) rest.resize(rest.size() - 4);
   if (rest.size() <= suffix.size() ||
@@ -66,26 +65,30 @@ bool checkpoint_step(const std::string& name, std::uint64_t& step, bool& tmp) {
   step = std::stoull(rest);
   return true;
 }
+}  // namespace
 
-/// After checkpoint `newest` is in place: keeps it and the newest older one, removes the other
-/// older ones and leftovers of writes that a kill interrupted (*.mck.tmp). Later checkpoints (of
-/// a run this one was resumed from an earlier point of) are left alone.
-void prune_checkpoints(const fs::path& dir, std::uint64_t newest) {
+void prune_numbered(const fs::path& dir, std::uint64_t newest, const std::string& prefix,
+                    const std::string& suffix, bool directories) {
   std::vector<std::pair<std::uint64_t, fs::path>> older;
   std::error_code ec;
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
     std::uint64_t step = 0;
     bool tmp = false;
-    if (!checkpoint_step(e.path().filename().string(), step, tmp)) continue;
+    if (e.is_directory(ec) != directories ||
+        !numbered_step(e.path().filename().string(), prefix, suffix, step, tmp)) {
+      continue;
+    }
     if (tmp) {
-      fs::remove(e.path(), ec);
+      fs::remove_all(e.path(), ec);
     } else if (step < newest) {
       older.emplace_back(step, e.path());
     }
   }
   std::sort(older.begin(), older.end(), [](const auto& a, const auto& b) { return a > b; });
-  for (std::size_t k = 1; k < older.size(); ++k) fs::remove(older[k].second, ec);
+  for (std::size_t k = 1; k < older.size(); ++k) fs::remove_all(older[k].second, ec);
 }
+
+namespace {
 
 class Session {
  public:
@@ -167,7 +170,7 @@ class Session {
     }
     const fs::path path = dir / checkpoint_file_name(sim.steps());
     if (Status s = sim.save_state(path.string(), record); !s) fail(s.message());
-    prune_checkpoints(dir, sim.steps());
+    prune_numbered(dir, sim.steps(), kCheckpointPrefix, kCheckpointSuffix, false);
     last_checkpoint_ = path.string();
     ++checkpoints_;
     output_seconds_ += seconds_since(start);

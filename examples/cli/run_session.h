@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -57,5 +58,12 @@ std::string checkpoint_file_name(std::uint64_t step);
 /// Runs the plan to its end or to SIGINT/SIGTERM and prints the summary; exits through
 /// CLI::RuntimeError with 128 + the signal's number after a signal, through fail() on errors.
 void run_session(SessionPlan plan);
+
+/// After checkpoint `newest` (PREFIX<step>SUFFIX in `dir`, files, or directories for the sets
+/// of a run over MPI ranks) is in place: keeps it and the newest older one, removes the other
+/// older ones and what kills left of writes (SUFFIX.tmp). Later ones (of a run this one was
+/// resumed from an earlier point of) and entries of the other kind are left alone.
+void prune_numbered(const std::filesystem::path& dir, std::uint64_t newest,
+                    const std::string& prefix, const std::string& suffix, bool directories);
 
 }  // namespace motes::cli
