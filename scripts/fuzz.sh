@@ -2,10 +2,12 @@
 # Fuzzing (docs/fuzzing.md): scripts/fuzz.sh TARGET SECONDS, TARGET one of scene, mesh, checkpoint,
 # frames or all. Configures and builds the fuzz build with clang if needed (only the fuzz targets),
 # seeds each target's corpus from the repository's scenes, meshes and test data (checkpoints and
-# frames from the targets' own small simulation), runs libFuzzer for SECONDS seconds per target and
-# fails on any crash, leak, timeout, out-of-memory or sanitizer report, printing the reproducer.
-# Environment: MOTES_FUZZ_BUILD (default build-fuzz), JOBS (build parallelism), MOTES_FUZZ_ARGS
-# (more libFuzzer flags, e.g. -jobs=2 -workers=2).
+# frames from the targets' own small simulation), runs libFuzzer for SECONDS seconds per target (the
+# targets side by side, one per core) and fails on any crash, leak, timeout, out-of-memory or
+# sanitizer report, printing the reproducer.
+# Environment: MOTES_FUZZ_BUILD (default build-fuzz), JOBS (build parallelism),
+# MOTES_FUZZ_PARALLEL (targets at once, default the number of cores), MOTES_FUZZ_ARGS (more
+# libFuzzer flags, e.g. -jobs=2 -workers=2).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${MOTES_FUZZ_BUILD:-$root/build-fuzz}
@@ -118,10 +120,10 @@ flags_for() {
 
 files() { find "$1" -type f | wc -l; }
 
-status=0
-summary=()
-for t in "${targets[@]}"; do
-  work="$build/fuzz/$t"
+# One target: seeds, then libFuzzer for SECONDS; its one-line summary goes to its folder's
+# summary.txt and its report (on a finding) to report.txt. Exit status 1 on a finding.
+fuzz_one() {
+  local t=$1 work="$build/fuzz/$1"
   rm -rf "$work/seeds"
   mkdir -p "$work/seeds" "$work/corpus" "$work/artifacts"
   case "$t" in
@@ -129,13 +131,13 @@ for t in "${targets[@]}"; do
     mesh) seed_mesh "$work/seeds" ;;
     checkpoint | frames) seed_generated "$work/seeds" "$t" ;;
   esac
-  dict=()
+  local dict=()
   [ -f "$root/tests/fuzz/$t.dict" ] && dict=("-dict=$root/tests/fuzz/$t.dict")
-  log="$work/fuzz.log"
+  local log="$work/fuzz.log"
   echo "== fuzz_$t for ${seconds} s ($(files "$work/seeds") seeds, $(files "$work/corpus") in the corpus; log: $log)"
-  rm -rf "$work"/artifacts/* "$work/tmp"
+  rm -rf "$work"/artifacts/* "$work/tmp" "$work/summary.txt" "$work/report.txt"
   mkdir -p "$work/tmp"  # the targets' files; a crashed run leaves its folder here
-  rc=0
+  local rc=0
   # Every UB report aborts (the targets are built with -fno-sanitize-recover); leaks inside
   # assimp's own error paths are suppressed (tests/fuzz/lsan.supp says why).
   export LSAN_OPTIONS="suppressions=$root/tests/fuzz/lsan.supp:print_suppressions=0"
@@ -145,22 +147,56 @@ for t in "${targets[@]}"; do
     -rss_limit_mb=2560 -print_final_stats=1 -artifact_prefix="$work/artifacts/" \
     "${dict[@]}" $(flags_for "$t") ${MOTES_FUZZ_ARGS:-} "$work/corpus" "$work/seeds") \
     >"$log" 2>&1 || rc=$?
+  local execs rate found
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
   mapfile -t found < <(find "$work/artifacts" -type f | sort)
   if [ "$rc" -ne 0 ] || [ ${#found[@]} -gt 0 ] ||
     grep -qE "ERROR: (AddressSanitizer|LeakSanitizer|libFuzzer)|runtime error:|SUMMARY: " "$log"; then
+    {
+      echo "!! fuzz_$t FAILED (exit $rc): the report:"
+      awk '/ERROR:|runtime error:|ai_assert|terminate called|^motes fuzz|Test unit written/ {p = 1} p' \
+        "$log" | head -60 || true
+      for a in "${found[@]}"; do
+        echo "!! reproducer: $a"
+        echo "!!   replay: LSAN_OPTIONS=$LSAN_OPTIONS $build/tests/fuzz/fuzz_$t $a"
+      done
+    } >"$work/report.txt"
+    echo "fuzz_$t: FAILED after ${execs:-?} executions (${found[*]:-no reproducer; see $log})" \
+      >"$work/summary.txt"
+    return 1
+  fi
+  echo "fuzz_$t: ${execs:-?} executions in ${seconds} s (${rate:-?}/s), corpus $(files "$work/corpus") inputs, no findings" \
+    >"$work/summary.txt"
+}
+
+# The targets run side by side, one per core (MOTES_FUZZ_PARALLEL, default the number of cores):
+# each is one single-threaded libFuzzer process, so each still gets SECONDS of a core, and four
+# targets on two cores take two rounds instead of four.
+parallel=${MOTES_FUZZ_PARALLEL:-$(nproc)}
+[[ "$parallel" =~ ^[1-9][0-9]*$ ]] || {
+  echo "fuzz: MOTES_FUZZ_PARALLEL must be a positive number, not '$parallel'" >&2
+  exit 2
+}
+for t in "${targets[@]}"; do
+  rm -f "$build/fuzz/$t/summary.txt" "$build/fuzz/$t/report.txt"
+  while [ "$(jobs -rp | wc -l)" -ge "$parallel" ]; do wait -n || true; done
+  fuzz_one "$t" &
+done
+wait
+# The outcome comes from each target's files, not from exit statuses (wait -n has collected some).
+status=0
+summary=()
+for t in "${targets[@]}"; do
+  if [ -f "$build/fuzz/$t/report.txt" ]; then
+    cat "$build/fuzz/$t/report.txt" >&2
     status=1
-    echo "!! fuzz_$t FAILED (exit $rc): the report:" >&2
-    awk '/ERROR:|runtime error:|ai_assert|terminate called|^motes fuzz|Test unit written/ {p = 1} p' \
-      "$log" | head -60 >&2 || true
-    for a in "${found[@]}"; do
-      echo "!! reproducer: $a" >&2
-      echo "!!   replay: LSAN_OPTIONS=$LSAN_OPTIONS $build/tests/fuzz/fuzz_$t $a" >&2
-    done
-    summary+=("fuzz_$t: FAILED after ${execs:-?} executions (${found[*]:-no reproducer; see $log})")
+  fi
+  if [ -f "$build/fuzz/$t/summary.txt" ]; then
+    summary+=("$(cat "$build/fuzz/$t/summary.txt")")
   else
-    summary+=("fuzz_$t: ${execs:-?} executions in ${seconds} s (${rate:-?}/s), corpus $(files "$work/corpus") inputs, no findings")
+    summary+=("fuzz_$t: FAILED: it stopped before its summary (see the messages above)")
+    status=1
   fi
 done
 
