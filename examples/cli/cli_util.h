@@ -2,6 +2,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -27,6 +28,15 @@ std::uint64_t checked_steps(std::uint64_t steps, const char* option);
 
 /// `path` made absolute (from the current directory) and normalized.
 std::string absolute_path(const std::string& path);
+
+/// Seconds on the steady clock since `start`.
+double seconds_since(std::chrono::steady_clock::time_point start);
+
+/// A run hands steps to the device (or to the ranks) in chunks sized to take about this long, so
+/// that progress, signals and device errors are seen promptly without a call per step.
+constexpr double kChunkSeconds = 0.1;
+/// The largest chunk, however fast the steps.
+constexpr std::uint64_t kMaxChunk = std::uint64_t{1} << 20;
 
 /// A duration for people: "850 ms", "12.3 s", "4 min 05 s", "2 h 03 min".
 std::string format_seconds(double seconds);

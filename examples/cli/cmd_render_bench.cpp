@@ -39,10 +39,6 @@ Snapshot particle_block(std::uint32_t count) {
   return s;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 void render_bench(const RenderBenchArgs& args) {
   const Snapshot frame = particle_block(args.particles);
   render::SceneLook look;

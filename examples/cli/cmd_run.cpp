@@ -48,10 +48,6 @@ struct RunArgs {
   CLI::Option* every_option = nullptr;
 };
 
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 std::uint64_t total_steps(const RunArgs& a, const Settings& s) {
   if (a.steps_option->count() > 0) return checked_steps(a.steps, "--steps");
   return steps_of_duration(a.duration_option->count() > 0 ? a.duration : s.duration, s.dt);

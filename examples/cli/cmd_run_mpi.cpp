@@ -86,10 +86,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 /// The device this rank opens: --device, or the rank's index on its host among the backend's
 /// devices (one GPU per rank); the CPU backend has one device.
 DeviceOpener device_opener(std::string backend, int index, int threads) {

@@ -30,17 +30,11 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// Steps are handed to the ranks in chunks of about this long (the slowest rank's), so that
-// progress and signals are seen promptly; each chunk ends with one small collective.
-constexpr double kChunkSeconds = 0.1;
-constexpr std::uint64_t kMaxChunk = std::uint64_t{1} << 20;
+// Chunks of steps (kChunkSeconds, cli_util.h) are timed by the slowest rank; each ends with one
+// small collective.
 
 constexpr const char* kSetPrefix = "checkpoint-";
 constexpr const char* kSetSuffix = ".mckset";
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 /// The motion guard of a run over ranks, on the state rank 0 gathered (docs/scale-out.md): a
 /// non-finite particle is an error naming step, body and particle (scene indices); the fastest

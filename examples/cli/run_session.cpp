@@ -25,11 +25,6 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// Steps go to the device in chunks sized to take about this long, so that progress, signals and
-// device errors are seen promptly without a call per step.
-constexpr double kChunkSeconds = 0.1;
-constexpr std::uint64_t kMaxChunk = std::uint64_t{1} << 20;
-
 constexpr const char* kCheckpointPrefix = "checkpoint-";
 constexpr const char* kCheckpointSuffix = ".mck";
 
@@ -39,10 +34,6 @@ extern "C" void on_signal(int signal) {
   g_signal = signal;
   // A second Ctrl-C (or SIGTERM) ends the process at once.
   std::signal(signal, SIG_DFL);
-}
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
 /// The step of a name PREFIX<digits>SUFFIX, or nothing; `tmp`: the name of one being written

@@ -24,7 +24,7 @@ namespace {
 
 using motes::Buffer;
 
-constexpr double kTolerance = 1.0e-10;
+constexpr double kBodiesIntegrateTolerance = 1.0e-10;
 
 class BodiesIntegrate : public DeviceTest {
  protected:
@@ -52,12 +52,12 @@ class BodiesIntegrate : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngVel, got.angvel));
 
     begin_case("bodies_integrate/" + layout, w.sizes.bodies);
-    check_close("BodyPos", got.pos, want.pos, kTolerance, Part::Xyz);
+    check_close("BodyPos", got.pos, want.pos, kBodiesIntegrateTolerance, Part::Xyz);
     check_w_identical("BodyPos.w (inverse mass) kept", got.pos, want.pos);
-    check_close("BodyQuat", got.quat, want.quat, kTolerance);
-    check_close("BodyVel", got.vel, want.vel, kTolerance);
-    check_close("BodyAngMom", got.angmom, want.angmom, kTolerance);
-    check_close("BodyAngVel", got.angvel, want.angvel, kTolerance);
+    check_close("BodyQuat", got.quat, want.quat, kBodiesIntegrateTolerance);
+    check_close("BodyVel", got.vel, want.vel, kBodiesIntegrateTolerance);
+    check_close("BodyAngMom", got.angmom, want.angmom, kBodiesIntegrateTolerance);
+    check_close("BodyAngVel", got.angvel, want.angvel, kBodiesIntegrateTolerance);
     end_case();
   }
 };

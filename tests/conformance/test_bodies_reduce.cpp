@@ -23,7 +23,7 @@ namespace {
 
 using motes::Buffer;
 
-constexpr double kTolerance = 1.0e-10;
+constexpr double kBodiesReduceTolerance = 1.0e-10;
 
 /// Random forces (up to 1 N per component), w = 0.
 class BodiesReduce : public DeviceTest {
@@ -46,8 +46,8 @@ class BodiesReduce : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyTorque, got_torque));
 
     begin_case("bodies_reduce/" + layout, w.sizes.particles);
-    check_close("BodyForce", got_force, w.bodies.force, kTolerance);
-    check_close("BodyTorque", got_torque, w.bodies.torque, kTolerance);
+    check_close("BodyForce", got_force, w.bodies.force, kBodiesReduceTolerance);
+    check_close("BodyTorque", got_torque, w.bodies.torque, kBodiesReduceTolerance);
     end_case();
   }
 };

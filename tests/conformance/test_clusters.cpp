@@ -38,9 +38,9 @@ using motes_ref::Cluster;
 using motes_ref::ClusterFrame;
 using motes_ref::ClusterMember;
 
-constexpr double kTolerance = 1.0e-10;
-constexpr double kVelocityUlps = 16.0;
-constexpr float kSkin = 0.004f;
+constexpr double kClustersTolerance = 1.0e-10;
+constexpr double kClustersVelocityUlps = 16.0;
+constexpr float kClustersSkin = 0.004f;
 constexpr float kDt = 1.0e-4f;
 
 /// Particles (free spheres, then soft bodies, then cloth particles), clusters and launch data.
@@ -124,7 +124,7 @@ SoftCase make_case(std::uint32_t seed, const std::vector<BodyPlan>& bodies, std:
   }
   c.params.gravity_dt = vec4(0.0f, -9.81f, 0.0f, kDt);
   c.params.particle_count = static_cast<uint>(p.size());
-  c.params.neighbour_skin = kSkin;
+  c.params.neighbour_skin = kClustersSkin;
   c.params.cluster_count = static_cast<uint>(c.soft.clusters.size());
   c.params.material_count = 1;
   c.params.neighbour_capacity = 16;
@@ -191,13 +191,14 @@ class Clusters : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticlePos, pos));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticleVel, vel));
     begin_case("clusters_fit/" + layout, c.soft.clusters.size());
-    check_close("ClusterFrames.rotation", frame_part(got, 0), frame_part(want, 0), kTolerance);
+    check_close("ClusterFrames.rotation", frame_part(got, 0), frame_part(want, 0),
+                kClustersTolerance);
     check_close("ClusterFrames.centre (w: mass)", frame_part(got, 1), frame_part(want, 1),
-                kTolerance);
-    check_close("ClusterFrames.t", frame_part(got, 2), frame_part(want, 2), kTolerance);
+                kClustersTolerance);
+    check_close("ClusterFrames.t", frame_part(got, 2), frame_part(want, 2), kClustersTolerance);
     check_close("ClusterFrames.velocity (w: damping)", frame_part(got, 3), frame_part(want, 3),
-                kTolerance);
-    check_close("ClusterFrames.omega", frame_part(got, 4), frame_part(want, 4), kTolerance);
+                kClustersTolerance);
+    check_close("ClusterFrames.omega", frame_part(got, 4), frame_part(want, 4), kClustersTolerance);
     check_identical("ParticlePos (read only)", pos, c.particles.pos);
     check_identical("ParticleVel (read only)", vel, c.particles.vel);
     end_case();
@@ -210,11 +211,11 @@ class Clusters : public DeviceTest {
     motes_ref::Particles want = c.particles;
     motes_ref::clusters_goal(want, c.soft.members, frames, c.params);
     Rng rng(c.sizes.particles + 7u);
-    std::vector<vec4> ref = moved_by(rng, want.pos, kSkin, 0.3f);
+    std::vector<vec4> ref = moved_by(rng, want.pos, kClustersSkin, 0.3f);
     std::size_t moved_particle = c.particles.size();
     if (far && c.params.linked_first > c.params.soft_first) {
       moved_particle = (c.params.soft_first + c.params.linked_first) / 2;
-      ref[moved_particle] = moved_by(rng, {want.pos[moved_particle]}, kSkin, 0.6f)[0];
+      ref[moved_particle] = moved_by(rng, {want.pos[moved_particle]}, kClustersSkin, 0.6f)[0];
     }
     motes_ref::Particles again = c.particles;
     const bool rebuild = motes_ref::clusters_goal(again, c.soft.members, frames, c.params, ref);
@@ -246,10 +247,10 @@ class Clusters : public DeviceTest {
     const std::size_t n = c.particles.size();
 
     begin_case("clusters_goal/" + layout, b - a);
-    check_close("ParticlePos", pos, want.pos, kTolerance, Part::Xyz);
+    check_close("ParticlePos", pos, want.pos, kClustersTolerance, Part::Xyz);
     const double ulp_per_dt = coordinate_ulp(want.pos) / static_cast<double>(kDt);
     check_at_most("ParticleVel", "max dv (ulp/dt)", max_distance(vel, want.vel) / ulp_per_dt,
-                  kVelocityUlps);
+                  kClustersVelocityUlps);
     check_w_identical("ParticlePos.w (radius) kept", pos, c.particles.pos);
     check_w_identical("ParticleVel.w (inverse mass) kept", vel, c.particles.vel);
     check_identical("ParticlePos outside the soft range", slice(pos, 0, a),

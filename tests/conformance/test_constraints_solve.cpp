@@ -38,14 +38,14 @@ namespace {
 using motes::Buffer;
 using motes::shared::Constraint;
 
-constexpr double kTolerance = 1.0e-10;
-constexpr double kVelocityUlps = 16.0;
+constexpr double kConstraintsSolveTolerance = 1.0e-10;
+constexpr double kConstraintsVelocityUlps = 16.0;
 constexpr int kIterations = 2;
 /// The skin of these cases: the rebuild word is set when a particle is 0.45 skin from its
 /// reference at any projection of the last sweep. Projections move particles by up to a few mm in
 /// between, so the references sit 0.3 skin from the final positions (no rebuild) and one 0.6 skin
 /// (rebuild).
-constexpr float kSkin = 0.1f;
+constexpr float kConstraintsSkin = 0.1f;
 
 /// A world whose free particles are replaced by a linked object's points (each moved by up to
 /// `jitter` so that every constraint has an error to remove) and its constraints, coloured.
@@ -136,7 +136,7 @@ class ConstraintsSolve : public DeviceTest {
  protected:
   void run_case(const std::string& layout, LinkedCase c, bool far, bool checked = true) {
     World& w = c.world;
-    w.params.neighbour_skin = kSkin;
+    w.params.neighbour_skin = kConstraintsSkin;
     const std::vector<Constraint>& constraints = c.colouring.constraints;
     const std::vector<std::uint32_t>& first = c.colouring.first;
     auto colour_params = [&](int it, std::size_t k) {
@@ -153,14 +153,14 @@ class ConstraintsSolve : public DeviceTest {
       }
     }
     Rng rng(static_cast<std::uint32_t>(w.sizes.particles) + 91u);
-    std::vector<vec4> ref = moved_by(rng, want.pos, kSkin, 0.3f);
+    std::vector<vec4> ref = moved_by(rng, want.pos, kConstraintsSkin, 0.3f);
     std::vector<bool> in_constraint(w.particles.size(), false);
     for (const Constraint& k : constraints) in_constraint[k.a] = in_constraint[k.b] = true;
     std::size_t moved_particle = w.particles.size();
     if (far && !constraints.empty()) {
       const Constraint& k = constraints[constraints.size() / 2];
       moved_particle = w.particles.vel[k.a].w != 0.0f ? k.a : k.b;
-      ref[moved_particle] = moved_by(rng, {want.pos[moved_particle]}, kSkin, 0.6f)[0];
+      ref[moved_particle] = moved_by(rng, {want.pos[moved_particle]}, kConstraintsSkin, 0.6f)[0];
     }
     motes_ref::Particles again = w.particles;
     bool rebuild = false;
@@ -211,10 +211,10 @@ class ConstraintsSolve : public DeviceTest {
     begin_case(
         "constraints_solve/" + layout + " (" + std::to_string(c.colouring.colours()) + " colours)",
         static_cast<std::uint32_t>(constraints.size()));
-    check_close("ParticlePos", pos, want.pos, kTolerance, Part::Xyz);
+    check_close("ParticlePos", pos, want.pos, kConstraintsSolveTolerance, Part::Xyz);
     const double ulp_per_dt = coordinate_ulp(want.pos) / static_cast<double>(w.params.gravity_dt.w);
     check_at_most("ParticleVel", "max dv (ulp/dt)", max_distance(vel, want.vel) / ulp_per_dt,
-                  kVelocityUlps);
+                  kConstraintsVelocityUlps);
     check_w_identical("ParticlePos.w (radius) kept", pos, w.particles.pos);
     check_w_identical("ParticleVel.w (inverse mass) kept", vel, w.particles.vel);
     check_identical("ParticlePos of particles in no constraint", free_pos, free_pos_in);

@@ -34,7 +34,7 @@ namespace {
 
 using motes::Buffer;
 
-constexpr double kTolerance = 1.0e-7;
+constexpr double kContactsComputeTolerance = 1.0e-7;
 
 class ContactsCompute : public DeviceTest {
  protected:
@@ -115,8 +115,8 @@ class ContactsCompute : public DeviceTest {
       differ += a.x == b.x && a.y == b.y && a.z == b.z && a.w == b.w ? 0 : 1;
     }
     begin_case("contacts_compute/" + layout, n);
-    check_close("ParticleForce", listed, want, kTolerance);
-    check_close("ParticleForce (K = 2: walks)", walked, want, kTolerance);
+    check_close("ParticleForce", listed, want, kContactsComputeTolerance);
+    check_close("ParticleForce (K = 2: walks)", walked, want, kContactsComputeTolerance);
     check_that("K = 2 and K = 16 give the same forces",
                differ == 0 && listed.size() == walked.size());
     check_that("some particles walk the grid at K = 2", n < 31 || walking > 0);

@@ -35,7 +35,7 @@ namespace {
 
 using motes::Buffer;
 
-constexpr double kTolerance = 1.0e-7;
+constexpr double kImpulsesTolerance = 1.0e-7;
 constexpr uint kBuilds = 7;
 constexpr int kIterations = 3;
 
@@ -144,15 +144,15 @@ class Impulses : public DeviceTest {
                                    : 0);
     }
     begin_case("impulses/" + name, w.particles.size());
-    check_close("BodyVel", vel, want.vel, kTolerance);
-    check_close("BodyAngMom", angmom, want.angmom, kTolerance);
-    check_close("BodyAngVel", angvel, want.angvel, kTolerance);
-    check_close("BodyVelStart", vel0, s.vel0, kTolerance);
-    check_close("BodyAngVelStart", angvel0, s.angvel0, kTolerance);
-    check_close("ContactImpulse", acc, s.acc, kTolerance);
+    check_close("BodyVel", vel, want.vel, kImpulsesTolerance);
+    check_close("BodyAngMom", angmom, want.angmom, kImpulsesTolerance);
+    check_close("BodyAngVel", angvel, want.angvel, kImpulsesTolerance);
+    check_close("BodyVelStart", vel0, s.vel0, kImpulsesTolerance);
+    check_close("BodyAngVelStart", angvel0, s.angvel0, kImpulsesTolerance);
+    check_close("ContactImpulse", acc, s.acc, kImpulsesTolerance);
     check_identical("ImpulseStamp", stamp, s.stamp);
-    check_close("ParticleForce (impulses)", slice(force, 0, nr), s.impulse, kTolerance);
-    check_close("ParticleMoment", slice(moment, 0, nr), s.moment, kTolerance);
+    check_close("ParticleForce (impulses)", slice(force, 0, nr), s.impulse, kImpulsesTolerance);
+    check_close("ParticleMoment", slice(moment, 0, nr), s.moment, kImpulsesTolerance);
     check_identical("impulse and moment of static particles are 0", static_nonzero,
                     std::vector<uint>(static_nonzero.size(), 0u));
     check_that("a quarter of the rigid particles touch something", nr < 31 || touching >= nr / 4);

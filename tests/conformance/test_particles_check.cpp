@@ -25,7 +25,7 @@ namespace {
 
 using motes::Buffer;
 
-constexpr double kTolerance = 1.0e-6;
+constexpr double kParticlesCheckTolerance = 1.0e-6;
 
 double relative(uint device, uint oracle) {
   const auto a = static_cast<double>(std::bit_cast<float>(device));
@@ -53,9 +53,11 @@ class ParticlesCheck : public DeviceTest {
                     std::vector<uint>{got[MOTES_MOTION_FASTEST], got[MOTES_MOTION_NON_FINITE]},
                     std::vector<uint>{want[MOTES_MOTION_FASTEST], want[MOTES_MOTION_NON_FINITE]});
     check_at_most("MotionCheck largest (|v| / d)^2", "relative",
-                  relative(got[MOTES_MOTION_RATE2], want[MOTES_MOTION_RATE2]), kTolerance);
+                  relative(got[MOTES_MOTION_RATE2], want[MOTES_MOTION_RATE2]),
+                  kParticlesCheckTolerance);
     check_at_most("MotionCheck |v|^2 of the fastest", "relative",
-                  relative(got[MOTES_MOTION_SPEED2], want[MOTES_MOTION_SPEED2]), kTolerance);
+                  relative(got[MOTES_MOTION_SPEED2], want[MOTES_MOTION_SPEED2]),
+                  kParticlesCheckTolerance);
     end_case();
   }
 };

@@ -22,7 +22,7 @@ namespace {
 
 using motes::Buffer;
 
-constexpr double kTolerance = 1.0e-10;
+constexpr double kParticlesIntegrateTolerance = 1.0e-10;
 
 class ParticlesIntegrate : public DeviceTest {
  protected:
@@ -69,9 +69,9 @@ class ParticlesIntegrate : public DeviceTest {
 
     begin_case("particles_integrate/" + layout, w.sizes.particles - rigid);
     check_close("ParticlePos", slice(pos, rigid, pos.size()), slice(want.pos, rigid, pos.size()),
-                kTolerance, Part::Xyz);
+                kParticlesIntegrateTolerance, Part::Xyz);
     check_close("ParticleVel", slice(vel, rigid, vel.size()), slice(want.vel, rigid, vel.size()),
-                kTolerance, Part::Xyz);
+                kParticlesIntegrateTolerance, Part::Xyz);
     check_w_identical("ParticlePos.w (radius) kept", pos, w.particles.pos);
     check_w_identical("ParticleVel.w (inverse mass) kept", vel, w.particles.vel);
     check_identical("rigid particles' ParticlePos untouched", slice(pos, 0, rigid),

@@ -31,7 +31,7 @@ namespace {
 
 using motes::Buffer;
 
-constexpr double kTolerance = 1.0e-10;
+constexpr double kParticlesUpdateTolerance = 1.0e-10;
 
 class ParticlesUpdate : public DeviceTest {
  protected:
@@ -91,10 +91,10 @@ class ParticlesUpdate : public DeviceTest {
     if (rebuild) state_want[MOTES_NEIGHBOUR_REBUILD] = 1u;
 
     begin_case("particles_update/" + layout, w.sizes.particles);
-    check_close("ParticlePos", slice(pos, 0, rigid), slice(want.pos, 0, rigid), kTolerance,
-                Part::Xyz);
-    check_close("ParticleVel", slice(vel, 0, rigid), slice(want.vel, 0, rigid), kTolerance,
-                Part::Xyz);
+    check_close("ParticlePos", slice(pos, 0, rigid), slice(want.pos, 0, rigid),
+                kParticlesUpdateTolerance, Part::Xyz);
+    check_close("ParticleVel", slice(vel, 0, rigid), slice(want.vel, 0, rigid),
+                kParticlesUpdateTolerance, Part::Xyz);
     check_w_identical("ParticlePos.w (radius) kept", pos, w.particles.pos);
     check_w_identical("ParticleVel.w (inverse mass) kept", vel, w.particles.vel);
     check_identical("free particles' ParticlePos untouched", slice(pos, rigid, pos.size()),
@@ -104,8 +104,8 @@ class ParticlesUpdate : public DeviceTest {
     check_identical("NeighbourState", state, state_want);
     if (absorb) {
       check_close("ParticleForce (absorbed impulse)", slice(impulse, 0, rigid), impulse_want,
-                  kTolerance);
-      check_close("ParticleMoment (absorbed)", moment, moment_want, kTolerance);
+                  kParticlesUpdateTolerance);
+      check_close("ParticleMoment (absorbed)", moment, moment_want, kParticlesUpdateTolerance);
     }
     end_case();
   }

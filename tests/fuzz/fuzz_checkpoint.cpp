@@ -51,23 +51,18 @@ constexpr std::size_t kV1HeaderBytes = 48;
 /// Version 2: the header's file size field.
 constexpr std::size_t kFileBytesOffset = 16;
 
-[[noreturn]] void broken(const char* what, const std::string& message = {}) {
-  std::fprintf(stderr, "motes fuzz checkpoint: %s %s\n", what, message.c_str());
-  std::abort();
-}
-
 /// The simulation every input is loaded into (built once per process).
 Simulation& simulation() {
   static const std::unique_ptr<Simulation> sim = [] {
     Result<Scene> scene = load_scene_text(kScene, "fuzz_checkpoint.json", "");
-    if (!scene) broken("the fixed scene does not load:", scene.message());
+    if (!scene) broken("checkpoint", "the fixed scene does not load:", scene.message());
     DeviceOptions options;
     options.cpu_threads = 1;
     Result<std::unique_ptr<Device>> device = open_device("openmp", -1, options);
-    if (!device) broken("no OpenMP device:", device.message());
+    if (!device) broken("checkpoint", "no OpenMP device:", device.message());
     Result<std::unique_ptr<Simulation>> made =
         Simulation::create(scene.value(), std::move(device).value());
-    if (!made) broken("the fixed scene does not build:", made.message());
+    if (!made) broken("checkpoint", "the fixed scene does not build:", made.message());
     return std::move(made).value();
   }();
   return *sim;
@@ -86,16 +81,17 @@ std::uint64_t fnv1a(const std::uint8_t* data, std::size_t size) {
 void load(Simulation& sim, const std::filesystem::path& path) {
   const Status loaded = sim.load_state(path.string());
   if (!loaded) {
-    if (loaded.message().empty()) broken("an error without a message");
+    if (loaded.message().empty()) broken("checkpoint", "an error without a message");
     return;
   }
   // A loaded state is one the simulation must be able to go on from, or refuse with a message.
   (void)sim.step(1);
   (void)sim.check_finite();
   const Result<Snapshot> snap = sim.snapshot();
-  if (!snap) broken("snapshot after a load failed:", snap.message());
-  if (snap->particle_pos.size() != sim.particle_count()) broken("snapshot size");
-  if (!sim.save_state((work_dir() / "saved.ck").string())) broken("save_state after a load");
+  if (!snap) broken("checkpoint", "snapshot after a load failed:", snap.message());
+  if (snap->particle_pos.size() != sim.particle_count()) broken("checkpoint", "snapshot size");
+  if (!sim.save_state((work_dir() / "saved.ck").string()))
+    broken("checkpoint", "save_state after a load");
 }
 
 }  // namespace
@@ -130,13 +126,14 @@ void write_checkpoint_seeds(const std::filesystem::path& dir) {
   Simulation& sim = simulation();
   for (int i = 0; i < 3; ++i) {
     const std::string path = (dir / ("state_" + std::to_string(i) + ".ck")).string();
-    if (const Status s = sim.save_state(path); !s) broken("cannot write a seed:", s.message());
-    if (const Status s = sim.step(100); !s) broken("cannot step:", s.message());
+    if (const Status s = sim.save_state(path); !s)
+      broken("checkpoint", "cannot write a seed:", s.message());
+    if (const Status s = sim.step(100); !s) broken("checkpoint", "cannot step:", s.message());
   }
   // A version 1 file (the format motes bench's caches may still hold): the snapshot's body and
   // particle arrays after a 48-byte header, then the FNV-1a 64 of those arrays.
   const Result<Snapshot> snap = sim.snapshot();
-  if (!snap) broken("snapshot for a seed:", snap.message());
+  if (!snap) broken("checkpoint", "snapshot for a seed:", snap.message());
   std::vector<std::uint8_t> payload;
   for (const std::vector<shared::vec4>* v :
        {&snap->body_pos, &snap->body_quat, &snap->body_vel, &snap->body_angmom, &snap->body_angvel,

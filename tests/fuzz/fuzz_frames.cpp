@@ -24,23 +24,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
-[[noreturn]] void broken(const char* what, const std::string& message = {}) {
-  std::fprintf(stderr, "motes fuzz frames: %s %s\n", what, message.c_str());
-  std::abort();
-}
-
 /// Reads one frame; false at the end or on an error (which must say why).
 bool read_frame(render::FrameReader& reader) {
   Snapshot frame;
   const Result<bool> got = reader.next(frame);
   if (!got) {
-    if (got.message().empty()) broken("an error without a message");
+    if (got.message().empty()) broken("frames", "an error without a message");
     return false;
   }
   if (!got.value()) return false;
   const std::size_t n = frame.particle_pos.size();
   if (frame.particle_vel.size() != n || frame.particle_body.size() != n) {
-    broken("a frame whose arrays differ in length");
+    broken("frames", "a frame whose arrays differ in length");
   }
   return true;
 }
@@ -77,14 +72,14 @@ int frames(const std::uint8_t* data, std::size_t size) {
   }
   Result<std::unique_ptr<render::FrameReader>> opened = render::FrameReader::open(path.string());
   if (!opened) {
-    if (opened.message().empty()) broken("an error without a message");
+    if (opened.message().empty()) broken("frames", "an error without a message");
     return 0;
   }
   render::FrameReader& reader = *opened.value();
   for (int i = 0; i < 64 && read_frame(reader); ++i) {
   }
   if (const Status s = reader.rewind(); !s) {
-    if (s.message().empty()) broken("an error without a message");
+    if (s.message().empty()) broken("frames", "an error without a message");
     return 0;
   }
   (void)read_frame(reader);
@@ -105,26 +100,27 @@ void write_frame_seeds(const fs::path& dir) {
     ]
   })";
   Result<Scene> scene = load_scene_text(kScene, "fuzz_frames.json", "");
-  if (!scene) broken("the seed scene does not load:", scene.message());
+  if (!scene) broken("frames", "the seed scene does not load:", scene.message());
   DeviceOptions options;
   options.cpu_threads = 1;
   Result<std::unique_ptr<Device>> device = open_device("openmp", -1, options);
-  if (!device) broken("no OpenMP device:", device.message());
+  if (!device) broken("frames", "no OpenMP device:", device.message());
   Result<std::unique_ptr<Simulation>> sim =
       Simulation::create(scene.value(), std::move(device).value());
-  if (!sim) broken("the seed scene does not build:", sim.message());
+  if (!sim) broken("frames", "the seed scene does not build:", sim.message());
   const fs::path out = dir / "run";
   Result<std::unique_ptr<FrameWriter>> vtu = open_vtu_writer((out / "vtu").string());
   Result<std::unique_ptr<FrameWriter>> csv = open_csv_writer((out / "csv").string());
-  if (!vtu || !csv) broken("cannot open the writers");
+  if (!vtu || !csv) broken("frames", "cannot open the writers");
   for (int frame = 0; frame < 3; ++frame) {
     Result<Snapshot> snap = sim.value()->snapshot();
     if (!snap || !vtu.value()->write_frame(snap.value()) ||
         !csv.value()->write_frame(snap.value()) || !sim.value()->step(200)) {
-      broken("cannot write a frame");
+      broken("frames", "cannot write a frame");
     }
   }
-  if (!vtu.value()->finish() || !csv.value()->finish()) broken("cannot finish the writers");
+  if (!vtu.value()->finish() || !csv.value()->finish())
+    broken("frames", "cannot finish the writers");
   const auto bytes = [](const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
     std::ostringstream text;

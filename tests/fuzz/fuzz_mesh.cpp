@@ -22,21 +22,16 @@ namespace motes::fuzz {
 
 namespace {
 
-[[noreturn]] void broken(const char* what) {
-  std::fprintf(stderr, "motes fuzz mesh: %s\n", what);
-  std::abort();
-}
-
 /// What the scene loader relies on in a voxelized set.
 void check_particles(const Result<ParticleSet>& set) {
   if (!set) {
-    if (set.message().empty()) broken("an error without a message");
+    if (set.message().empty()) broken("mesh", "an error without a message");
     return;
   }
-  if (set->points.empty()) broken("voxelize returned no particles without an error");
-  if (!(set->diameter > 0.0) || !std::isfinite(set->diameter)) broken("a bad diameter");
+  if (set->points.empty()) broken("mesh", "voxelize returned no particles without an error");
+  if (!(set->diameter > 0.0) || !std::isfinite(set->diameter)) broken("mesh", "a bad diameter");
   for (const Eigen::Vector3f& p : set->points) {
-    if (!p.allFinite()) broken("a particle that is not finite");
+    if (!p.allFinite()) broken("mesh", "a particle that is not finite");
   }
 }
 
@@ -80,19 +75,19 @@ int mesh(const std::uint8_t* data, std::size_t size) {
     write_file(path, data + 1, size - 1);
     loaded = load_mesh(path.string());
     if (!loaded) {
-      if (loaded.message().empty()) broken("an error without a message");
+      if (loaded.message().empty()) broken("mesh", "an error without a message");
       return 0;
     }
-    if (loaded->triangles.empty()) broken("load_mesh returned a mesh without triangles");
+    if (loaded->triangles.empty()) broken("mesh", "load_mesh returned a mesh without triangles");
   }
   const TriangleMesh& mesh = loaded.value();
   const auto vertices = static_cast<int>(mesh.vertices.size());
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (const Eigen::Vector3i& t : mesh.triangles) {
     for (int c = 0; c < 3; ++c) {
-      if (t[c] < 0 || t[c] >= vertices) broken("a triangle's vertex index is out of range");
+      if (t[c] < 0 || t[c] >= vertices) broken("mesh", "a triangle's vertex index is out of range");
       const Eigen::Vector3d& v = mesh.vertices[static_cast<std::size_t>(t[c])];
-      if (!v.allFinite()) broken("a vertex that is not finite");
+      if (!v.allFinite()) broken("mesh", "a vertex that is not finite");
       lo = lo.cwiseMin(v);
       hi = hi.cwiseMax(v);
     }

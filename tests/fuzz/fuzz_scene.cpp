@@ -89,57 +89,70 @@ std::string capped(const std::string& text) {
   return doc.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
-[[noreturn]] void broken(const char* what) {
-  std::fprintf(stderr, "motes fuzz scene: a loaded scene breaks an invariant: %s\n", what);
-  std::abort();
-}
-
 /// What Simulation::create relies on in a scene that loaded.
 void check_invariants(const Scene& scene) {
   const auto finite = [](const Eigen::Vector3d& v) { return v.allFinite(); };
-  if (scene.materials.empty()) broken("no materials");
+  if (scene.materials.empty()) broken("scene: a loaded scene breaks an invariant:", "no materials");
   const auto material_ok = [&](int m) {
     return m >= 0 && static_cast<std::size_t>(m) < scene.materials.size();
   };
-  if (scene.bodies.empty() && scene.linked.empty()) broken("no bodies");
-  if (scene.particle_count() > static_cast<std::size_t>(kCap)) broken("more than max_particles");
+  if (scene.bodies.empty() && scene.linked.empty())
+    broken("scene: a loaded scene breaks an invariant:", "no bodies");
+  if (scene.particle_count() > static_cast<std::size_t>(kCap))
+    broken("scene: a loaded scene breaks an invariant:", "more than max_particles");
   for (const BodySpec& b : scene.bodies) {
-    if (!b.shape || b.shape->points.empty()) broken("a body without particles");
-    if (!(b.shape->diameter > 0.0)) broken("a body's particle diameter is not positive");
-    if (!material_ok(b.material)) broken("a body's material index");
+    if (!b.shape || b.shape->points.empty())
+      broken("scene: a loaded scene breaks an invariant:", "a body without particles");
+    if (!(b.shape->diameter > 0.0))
+      broken("scene: a loaded scene breaks an invariant:",
+             "a body's particle diameter is not positive");
+    if (!material_ok(b.material))
+      broken("scene: a loaded scene breaks an invariant:", "a body's material index");
     if (!finite(b.position) || !finite(b.velocity) || !finite(b.angular_velocity)) {
-      broken("a body's position or velocity is not finite");
+      broken("scene: a loaded scene breaks an invariant:",
+             "a body's position or velocity is not finite");
     }
-    if (!(std::abs(b.rotation.norm() - 1.0) < 1e-6)) broken("a body's rotation is not a unit");
+    if (!(std::abs(b.rotation.norm() - 1.0) < 1e-6))
+      broken("scene: a loaded scene breaks an invariant:", "a body's rotation is not a unit");
     for (const Eigen::Vector3f& p : b.shape->points) {
-      if (!p.allFinite()) broken("a shape point is not finite");
+      if (!p.allFinite())
+        broken("scene: a loaded scene breaks an invariant:", "a shape point is not finite");
     }
   }
   for (const LinkedSpec& l : scene.linked) {
-    if (l.points.empty() || !(l.diameter > 0.0)) broken("an empty cloth or rope");
-    if (!material_ok(l.material)) broken("a cloth's or rope's material index");
+    if (l.points.empty() || !(l.diameter > 0.0))
+      broken("scene: a loaded scene breaks an invariant:", "an empty cloth or rope");
+    if (!material_ok(l.material))
+      broken("scene: a loaded scene breaks an invariant:", "a cloth's or rope's material index");
     for (const LinkSpec& link : l.links) {
-      if (link.a >= l.points.size() || link.b >= l.points.size()) broken("a link's index");
+      if (link.a >= l.points.size() || link.b >= l.points.size())
+        broken("scene: a loaded scene breaks an invariant:", "a link's index");
     }
     for (std::uint32_t pin : l.pinned) {
-      if (pin >= l.points.size()) broken("a pin's index");
+      if (pin >= l.points.size())
+        broken("scene: a loaded scene breaks an invariant:", "a pin's index");
     }
     for (const LinkAttachment& a : l.attached) {
-      if (a.point >= l.points.size()) broken("an attachment's index");
+      if (a.point >= l.points.size())
+        broken("scene: a loaded scene breaks an invariant:", "an attachment's index");
     }
     for (const Eigen::Vector3d& x : l.points) {
-      if (!x.allFinite()) broken("a cloth or rope point is not finite");
+      if (!x.allFinite())
+        broken("scene: a loaded scene breaks an invariant:", "a cloth or rope point is not finite");
     }
     // A lattice place per point, or none at all for a cloth made from a mesh.
     if (l.lattice.empty() ? l.kind != LinkedKind::Cloth : l.lattice.size() != l.points.size()) {
-      broken("a cloth's or rope's lattice");
+      broken("scene: a loaded scene breaks an invariant:", "a cloth's or rope's lattice");
     }
   }
   for (const PlaneSpec& p : scene.planes) {
-    if (!material_ok(p.material)) broken("a plane's material index");
-    if (!(std::abs(p.normal.norm() - 1.0) < 1e-9) || !finite(p.point)) broken("a plane");
+    if (!material_ok(p.material))
+      broken("scene: a loaded scene breaks an invariant:", "a plane's material index");
+    if (!(std::abs(p.normal.norm() - 1.0) < 1e-9) || !finite(p.point))
+      broken("scene: a loaded scene breaks an invariant:", "a plane");
   }
-  if (!(scene.settings.dt > 0.0) || scene.settings.substeps < 1) broken("dt or substeps");
+  if (!(scene.settings.dt > 0.0) || scene.settings.substeps < 1)
+    broken("scene: a loaded scene breaks an invariant:", "dt or substeps");
 }
 
 }  // namespace
@@ -150,7 +163,7 @@ int scene(const std::uint8_t* data, std::size_t size) {
   if (loaded) {
     check_invariants(loaded.value());
   } else if (loaded.message().empty()) {
-    broken("an error without a message");
+    broken("scene: a loaded scene breaks an invariant:", "an error without a message");
   }
   return 0;
 }

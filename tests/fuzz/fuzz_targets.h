@@ -33,6 +33,14 @@ int frames(const std::uint8_t* data, std::size_t size);
 void write_checkpoint_seeds(const std::filesystem::path& dir);
 void write_frame_seeds(const std::filesystem::path& dir);
 
+/// A broken invariant: "motes fuzz TARGET: WHAT MESSAGE" on stderr, then abort (libFuzzer keeps the
+/// input; the unit tests' replay fails).
+[[noreturn]] inline void broken(const char* target, const char* what,
+                                const std::string& message = {}) {
+  std::fprintf(stderr, "motes fuzz %s: %s %s\n", target, what, message.c_str());
+  std::abort();
+}
+
 /// A directory of this process for the files the targets write (removed at exit).
 inline const std::filesystem::path& work_dir() {
   struct Dir {

@@ -11,7 +11,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -19,36 +18,19 @@
 #include "motes/distributed.h"
 #include "motes/simulation.h"
 #include "motes/workloads.h"
+#include "mpi_support.h"
 
 namespace motes {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string backend() {
-  const char* b = std::getenv("MOTES_MPI_BACKEND");
-  return b != nullptr && *b != '\0' ? b : "openmp";
-}
-
-DeviceOpener opener() {
-  return [] {
-    DeviceOptions options;
-    options.cpu_threads = 1;
-    return open_device(backend(), -1, options);
-  };
-}
-
-int rank_in(MPI_Comm comm) {
-  int r = 0;
-  MPI_Comm_rank(comm, &r);
-  return r;
-}
-
-int size_of(MPI_Comm comm) {
-  int n = 1;
-  MPI_Comm_size(comm, &n);
-  return n;
-}
+using mpi_test::backend;
+using mpi_test::example;
+using mpi_test::opener;
+using mpi_test::rank_in;
+using mpi_test::shaken_settle;
+using mpi_test::size_of;
 
 /// A directory every rank sees (rank 0 names it), removed at the end.
 class SharedDir {
@@ -80,24 +62,6 @@ class SharedDir {
  private:
   fs::path path_;
 };
-
-/// W1's spheres given random velocities (as test_distributed.cpp's): collisions across every
-/// rank boundary, many partitions and migrations within a few hundred steps.
-Scene shaken_settle(double stiffness_factor = 1.0) {
-  Scene scene = settle_workload(12, 6, 12);
-  std::mt19937 random(7);
-  std::uniform_real_distribution<double> speed(-2.0, 2.0);
-  for (BodySpec& b : scene.bodies) b.velocity = {speed(random), speed(random), speed(random)};
-  for (Material& m : scene.materials) m.stiffness *= stiffness_factor;
-  return scene;
-}
-
-Scene example(const std::string& name) {
-  Result<Scene> scene =
-      load_scene_file(std::string(MOTES_SOURCE_DIR) + "/examples/scenes/" + name + ".json");
-  EXPECT_TRUE(scene) << scene.message();
-  return scene ? scene.value() : Scene{};
-}
 
 std::unique_ptr<DistributedSimulation> make(const Scene& scene, MPI_Comm comm,
                                             const DistributedOptions& options = {}) {

@@ -5,9 +5,7 @@
 #include <mpi.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
-#include <random>
 #include <set>
 #include <string>
 #include <utility>
@@ -18,44 +16,18 @@
 #include "motes/distributed.h"
 #include "motes/simulation.h"
 #include "motes/workloads.h"
+#include "mpi_support.h"
 
 namespace motes {
 namespace {
 
-std::string backend() {
-  const char* b = std::getenv("MOTES_MPI_BACKEND");
-  return b != nullptr && *b != '\0' ? b : "openmp";
-}
+using mpi_test::backend;
+using mpi_test::example;
+using mpi_test::opener;
+using mpi_test::shaken_settle;
 
-DeviceOpener opener() {
-  return [] {
-    DeviceOptions options;
-    options.cpu_threads = 1;
-    return open_device(backend(), -1, options);
-  };
-}
-
-int world_rank() {
-  int r = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &r);
-  return r;
-}
-
-int world_size() {
-  int n = 1;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
-
-/// W1's spheres given random velocities (up to 2 m/s a component, seeded): they collide with each
-/// other, the walls and the floor within a few hundred steps, across every rank boundary.
-Scene shaken_settle() {
-  Scene scene = settle_workload(12, 6, 12);
-  std::mt19937 random(7);
-  std::uniform_real_distribution<double> speed(-2.0, 2.0);
-  for (BodySpec& b : scene.bodies) b.velocity = {speed(random), speed(random), speed(random)};
-  return scene;
-}
+int world_rank() { return mpi_test::rank_in(MPI_COMM_WORLD); }
+int world_size() { return mpi_test::size_of(MPI_COMM_WORLD); }
 
 /// The scene's first `count` dominoes (examples/scenes/dominoes.json): the chain falls across
 /// the rank boundaries along x within the steps the test runs.
@@ -215,16 +187,6 @@ TEST(Distributed, RefusesAWrongDecomposition) {
       DistributedSimulation::create(shaken_settle(), MPI_COMM_WORLD, opener(), wrong);
   ASSERT_FALSE(d);
   EXPECT_NE(d.message().find("must multiply to the"), std::string::npos) << d.message();
-}
-
-Scene example(const std::string& name) {
-  // Appended rather than `a + b + c`: GCC 12 warns falsely (-Warray-bounds) inside
-  // std::string's operator+ on the temporaries here.
-  std::string path = MOTES_SOURCE_DIR "/examples/scenes/";
-  path.append(name).append(".json");
-  Result<Scene> scene = load_scene_file(path);
-  EXPECT_TRUE(scene) << scene.message();
-  return scene ? scene.value() : Scene{};
 }
 
 /// The domino row of impulse_dominoes.json sliding along -x at 0.5 m/s (with friction on the

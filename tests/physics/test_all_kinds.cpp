@@ -18,20 +18,20 @@ namespace {
 
 using motes_test::to_vec3;
 
-constexpr double kD = 0.01;
+constexpr double kAllKindsD = 0.01;
 
 motes::Scene all_kinds(motes::ContactModel model) {
   motes::Material mat = motes_test::material(1000.0, 2000.0, 500.0, 200.0, 0.5);
   mat.restitution = 0.3;
   motes::Scene scene = motes_test::scene_with(1.0e-4, Eigen::Vector3d::Zero(), mat);
   scene.settings.contact_model = model;
-  auto box = motes_test::lattice(3, 3, 3, kD);
+  auto box = motes_test::lattice(3, 3, 3, kAllKindsD);
   // Rigid box from -x, spinning; a one-particle sphere from +z.
   scene.bodies.push_back(motes_test::body(box, Eigen::Vector3d(-0.05, 0.0, 0.0),
                                           Eigen::Vector3d(1.0, 0.0, 0.0),
                                           Eigen::Vector3d(0.0, 4.0, 2.0)));
   scene.bodies.back().name = "rigid box";
-  scene.bodies.push_back(motes_test::body(motes_test::single_particle(kD),
+  scene.bodies.push_back(motes_test::body(motes_test::single_particle(kAllKindsD),
                                           Eigen::Vector3d(0.0, 0.0, 0.05),
                                           Eigen::Vector3d(0.0, 0.0, -1.0)));
   scene.bodies.back().name = "sphere";
@@ -53,7 +53,7 @@ motes::Scene all_kinds(motes::ContactModel model) {
   c.edge_v = Eigen::Vector3d(0.0, 0.0, 0.06);
   c.nu = 7;
   c.nv = 7;
-  c.diameter = kD;
+  c.diameter = kAllKindsD;
   motes::LinkedSpec cloth = motes::make_cloth(c).value();
   cloth.name = "cloth";
   cloth.velocity = Eigen::Vector3d(0.0, -1.0, 0.0);
@@ -62,7 +62,7 @@ motes::Scene all_kinds(motes::ContactModel model) {
   r.from = Eigen::Vector3d(0.0, -0.05, -0.04);
   r.to = Eigen::Vector3d(0.0, -0.05, 0.04);
   r.count = 9;
-  r.diameter = kD;
+  r.diameter = kAllKindsD;
   motes::LinkedSpec rope = motes::make_rope(r).value();
   rope.name = "rope";
   rope.velocity = Eigen::Vector3d(0.0, 1.0, 0.0);

@@ -20,7 +20,7 @@ namespace {
 
 using motes_test::to_vec3;
 
-constexpr double kD = 0.01;
+constexpr double kAttachmentsD = 0.01;
 
 motes::Scene rope_scene(const Eigen::Vector3d& gravity) {
   const motes::Material mat = motes_test::material(1000.0, 2000.0, 500.0, 200.0, 0.5);
@@ -35,7 +35,7 @@ motes::LinkedSpec rope_to_box(const Eigen::Vector3d& from, const Eigen::Vector3d
   o.from = from;
   o.to = to;
   o.count = count;
-  o.diameter = kD;
+  o.diameter = kAttachmentsD;
   motes::LinkedSpec rope = motes::make_rope(o).value();
   rope.name = "rope";
   rope.attached.push_back({static_cast<std::uint32_t>(count - 1), "box"});
@@ -50,7 +50,7 @@ TEST(Attachment, RopeHoldsAHangingBox) {
   // below its last point.
   motes::LinkedSpec rope = rope_to_box({0.0, 0.4, 0.0}, {0.0, 0.2, 0.0}, 21);
   rope.pinned = {0u};
-  auto box = motes_test::lattice(3, 3, 3, kD);
+  auto box = motes_test::lattice(3, 3, 3, kAttachmentsD);
   motes::BodySpec held = motes_test::body(box, Eigen::Vector3d(0.0, 0.17, 0.0));
   held.name = "box";
   scene.bodies.push_back(held);
@@ -81,7 +81,7 @@ TEST(Attachment, DraggedRopeKeepsMomentum) {
   motes::Scene scene = rope_scene(Eigen::Vector3d::Zero());
   // A rope lying along -x from the box, which moves at 1 m/s along +x and spins.
   motes::LinkedSpec rope = rope_to_box({-0.22, 0.0, 0.0}, {-0.03, 0.0, 0.0}, 20);
-  auto box = motes_test::lattice(3, 3, 3, kD);
+  auto box = motes_test::lattice(3, 3, 3, kAttachmentsD);
   motes::BodySpec moving =
       motes_test::body(box, Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(1.0, 0.2, 0.0),
                        Eigen::Vector3d(0.0, 0.0, 3.0));

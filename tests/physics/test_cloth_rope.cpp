@@ -29,10 +29,10 @@ namespace {
 
 using motes_test::to_vec3;
 
-constexpr double kDensity = 1000.0;
+constexpr double kClothDensity = 1000.0;
 
 motes::Scene linked_scene(double dt, const Eigen::Vector3d& gravity) {
-  const motes::Material mat = motes_test::material(kDensity, 2000.0, 500.0, 200.0, 0.5);
+  const motes::Material mat = motes_test::material(kClothDensity, 2000.0, 500.0, 200.0, 0.5);
   return motes_test::scene_with(dt, gravity, mat);
 }
 

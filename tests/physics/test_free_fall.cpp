@@ -31,12 +31,12 @@ struct FallRun {
   motes::Snapshot last;
 };
 
-constexpr double kDt = 1.0e-3;
+constexpr double kFreeFallDt = 1.0e-3;
 constexpr int kSteps = 1000;
 
 motes::Scene fall_scene(const Eigen::Vector3d& w) {
   const motes::Material mat = motes_test::material(2500.0, 1.0e4, 50.0, 10.0, 0.5);
-  motes::Scene scene = motes_test::scene_with(kDt, Eigen::Vector3d(0.3, -9.81, 0.1), mat);
+  motes::Scene scene = motes_test::scene_with(kFreeFallDt, Eigen::Vector3d(0.3, -9.81, 0.1), mat);
   // A 3 x 4 x 5 lattice: the three principal moments differ, so w changes while L must not.
   auto shape = motes_test::lattice(3, 4, 5, 0.05);
   scene.bodies.push_back(motes_test::body(
@@ -75,7 +75,7 @@ TEST(FreeFall, MatchesExactDiscreteSolution) {
   EXPECT_NEAR((x0 - Eigen::Vector3d(1.5, 4.0, -2.0)).norm(), 0.0, 1e-6)
       << "the centre of mass goes at BodySpec::position";
   EXPECT_NEAR((v0 - Eigen::Vector3d(1.0, 3.0, -0.5)).norm(), 0.0, 1e-6);
-  const double dt = as_float(kDt);
+  const double dt = as_float(kFreeFallDt);
   const Eigen::Vector3d g(as_float(0.3), as_float(-9.81), as_float(0.1));
   double worst_x = 0.0;
   double worst_v = 0.0;
@@ -88,8 +88,8 @@ TEST(FreeFall, MatchesExactDiscreteSolution) {
     worst_x = std::max(worst_x, (run.pos[n] - x).norm() / x_scale);
     worst_v = std::max(worst_v, (run.vel[n] - v).norm() / v_scale);
   }
-  std::printf("[free fall] 1000 steps of %.0e s: max relative error x %.2e, v %.2e\n", kDt, worst_x,
-              worst_v);
+  std::printf("[free fall] 1000 steps of %.0e s: max relative error x %.2e, v %.2e\n", kFreeFallDt,
+              worst_x, worst_v);
   EXPECT_LE(worst_x, 1e-5);
   EXPECT_LE(worst_v, 1e-5);
   // The discrete answer differs from the continuous one by g t dt / 2: make sure the test can

@@ -28,11 +28,11 @@ namespace {
 using motes_test::to_quat;
 using motes_test::to_vec3;
 
-constexpr double kDensity = 1000.0;
+constexpr double kImpulseDensity = 1000.0;
 
 motes::Scene impulse_scene(double dt, const Eigen::Vector3d& gravity, double restitution,
                            double friction, int iterations = 16) {
-  motes::Material mat = motes_test::material(kDensity, 0.0, 0.0, 0.0, friction);
+  motes::Material mat = motes_test::material(kImpulseDensity, 0.0, 0.0, 0.0, friction);
   mat.restitution = restitution;
   motes::Scene scene = motes_test::scene_with(dt, gravity, mat);
   scene.settings.contact_model = motes::ContactModel::Impulses;
@@ -105,7 +105,7 @@ TEST(ImpulseContact, TiltedBoxLandingOnACornerMatchesRigidBodyTheory) {
   ASSERT_TRUE(shape);
   const Eigen::Quaterniond tilt(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitX()) *
                                 Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitZ()));
-  const motes::MassProperties mp = motes::mass_properties(*shape, kDensity);
+  const motes::MassProperties mp = motes::mass_properties(*shape, kImpulseDensity);
   // The lowest particle, and the gap to the next one (only one may touch).
   Eigen::Vector3d lowest(0.0, 1e9, 0.0);
   double second = 1e9;

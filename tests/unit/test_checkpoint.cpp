@@ -35,7 +35,7 @@ namespace fs = std::filesystem;
 using motes::Buffer;
 using motes_test::TempDir;
 
-const std::string kMixedScene = std::string(MOTES_TEST_DATA_DIR) + "/checkpoint/mixed.json";
+using motes_test::kMixedScene;
 
 /// The device buffers a checkpoint holds (core/src/checkpoint.cpp), compared byte for byte.
 constexpr Buffer kStateBuffers[] = {

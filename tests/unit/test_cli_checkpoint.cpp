@@ -40,7 +40,7 @@ using motes_test::read_text;
 using motes_test::run_motes;
 using motes_test::TempDir;
 
-const std::string kMixedScene = std::string(MOTES_TEST_DATA_DIR) + "/checkpoint/mixed.json";
+using motes_test::kMixedScene;
 
 std::string summary_hash(const Outcome& o) {
   std::smatch m;

@@ -7,17 +7,19 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <numbers>
 #include <string>
 #include <vector>
 
 #include "motes/cloth.h"
 #include "motes/scene.h"
+#include "unit/test_support.h"
 
 namespace motes {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using motes_test::example_path;
+using motes_test::kPi;
+using motes_test::stable_substep;
 
 /// A scene with the given "bodies" entries (and extra "settings" keys), default contact k = 1000.
 std::string scene_text(const std::string& bodies, const std::string& settings = "",
@@ -26,7 +28,7 @@ std::string scene_text(const std::string& bodies, const std::string& settings = 
                      settings.empty() ? "" : settings + ", ", bodies, rest);
 }
 
-Scene load_or_fail(const std::string& text) {
+Scene load_text_or_fail(const std::string& text) {
   Result<Scene> r = load_scene_text(text, "s.json", "");
   if (!r) ADD_FAILURE() << r.message();
   return r ? std::move(r).value() : Scene{};
@@ -39,7 +41,7 @@ const char* const kSheet =
         "velocity": [0, -1, 0], "color": [1, 0.5, 0]})";
 
 TEST(SceneLinked, ClothLoadsItsLatticePinsAndLinks) {
-  const Scene s = load_or_fail(
+  const Scene s = load_text_or_fail(
       scene_text(std::string(kSheet) + R"(, {"name": "ball", "shape": {"type": "particle"}})", "",
                  R"(, "materials": {"silk": {"density": 300}})"));
   ASSERT_EQ(s.linked.size(), 1u);
@@ -73,7 +75,7 @@ TEST(SceneLinked, ClothLoadsItsLatticePinsAndLinks) {
 }
 
 TEST(SceneLinked, RopeLoadsWithNegativePinsSortedAndNoBendByDefault) {
-  const Scene s = load_or_fail(scene_text(
+  const Scene s = load_text_or_fail(scene_text(
       R"({"name": "line", "kind": "rope", "rope": {"from": [0, 1, 0], "to": [0.19, 1, 0],
           "particles": 20, "stiffness": 0.5, "pin": [-1, 0]}})"));
   ASSERT_EQ(s.linked.size(), 1u);
@@ -94,7 +96,7 @@ TEST(SceneLinked, RopeLoadsWithNegativePinsSortedAndNoBendByDefault) {
 }
 
 TEST(SceneLinked, RopeAlongAPath) {
-  const Scene s = load_or_fail(scene_text(
+  const Scene s = load_text_or_fail(scene_text(
       R"({"kind": "rope", "rope": {"path": [[0, 1, 0], [0.1, 0.9, 0], [0.2, 1, 0]],
           "particles": 5, "pin": [0, -1]}})"));
   ASSERT_EQ(s.linked.size(), 1u);
@@ -106,7 +108,7 @@ TEST(SceneLinked, RopeAlongAPath) {
 }
 
 TEST(SceneLinked, BendOptionsAndDefaultNamesInFileOrder) {
-  const Scene s = load_or_fail(scene_text(
+  const Scene s = load_text_or_fail(scene_text(
       R"({"kind": "rope", "rope": {"from": [0, 1, 0], "to": [1, 1, 0], "particles": 10,
           "bend": true, "bend_stiffness": 0.25}},
          {"shape": {"type": "particle"}},
@@ -125,11 +127,11 @@ TEST(SceneLinked, BendOptionsAndDefaultNamesInFileOrder) {
 }
 
 TEST(SceneLinked, SettingsAreReadWithDefaults) {
-  const Scene d = load_or_fail(scene_text(R"({"shape": {"type": "particle"}})"));
+  const Scene d = load_text_or_fail(scene_text(R"({"shape": {"type": "particle"}})"));
   EXPECT_EQ(d.settings.constraint_iterations, 8);
   EXPECT_EQ(d.settings.link_damping, 0.0);
-  const Scene s = load_or_fail(scene_text(R"({"shape": {"type": "particle"}})",
-                                          R"("constraint_iterations": 12, "link_damping": 1.5)"));
+  const Scene s = load_text_or_fail(scene_text(
+      R"({"shape": {"type": "particle"}})", R"("constraint_iterations": 12, "link_damping": 1.5)"));
   EXPECT_EQ(s.settings.constraint_iterations, 12);
   EXPECT_EQ(s.settings.link_damping, 1.5);
 }
@@ -155,11 +157,6 @@ TEST(SceneLinked, MaxObjectsIsTheLimit) {
 }
 
 // ---- stability: lone-sphere particle mass, self contact, pins as static partners ----
-
-double stable_substep(double k, double gamma, double m_eff) {
-  const double w2 = k / m_eff;
-  return (-gamma + std::sqrt(gamma * gamma + 4 * w2)) / w2;
-}
 
 std::string linked_scene(double dt, const std::string& rope) {
   return fmt::format(
@@ -466,13 +463,9 @@ INSTANTIATE_TEST_SUITE_P(Bad, SceneLinkedErrors, ::testing::ValuesIn(bad_cases()
 
 // ---- example scenes ----
 
-std::string example(const std::string& name) {
-  return std::string(MOTES_SOURCE_DIR) + "/examples/scenes/" + name;
-}
-
 TEST(SceneLinkedExamples, EveryExampleSceneLoads) {
   std::size_t count = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(example(""))) {
+  for (const auto& entry : std::filesystem::directory_iterator(example_path(""))) {
     if (entry.path().extension() != ".json") continue;
     ++count;
     Result<Scene> r = load_scene_file(entry.path().string());
@@ -482,7 +475,7 @@ TEST(SceneLinkedExamples, EveryExampleSceneLoads) {
 }
 
 TEST(SceneLinkedExamples, ClothFallsOnTwoStaticBunnies) {
-  Result<Scene> r = load_scene_file(example("cloth.json"));
+  Result<Scene> r = load_scene_file(example_path("cloth.json"));
   ASSERT_TRUE(r) << r.message();
   const Scene& s = *r;
   ASSERT_EQ(s.linked.size(), 1u);
@@ -515,7 +508,7 @@ TEST(SceneLinkedExamples, ClothFallsOnTwoStaticBunnies) {
 }
 
 TEST(SceneLinkedExamples, RopeBridgeAndHangingRope) {
-  Result<Scene> r = load_scene_file(example("rope.json"));
+  Result<Scene> r = load_scene_file(example_path("rope.json"));
   ASSERT_TRUE(r) << r.message();
   const Scene& s = *r;
   ASSERT_EQ(s.linked.size(), 2u);

@@ -4,22 +4,21 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <numbers>
 #include <string>
 #include <vector>
 
 #include "motes/scene.h"
+#include "unit/test_support.h"
 
 namespace motes {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using motes_test::example_path;
+using motes_test::kPi;
+using motes_test::stable_substep;
 
 std::string data(const std::string& name) {
   return std::string(MOTES_TEST_DATA_DIR) + "/scenes/" + name;
-}
-std::string example(const std::string& name) {
-  return std::string(MOTES_SOURCE_DIR) + "/examples/scenes/" + name;
 }
 
 Scene load_or_fail(const std::string& path) {
@@ -48,7 +47,7 @@ Eigen::Vector3d extent(const ParticleSet& p) {
 // ---- example scenes ----
 
 TEST(SceneExamples, DominoesIsAChainOf40With15ParticlesEach) {
-  const Scene s = load_or_fail(example("dominoes.json"));
+  const Scene s = load_or_fail(example_path("dominoes.json"));
   ASSERT_EQ(s.bodies.size(), 40u);
   EXPECT_EQ(s.particle_count(), 600u);
   EXPECT_EQ(s.bodies[0].name, "first");
@@ -88,7 +87,7 @@ TEST(SceneExamples, DominoesIsAChainOf40With15ParticlesEach) {
 }
 
 TEST(SceneExamples, DiceArePileOf4x4x4CubesInABox) {
-  const Scene s = load_or_fail(example("dice.json"));
+  const Scene s = load_or_fail(example_path("dice.json"));
   ASSERT_EQ(s.bodies.size(), 36u);
   EXPECT_EQ(s.particle_count(), 36u * 64u);
   for (const BodySpec& b : s.bodies) EXPECT_EQ(b.shape, s.bodies[0].shape);
@@ -120,7 +119,7 @@ TEST(SceneExamples, DiceArePileOf4x4x4CubesInABox) {
 }
 
 TEST(SceneExamples, BunnyIsVoxelizedNearItsParticleCount) {
-  const Scene s = load_or_fail(example("bunny.json"));
+  const Scene s = load_or_fail(example_path("bunny.json"));
   ASSERT_EQ(s.bodies.size(), 1u);
   const std::size_t n = s.particle_count();
   EXPECT_NEAR(static_cast<double>(n), 3000.0, 150.0);
@@ -138,7 +137,7 @@ TEST(SceneExamples, BunnyIsVoxelizedNearItsParticleCount) {
 TEST(SceneExamples, BuiltInSceneIsTheDominoChain) {
   Result<Scene> r = builtin_default_scene();
   ASSERT_TRUE(r) << r.message();
-  const Scene file = load_or_fail(example("dominoes.json"));
+  const Scene file = load_or_fail(example_path("dominoes.json"));
   EXPECT_EQ(r->source, "<built-in>");
   EXPECT_EQ(r->bodies.size(), file.bodies.size());
   EXPECT_EQ(r->particle_count(), file.particle_count());
@@ -379,13 +378,6 @@ TEST(SceneLoad, TextResolvesMeshesFromBaseDir) {
 }
 
 // ---- stability ----
-
-/// Largest stable substep of semi-implicit Euler for x'' = -w0^2 x - gamma x' (w0^2 h^2 +
-/// 2 gamma h < 4), written out here independently of the loader.
-double stable_substep(double k, double gamma, double m_eff) {
-  const double w2 = k / m_eff;
-  return (-gamma + std::sqrt(gamma * gamma + 4 * w2)) / w2;
-}
 
 std::string two_balls(double dt, int substeps, bool planes_only) {
   return fmt::format(

@@ -6,10 +6,14 @@
 #include <unistd.h>
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <memory>
+#include <numbers>
 #include <string>
 #include <system_error>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -107,6 +111,37 @@ inline std::unique_ptr<motes::Simulation> simulate_text(const std::string& text,
   auto sim = motes::Simulation::create(*scene, std::move(device.value()));
   EXPECT_TRUE(sim) << sim.message();
   return sim ? std::move(sim.value()) : nullptr;
+}
+
+/// Files the tests read: tests/data/meshes/NAME, the Stanford bunny, examples/scenes/NAME, and
+/// the checkpoint tests' scene with every kind of state. (Appended rather than `a + b + c`: GCC
+/// 12 warns falsely, -Warray-bounds, inside std::string's operator+ on such temporaries.)
+inline std::string mesh_path(const std::string& name) {
+  std::string path = MOTES_TEST_DATA_DIR "/meshes/";
+  return path.append(name);
+}
+inline std::string bunny_path() { return MOTES_SOURCE_DIR "/examples/assets/bunny.obj"; }
+inline std::string example_path(const std::string& name) {
+  std::string path = MOTES_SOURCE_DIR "/examples/scenes/";
+  return path.append(name);
+}
+inline const std::string kMixedScene = MOTES_TEST_DATA_DIR "/checkpoint/mixed.json";
+
+/// A particle set's centres, sorted: two sets compared as sets.
+inline std::vector<std::tuple<float, float, float>> sorted_points(const motes::ParticleSet& set) {
+  std::vector<std::tuple<float, float, float>> out;
+  for (const auto& p : set.points) out.emplace_back(p.x(), p.y(), p.z());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+inline constexpr double kPi = std::numbers::pi;
+
+/// Largest stable substep of semi-implicit Euler for x'' = -w0^2 x - gamma x' (w0^2 h^2 +
+/// 2 gamma h < 4) with w0^2 = k / m_eff, written out here independently of the loader.
+inline double stable_substep(double k, double gamma, double m_eff) {
+  const double w2 = k / m_eff;
+  return (-gamma + std::sqrt(gamma * gamma + 4 * w2)) / w2;
 }
 
 }  // namespace motes_test

@@ -22,11 +22,9 @@
 namespace motes {
 namespace {
 
-std::string mesh_path(const std::string& name) {
-  return std::string(MOTES_TEST_DATA_DIR) + "/meshes/" + name;
-}
-
-std::string bunny_path() { return std::string(MOTES_SOURCE_DIR) + "/examples/assets/bunny.obj"; }
+using motes_test::bunny_path;
+using motes_test::mesh_path;
+using motes_test::sorted_points;
 
 bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
@@ -94,13 +92,6 @@ TriangleMesh icosphere(double radius, int levels, const Eigen::Vector3d& centre)
   for (const auto& p : v) mesh.vertices.push_back(centre + radius * p);
   mesh.triangles = f;
   return mesh;
-}
-
-std::vector<std::tuple<float, float, float>> sorted_points(const ParticleSet& set) {
-  std::vector<std::tuple<float, float, float>> out;
-  for (const auto& p : set.points) out.emplace_back(p.x(), p.y(), p.z());
-  std::sort(out.begin(), out.end());
-  return out;
 }
 
 struct LatticeCount {

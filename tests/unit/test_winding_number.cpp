@@ -27,18 +27,9 @@ namespace {
 using winding::InsideTest;
 using Clock = std::chrono::steady_clock;
 
-std::string mesh_path(const std::string& name) {
-  return std::string(MOTES_TEST_DATA_DIR) + "/meshes/" + name;
-}
-
-std::string bunny_path() { return std::string(MOTES_SOURCE_DIR) + "/examples/assets/bunny.obj"; }
-
-std::vector<std::tuple<float, float, float>> sorted_points(const ParticleSet& set) {
-  std::vector<std::tuple<float, float, float>> out;
-  for (const auto& p : set.points) out.emplace_back(p.x(), p.y(), p.z());
-  std::sort(out.begin(), out.end());
-  return out;
-}
+using motes_test::bunny_path;
+using motes_test::mesh_path;
+using motes_test::sorted_points;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
