@@ -164,6 +164,8 @@ class RecordReader {
       bad = true;
       return;
     }
+    // `out` may be an empty vector's data(): a null pointer, which memcpy must not get.
+    if (n == 0) return;
     std::memcpy(out, p_ + at_, n);
     at_ += n;
   }

@@ -30,9 +30,6 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// Chunks of steps (kChunkSeconds, cli_util.h) are timed by the slowest rank; each ends with one
-// small collective.
-
 constexpr const char* kSetPrefix = "checkpoint-";
 constexpr const char* kSetSuffix = ".mckset";
 

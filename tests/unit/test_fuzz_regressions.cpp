@@ -56,7 +56,11 @@ TEST(FuzzRegressions, Scene) { replay(regressions("scene"), motes::fuzz::scene);
 
 TEST(FuzzRegressions, Mesh) { replay(regressions("mesh"), motes::fuzz::mesh); }
 
-TEST(FuzzRegressions, Checkpoint) { replay(regressions("checkpoint"), motes::fuzz::checkpoint); }
+TEST(FuzzRegressions, Checkpoint) {
+  // run_record_empty_extension: a run record whose extension is 0 bytes long; the reader handed
+  // memcpy the null data() of the empty vector (UBSan).
+  EXPECT_GE(replay(regressions("checkpoint"), motes::fuzz::checkpoint), 1u);
+}
 
 TEST(FuzzRegressions, Frames) {
   // vtu_array_name_outside_tag: an uncaught std::out_of_range; vtu_huge_point_count: 1.2 TB
