@@ -85,15 +85,14 @@ Neighbours neighbours_build(const Particles& particles, const Grid& grid, const 
     std::vector<std::pair<std::size_t, uint>> found;  // (place on the walk, slot) of each j
     const vec4 xi = particles.pos[i];
     for (std::size_t j = 0; j < n; ++j) {
-      // Every test must pass; the cheapest (the distance) goes first: at 20,000 particles the
+      // Every test must pass, so the cheapest (the distance) goes first: at 20,000 particles the
       // walk's search and the set lookup for every pair were most of the conformance suite's time.
       // Apart along x by the cutoff or more: neighbour_within says no (dx * dx alone reaches it).
-      const float dx = particles.pos[j].x - xi.x;
-      const float cutoff = (xi.w + particles.pos[j].w) + p.neighbour_skin;
+      const vec4 xj = particles.pos[j];
+      const float dx = xj.x - xi.x;
+      const float cutoff = (xi.w + xj.w) + p.neighbour_skin;
       if (dx >= cutoff || -dx >= cutoff) continue;
-      if (!motes::shared::neighbour_within(particles.pos[i], particles.pos[j], p.neighbour_skin)) {
-        continue;
-      }
+      if (!motes::shared::neighbour_within(xi, xj, p.neighbour_skin)) continue;
       if (motes::shared::contact_excluded(particles.body[j], particles.body[i]) ||
           particles.never_touch.count({uint(i), uint(j)}) != 0) {
         continue;  // j == i, or j never touches i
