@@ -12,11 +12,11 @@
 
 namespace motes::cuda {
 
-namespace {
-
 std::string error_text(cudaError_t e) {
   return fmt::format("{} ({})", cudaGetErrorString(e), cudaGetErrorName(e));
 }
+
+namespace {
 
 DeviceInfo describe(int ordinal, const cudaDeviceProp& prop) {
   DeviceInfo d;
@@ -109,6 +109,7 @@ CudaDevice::~CudaDevice() {
   if (stream_ != nullptr) cudaStreamSynchronize(stream_);
   release_graphs();
   release_buffers();
+  release_outboxes();
   for (cudaEvent_t e : events_) cudaEventDestroy(e);
   if (stream_ != nullptr) cudaStreamDestroy(stream_);
   if (body_stream_ != nullptr) cudaStreamDestroy(body_stream_);

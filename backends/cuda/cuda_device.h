@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "body_buffers.h"
@@ -79,6 +80,16 @@ class CudaDevice final : public Device {
   [[nodiscard]] void* allocate_host(std::size_t bytes) override;
   void free_host(void* memory) override;
   Status check_guards() override;
+  /// Device-direct halo between processes of one host through CUDA IPC (halo_outbox.cpp): the
+  /// outbox is its own cudaMalloc, shared by cudaIpcGetMemHandle; a neighbour's is mapped by
+  /// cudaIpcOpenMemHandle (peer access over NVLink enabled as needed) and copied from on stream_.
+  [[nodiscard]] Result<std::vector<unsigned char>> share_halo_outbox(std::size_t bytes) override;
+  Status publish_halo_outbox(std::size_t bytes) override;
+  [[nodiscard]] Result<std::size_t> open_peer_outbox(
+      const std::vector<unsigned char>& handle) override;
+  Status fetch_peer_outbox(std::size_t peer, std::size_t from, std::size_t to,
+                           std::size_t bytes) override;
+  void close_peer_outboxes() override;
   void set_timing(bool on) override { timing_ = on; }
   [[nodiscard]] KernelTimes kernel_times() const override { return times_; }
   void reset_kernel_times() override { times_ = {}; }
@@ -167,6 +178,16 @@ class CudaDevice final : public Device {
   bool bodies_fusable_ = false;
   void update_fusable();
 
+  /// This device's halo outbox and the opened outboxes of other processes (halo_outbox.cpp).
+  struct PeerOutbox {
+    void* memory = nullptr;
+    std::size_t bytes = 0;
+  };
+  void* outbox_ = nullptr;
+  std::size_t outbox_bytes_ = 0;
+  std::vector<PeerOutbox> peers_;
+  void release_outboxes();
+
   std::vector<KernelCall> pending_;
   std::vector<Graph> graphs_;
   bool host_rebuild_ = false;  ///< MOTES_CUDA_HOST_REBUILD=1: calls launched one by one
@@ -175,6 +196,9 @@ class CudaDevice final : public Device {
   bool timing_ = false;
   KernelTimes times_;
 };
+
+/// A CUDA error as text: its description and its name.
+std::string error_text(cudaError_t e);
 
 /// Blocks for n threads of CudaDevice::kBlock.
 inline unsigned blocks_for(std::uint64_t n) {

@@ -1,9 +1,10 @@
 // W1 over MPI ranks (docs/scale-out.md, docs/benchmarks.md "Scale-out"): the falling phase of
 // settle_workload at a docs/benchmarks.md size, stepped over every rank of mpirun; rank 0 prints
 // one JSON line: ms per step and the slowest rank's seconds per part (its own steps, halo copies,
-// MPI, partitions), halo copies at the end, and the setup's seconds (scene and first partition).
+// MPI, partitions), halo copies at the end, how they travelled (device to device, or through host
+// memory) and the setup's seconds (scene and first partition).
 // Usage: mpirun -np N motes_mpi_bench [--backend B] [--size N] [--steps S] [--warmup W]
-//                                     [--margin M]
+//                                     [--margin M] [--halo auto|host]
 #include <fmt/format.h>
 #include <mpi.h>
 
@@ -40,6 +41,13 @@ int main(int argc, char** argv) {
       warmup = std::stoull(value);
     } else if (key == "--margin") {
       options.margin = std::stod(value);
+    } else if (key == "--halo" && (value == "auto" || value == "host")) {
+      options.halo = value == "host" ? motes::DistributedOptions::Halo::Host
+                                     : motes::DistributedOptions::Halo::Auto;
+    } else {
+      if (rank == 0) fmt::print(stderr, "mpi_bench: unknown option {} {}\n", key, value);
+      MPI_Finalize();
+      return 2;
     }
   }
   int nx = 0, ny = 0, nz = 0;
@@ -96,10 +104,15 @@ int main(int argc, char** argv) {
         "{{\"ranks\": {}, \"backend\": \"{}\", \"device\": \"{}\", \"particles\": {}, "
         "\"bricks\": \"{}\", \"steps\": {}, \"ms_per_step\": {:.4f}, \"own_step_ms\": {:.4f}, "
         "\"halo_copy_ms\": {:.4f}, \"mpi_ms\": {:.4f}, \"partition_ms\": {:.4f}, "
-        "\"partitions\": {}, \"halo_particles\": {}, \"setup_s\": {:.1f}}}\n",
+        "\"partitions\": {}, \"halo_particles\": {}, \"halo\": \"{}\", \"setup_s\": {:.1f}}}\n",
         ranks, backend, sim.value()->device_info().name, sim.value()->particle_count(),
         sim.value()->decomposition().describe(), steps, seconds * per, most[0] * per, most[1] * per,
-        most[2] * per, most[3] * per, after.partitions - before.partitions, halo_total, setup);
+        most[2] * per, most[3] * per, after.partitions - before.partitions, halo_total,
+        after.halo_direct ? "device" : "host", setup);
+    if (!after.halo_direct && !after.halo_host_reason.empty()) {
+      fmt::print(stderr, "mpi_bench: the halo goes through host memory: {}\n",
+                 after.halo_host_reason);
+    }
   }
   sim.value().reset();
   MPI_Finalize();

@@ -301,6 +301,25 @@ void Device::free_host(void* memory) {
   ::operator delete (memory, std::align_val_t{kAlign});
 }
 
+Result<std::vector<unsigned char>> Device::share_halo_outbox(std::size_t /*bytes*/) {
+  return std::vector<unsigned char>{};
+}
+
+Status Device::publish_halo_outbox(std::size_t /*bytes*/) {
+  return Status::error(
+      fmt::format("{}: no device-direct halo (publish_halo_outbox)", info().backend));
+}
+
+Result<std::size_t> Device::open_peer_outbox(const std::vector<unsigned char>& /*handle*/) {
+  return Status::error(fmt::format("{}: no device-direct halo (open_peer_outbox)", info().backend));
+}
+
+Status Device::fetch_peer_outbox(std::size_t /*peer*/, std::size_t /*from*/, std::size_t /*to*/,
+                                 std::size_t /*bytes*/) {
+  return Status::error(
+      fmt::format("{}: no device-direct halo (fetch_peer_outbox)", info().backend));
+}
+
 BufferSize Device::largest_buffer(const Sizes& sizes) const {
   BufferSize largest;
   for (std::size_t i = 0; i < kBufferCount; ++i) {

@@ -1015,6 +1015,46 @@ Status Simulation::halo_unpack() {
   return Status::ok();
 }
 
+Result<std::vector<unsigned char>> Simulation::share_halo() {
+  return device_->share_halo_outbox(std::max<std::size_t>(halo_out_count_, 1) * sizeof(vec4));
+}
+
+Status Simulation::halo_pack_direct() {
+  if (halo_out_count_ == 0) return device_->synchronize();
+  shared::StepParams p = params_;
+  p.halo_particles = halo_entries_[0];
+  p.halo_bodies = halo_entries_[1];
+  p.halo_first = 0;
+  device_->halo_pack(p);
+  if (Status s = device_->publish_halo_outbox(halo_out_count_ * sizeof(vec4)); !s) return s;
+  return device_->synchronize();
+}
+
+Result<std::size_t> Simulation::open_peer_halo(const std::vector<unsigned char>& handle) {
+  return device_->open_peer_outbox(handle);
+}
+
+Status Simulation::halo_unpack_direct(std::span<const HaloFetch> fetches) {
+  if (halo_in_count_ == 0) return Status::ok();
+  for (const HaloFetch& f : fetches) {
+    if (f.to + f.count > halo_in_count_) {
+      return Status::error(fmt::format("halo_unpack_direct: vec4s [{}, {}) of a halo of {}", f.to,
+                                       f.to + f.count, halo_in_count_));
+    }
+    if (Status s = device_->fetch_peer_outbox(f.peer, f.from * sizeof(vec4), f.to * sizeof(vec4),
+                                              f.count * sizeof(vec4));
+        !s) {
+      return s;
+    }
+  }
+  shared::StepParams p = params_;
+  p.halo_particles = halo_entries_[2];
+  p.halo_bodies = halo_entries_[3];
+  p.halo_first = halo_entries_[0] + halo_entries_[1];
+  device_->halo_unpack(p);
+  return Status::ok();
+}
+
 Status Simulation::request_rebuild() {
   const std::uint32_t rebuild = 1;  // the first word, MOTES_NEIGHBOUR_REBUILD
   static_assert(MOTES_NEIGHBOUR_REBUILD == 0u);

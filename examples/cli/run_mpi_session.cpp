@@ -309,9 +309,10 @@ class DistributedSession {
     fmt::print("  {:<16}the slowest rank's own steps {}\n", "ranks' steps",
                format_seconds(most[3]));
     fmt::print(
-        "  {:<16}{}B sent; a rank's most: {} copying state, {} in MPI (transfer and waiting "
+        "  {:<16}{}B sent {}; a rank's most: {} copying state, {} in MPI (transfer and waiting "
         "for the slowest rank), {} partitioning\n",
-        "halos", format_si(static_cast<double>(sums[2])), format_seconds(most[0]),
+        "halos", format_si(static_cast<double>(sums[2])),
+        st.halo_direct ? "device to device" : "through host memory", format_seconds(most[0]),
         format_seconds(most[1]), format_seconds(most[2]));
     fmt::print("  {:<16}{} ({})\n", "setup", format_seconds(p_.setup_seconds),
                p_.resumed ? "scene, devices and the set's state"

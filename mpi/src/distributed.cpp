@@ -275,6 +275,13 @@ Result<std::unique_ptr<DistributedSimulation>> DistributedSimulation::create(
   // Every rank's lists have the skin of one process's (Simulation: the scene's largest diameter).
   d->skin_ = Simulation::neighbour_skin(scene.settings, diameter);
   d->margin_ = options.margin >= 0.0 ? options.margin : 0.5 * diameter;
+  d->halo_mode_ = options.halo;
+  MPI_Comm host = MPI_COMM_NULL;
+  MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &host);
+  int on_host = 0;
+  MPI_Comm_size(host, &on_host);
+  MPI_Comm_free(&host);
+  d->one_host_ = on_host == d->size_;
   d->halo_width_ = 2.0 * d->margin_;
 
   if (Status s = d->first_partition(centres); !s) return s;
@@ -634,6 +641,89 @@ Status DistributedSimulation::build_local(
   MPI_Allreduce(&bodies_here, &bodies_anywhere, 1, MPI_INT, MPI_LOR, comm_);
   halo_bodies_ = bodies_anywhere != 0;
   ++stats_.partitions;
+  return connect_halos();
+}
+
+Status DistributedSimulation::connect_halos() {
+  direct_ = false;
+  fetches_.clear();
+  stats_.halo_direct = false;
+  stats_.halo_host_reason.clear();
+  Device* device = local_ ? &local_->device() : spare_.get();
+  if (device != nullptr) device->close_peer_outboxes();
+  if (size_ == 1 || halo_mode_ == DistributedOptions::Halo::Host) return Status::ok();
+  if (!one_host_) {
+    stats_.halo_host_reason = "the ranks run on more than one host";
+    return Status::ok();
+  }
+  // Every rank has closed the outboxes it had opened: each may now grow its own.
+  MPI_Barrier(comm_);
+  constexpr std::size_t kBlock = 128;  // a handle's room: its length, then its bytes
+  std::array<unsigned char, kBlock> mine{};
+  Status able = Status::ok();
+  if (local_) {
+    Result<std::vector<unsigned char>> handle = local_->share_halo();
+    if (!handle) {
+      able = handle.status();
+    } else if (handle->empty() || handle->size() > kBlock - 1) {
+      able = Status::error(
+          fmt::format("{} cannot share device memory between processes", device_info_.backend));
+    } else {
+      mine[0] = static_cast<unsigned char>(handle->size());
+      std::copy(handle->begin(), handle->end(), mine.begin() + 1);
+    }
+  }
+  if (Status s = agree(comm_, able); !s) {
+    stats_.halo_host_reason = s.message();
+    return Status::ok();
+  }
+  const auto ranks = static_cast<std::size_t>(size_);
+  std::vector<unsigned char> handles(kBlock * ranks);
+  MPI_Allgather(mine.data(), static_cast<int>(kBlock), MPI_BYTE, handles.data(),
+                static_cast<int>(kBlock), MPI_BYTE, comm_);
+  // Where each part for each rank starts in this rank's outbox (the packed layout of the host
+  // path: every rank's particles, then every rank's bodies), and so where a neighbour's part for
+  // this rank starts in its outbox.
+  std::vector<std::int64_t> sent_at(2 * ranks), from(2 * ranks), received_at(2 * ranks);
+  std::int64_t out = 0;
+  std::int64_t in = 0;
+  for (std::size_t part = 0; part < 2; ++part) {
+    for (std::size_t r = 0; r < ranks; ++r) {
+      sent_at[2 * r + part] = out;
+      out += send_counts_[part][r];
+      received_at[2 * r + part] = in;
+      in += receive_counts_[part][r];
+    }
+  }
+  MPI_Alltoall(sent_at.data(), 2, MPI_INT64_T, from.data(), 2, MPI_INT64_T, comm_);
+  Status opened = Status::ok();
+  for (std::size_t r = 0; r < ranks && local_ && opened; ++r) {
+    const std::size_t parts = halo_bodies_ ? 2 : 1;
+    std::int64_t count = 0;
+    for (std::size_t part = 0; part < parts; ++part) count += receive_counts_[part][r];
+    if (count == 0) continue;
+    const unsigned char* block = handles.data() + kBlock * r;
+    Result<std::size_t> peer =
+        local_->open_peer_halo(std::vector<unsigned char>(block + 1, block + 1 + block[0]));
+    if (!peer) {
+      opened = peer.status();
+      break;
+    }
+    for (std::size_t part = 0; part < parts; ++part) {
+      if (receive_counts_[part][r] == 0) continue;
+      fetches_.push_back({peer.value(), static_cast<std::size_t>(from[2 * r + part]),
+                          static_cast<std::size_t>(received_at[2 * r + part]),
+                          static_cast<std::size_t>(receive_counts_[part][r])});
+    }
+  }
+  if (Status s = agree(comm_, opened); !s) {
+    if (local_) local_->device().close_peer_outboxes();
+    fetches_.clear();
+    stats_.halo_host_reason = s.message();
+    return Status::ok();
+  }
+  direct_ = true;
+  stats_.halo_direct = true;
   return Status::ok();
 }
 
@@ -672,36 +762,13 @@ Status DistributedSimulation::write_records(const std::vector<LocalEntry>& entri
   return local_->write_state(state);
 }
 
-Result<double> DistributedSimulation::exchange_halos(Status stepped) {
-  const Clock::time_point start = Clock::now();
-  // Any failure on the way is kept, and this rank still takes part in every collective with
-  // buffers of the agreed sizes; the last collective (agree) tells every rank.
-  Status status = std::move(stepped);
-  const auto total = [](const std::vector<int>& counts) {
-    std::size_t sum = 0;
-    for (const int c : counts) sum += static_cast<std::size_t>(c);
-    return sum;
-  };
-  const std::size_t out_particles = total(send_counts_[0]);
-  const std::size_t in_particles = total(receive_counts_[0]);
+double DistributedSimulation::exchange_on_host(std::size_t out_particles,
+                                               std::size_t in_particles) {
   // The packed halo in the local simulation's host memory (page-locked on CUDA), sent and
   // received in place; a rank without bodies has none to send or receive.
-  const vec4* out = nullptr;
-  vec4* in = nullptr;
-  if (local_) {
-    if (status) status = local_->halo_pack();
-    out = local_->halo_sent().data();
-    in = local_->halo_received().data();
-  }
-  stats_.halo_bytes += (out_particles + total(send_counts_[1])) * sizeof(vec4);
-  double mpi = 0.0;  // seconds in MPI calls: the transfer, and waiting for the slowest rank
-  const auto agreed = [&](double* value) {
-    const Clock::time_point t = Clock::now();
-    Status s = agree(comm_, status, value);
-    mpi += seconds_since(t);
-    return s;
-  };
-  const Clock::time_point mpi_start = Clock::now();
+  const vec4* out = local_ ? local_->halo_sent().data() : nullptr;
+  vec4* in = local_ ? local_->halo_received().data() : nullptr;
+  const Clock::time_point start = Clock::now();
   for (std::size_t part = 0; part < (halo_bodies_ ? 2u : 1u); ++part) {
     // Particles' part from the start of each buffer, the bodies' part after it.
     const std::vector<int>& sent = send_counts_[part];
@@ -718,8 +785,43 @@ Result<double> DistributedSimulation::exchange_halos(Status stepped) {
     MPI_Alltoallv(out, sent.data(), sent_at.data(), vec4_type(), in, received.data(),
                   received_at.data(), vec4_type(), comm_);
   }
-  mpi += seconds_since(mpi_start);
-  if (local_ && status) status = local_->halo_unpack();
+  return seconds_since(start);
+}
+
+Result<double> DistributedSimulation::exchange_halos(Status stepped) {
+  const Clock::time_point start = Clock::now();
+  // Any failure on the way is kept, and this rank still takes part in every collective with
+  // buffers of the agreed sizes; the last collective (agree) tells every rank.
+  Status status = std::move(stepped);
+  const auto total = [](const std::vector<int>& counts) {
+    std::size_t sum = 0;
+    for (const int c : counts) sum += static_cast<std::size_t>(c);
+    return sum;
+  };
+  const std::size_t out_particles = total(send_counts_[0]);
+  const std::size_t in_particles = total(receive_counts_[0]);
+  stats_.halo_bytes += (out_particles + total(send_counts_[1])) * sizeof(vec4);
+  double mpi = 0.0;  // seconds in MPI calls: the transfer, and waiting for the slowest rank
+  const auto agreed = [&](double* value) {
+    const Clock::time_point t = Clock::now();
+    Status s = agree(comm_, status, value);
+    mpi += seconds_since(t);
+    return s;
+  };
+  if (direct_) {
+    // Device to device: each rank publishes its packed halo in its outbox; once every rank has
+    // (the barrier), each copies its parts from its neighbours' outboxes. A rank publishes again
+    // only after the next agreement below, which every rank enters after its copies are done.
+    if (local_ && status) status = local_->halo_pack_direct();
+    const Clock::time_point t = Clock::now();
+    MPI_Barrier(comm_);
+    mpi += seconds_since(t);
+    if (local_ && status) status = local_->halo_unpack_direct(fetches_);
+  } else {
+    if (local_ && status) status = local_->halo_pack();
+    mpi += exchange_on_host(out_particles, in_particles);
+    if (local_ && status) status = local_->halo_unpack();
+  }
   // The lists are rebuilt on every rank at the steps one process would rebuild them: when any
   // particle anywhere has moved 0.45 skin since the last build (each rank tests its own
   // particles and the copies it received). Only then can the ranks partition again: how far any

@@ -689,7 +689,7 @@ Status DistributedSimulation::load_checkpoint(const std::string& set,
   stats_.owned_particles = listed.owned_particles;
   stats_.halo_particles = listed.halo_particles;
   stats_.halo_bytes = listed.halo_bytes;
-  return Status::ok();
+  return connect_halos();
 }
 
 }  // namespace motes

@@ -9,11 +9,13 @@
 # Usage: scripts/gpu/run-suite.sh [conformance|unit|sanitize|bench|mpi|scaling|all]...
 #   (default all but scaling, which needs several GPUs)
 #   unit: the unit tests' CUDA cases (checkpoint resume on CUDA, the CLI on CUDA), into unit.txt
-#   mpi: the MPI tests on CUDA and Vulkan at 1, 2 and 4 ranks (sharing the machine's GPUs), and
-#     W1 over 1, 2, 4 ranks (motes_mpi_bench, MOTES_MPI_SIZES), into mpi.txt
+#   mpi: the MPI tests on CUDA and Vulkan (MOTES_MPI_BACKENDS) at 1, 2 and 4 ranks (sharing the
+#     machine's GPUs), and W1 over 1, 2, 4 ranks (motes_mpi_bench, MOTES_MPI_SIZES; empty: none),
+#     into mpi.txt
 #   scaling: W1 over 1 and N GPUs, a rank each (motes_mpi_bench), into scaling.txt:
-#     MOTES_SCALING_RUNS="BACKEND:SIZE:RANKS ..." (default CUDA at 67 M on 1 and 2 GPUs, 134 M
-#     on 2), MOTES_SCALING_STEPS, LIMIT_SCALING_RUN seconds each
+#     MOTES_SCALING_RUNS="BACKEND:SIZE:RANKS[:HALO] ..." (default CUDA at 67 M on 1 and 2 GPUs,
+#     134 M on 2; HALO auto or host, motes_mpi_bench --halo), MOTES_SCALING_STEPS,
+#     LIMIT_SCALING_RUN seconds each
 #   MOTES_BENCH_RUNS="cuda:falling cuda:dominoes cuda:dense vulkan:falling ..."   what is measured
 #     (also BACKEND:huge: W1 at 67 M and 134 M particles, one short repeat; BACKEND:dominoes-1m:
 #     W2 with 1,000,000 dominoes; BACKEND:cloth: W3 at 256 x 256 and 1024 x 1024;
@@ -67,13 +69,13 @@ if want mpi; then
   # The machine's own OpenMPI runs the ranks (run as root: its two allow variables).
   export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
   export OMPI_MCA_btl_vader_single_copy_mechanism=none
-  for backend in cuda vulkan; do
+  for backend in ${MOTES_MPI_BACKENDS:-cuda vulkan}; do
     for n in 1 2 4; do
       MOTES_MPI_BACKEND=$backend MOTES_VULKAN_VALIDATION=1 part "${LIMIT_MPI:-120}" mpi \
         mpirun --oversubscribe --bind-to none -np "$n" motes_mpi_tests || status=1
     done
   done
-  for size in ${MOTES_MPI_SIZES:-1048576}; do
+  for size in ${MOTES_MPI_SIZES-1048576}; do
     for backend in cuda vulkan; do
       for n in 1 2 4; do
         part "${LIMIT_MPI:-120}" mpi mpirun --oversubscribe --bind-to none -np "$n" \
@@ -90,9 +92,10 @@ if want scaling; then
   { nvidia-smi topo -m; ompi_info --parsable --all | grep -i 'cuda_support' ; } \
     >>"$out/scaling.txt" 2>&1
   for run in ${MOTES_SCALING_RUNS:-cuda:67108864:1 cuda:67108864:2 cuda:134217728:2}; do
-    IFS=: read -r backend size n <<<"$run"
+    IFS=: read -r backend size n halo <<<"$run"
     part "${LIMIT_SCALING_RUN:-280}" scaling mpirun --bind-to none -np "$n" motes_mpi_bench \
-      --backend "$backend" --size "$size" --steps "${MOTES_SCALING_STEPS:-200}" --warmup 20 ||
+      --backend "$backend" --size "$size" --steps "${MOTES_SCALING_STEPS:-200}" --warmup 20 \
+      --halo "${halo:-auto}" ||
       status=1
   done
 fi

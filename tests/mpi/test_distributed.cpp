@@ -123,6 +123,13 @@ Snapshot expect_rank_independent(const Scene& scene, std::uint64_t steps, Expect
     if (expected.halo) {
       EXPECT_GT(total, 0u);
     }
+    // All ranks run on this host: the halo goes device to device where the backend can share
+    // device memory between processes (CUDA), else through host memory.
+    const bool direct = options.halo == DistributedOptions::Halo::Auto && backend() == "cuda";
+    EXPECT_EQ(stats.halo_direct, direct) << stats.halo_host_reason;
+    if (!direct) {
+      EXPECT_EQ(stats.halo_host_reason.empty(), options.halo == DistributedOptions::Halo::Host);
+    }
   }
   if (world_rank() != 0) return result;
 
@@ -159,6 +166,17 @@ Snapshot expect_rank_independent(const Scene& scene, std::uint64_t steps, Expect
 
 TEST(Distributed, ShakenSettleMatchesOneRank) {
   expect_rank_independent(shaken_settle(), 400, {.migrating = true});
+}
+
+TEST(Distributed, ShakenSettleWithTheHaloThroughHostMemoryMatchesOneRank) {
+  // Where the halo can go device to device (CUDA), the host path is still there: the same bits.
+  if (backend() != "cuda") {
+    GTEST_SKIP() << "the halo of " << backend()
+                 << " always goes through host memory (ShakenSettleMatchesOneRank)";
+  }
+  DistributedOptions host;
+  host.halo = DistributedOptions::Halo::Host;
+  expect_rank_independent(shaken_settle(), 400, {.migrating = true}, host);
 }
 
 TEST(Distributed, DominoChainMatchesOneRank) {

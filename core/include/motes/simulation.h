@@ -202,6 +202,23 @@ class Simulation {
   /// Writes halo_received() to the device and scatters it there (asks for a list rebuild where a
   /// copy moved past the skin).
   Status halo_unpack();
+  /// The same exchange straight between the devices of one host (Device::share_halo_outbox):
+  /// the send list's state packed and published in this device's outbox (waits for it), whose
+  /// handle share_halo() gives (empty: this device cannot); neighbours open it
+  /// (open_peer_halo) and halo_unpack_direct copies each one's part into HaloData and scatters
+  /// it. The same bits as the host path.
+  [[nodiscard]] Result<std::vector<unsigned char>> share_halo();
+  Status halo_pack_direct();
+  [[nodiscard]] Result<std::size_t> open_peer_halo(const std::vector<unsigned char>& handle);
+  /// One part of the received halo: `count` vec4s from opened outbox `peer` at vec4 `from`, into
+  /// the received layout (halo_received()) at vec4 `to`.
+  struct HaloFetch {
+    std::size_t peer = 0;
+    std::size_t from = 0;
+    std::size_t to = 0;
+    std::size_t count = 0;
+  };
+  Status halo_unpack_direct(std::span<const HaloFetch> fetches);
   /// Makes the next step rebuild the neighbour lists (the ranks of a run over MPI ranks rebuild
   /// together, when any of them must).
   Status request_rebuild();

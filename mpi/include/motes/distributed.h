@@ -42,6 +42,12 @@ struct DistributedOptions {
   /// of what a rank owns, so no contact is missed in between. Larger: rarer partitions, a wider
   /// halo.
   double margin = -1.0;
+  /// How the halo copies travel. Auto: straight from device to device (Device::share_halo_outbox:
+  /// CUDA IPC, over NVLink between GPUs) when every rank runs on one host and every rank's device
+  /// can, else through host memory and MPI; Host: always through host memory and MPI. The same
+  /// bits either way.
+  enum class Halo { Auto, Host };
+  Halo halo = Halo::Auto;
 };
 
 /// What the ranks did (the same on every rank after a collective call).
@@ -60,6 +66,10 @@ struct DistributedStats {
   double copy_seconds = 0.0;
   double mpi_seconds = 0.0;
   double partition_seconds = 0.0;
+  /// Whether the halo copies travel device to device (DistributedOptions::halo), and, when they go
+  /// through host memory on one host with Halo::Auto, why (the first rank that could not).
+  bool halo_direct = false;
+  std::string halo_host_reason;
 };
 
 struct CheckpointSetInfo;  // below
@@ -141,6 +151,10 @@ class DistributedSimulation {
   /// same on every rank) on how far a particle can move from the partition before the next
   /// rebuild; or the first error of any rank (`stepped`: this rank's step).
   Result<double> exchange_halos(Status stepped);
+  /// The packed halo through host memory: every rank's MPI_Alltoallv from halo_sent() into
+  /// halo_received(); returns the seconds it took (totals of the send and receive lists'
+  /// particle parts given).
+  double exchange_on_host(std::size_t out_particles, std::size_t in_particles);
   /// This rank's records of its owned bodies, from the local simulation.
   Result<std::vector<Record>> owned_records();
   /// A body of the local simulation: its scene index, its state (nullptr: the scene's start) and
@@ -161,6 +175,10 @@ class DistributedSimulation {
   Status write_records(const std::vector<LocalEntry>& entries);
   /// groups_ and group_of_ from the scene.
   void group_bodies();
+  /// Collective, after every change of the local simulations: the device-direct halo when
+  /// DistributedOptions::halo allows it and every rank can (each opens the outboxes of the ranks
+  /// it receives from), else the halo through host memory.
+  Status connect_halos();
 
   Scene scene_;
   MPI_Comm comm_ = MPI_COMM_NULL;
@@ -198,6 +216,12 @@ class DistributedSimulation {
   bool halo_bodies_ = false;
   /// The neighbour-list skin (the same on every rank: the scene's).
   double skin_ = 0.0;
+  /// Whether every rank runs on this host (MPI_COMM_TYPE_SHARED), what the options allow, and
+  /// with the device-direct halo, the parts this rank copies from its neighbours' outboxes.
+  bool one_host_ = false;
+  DistributedOptions::Halo halo_mode_ = DistributedOptions::Halo::Auto;
+  bool direct_ = false;
+  std::vector<Simulation::HaloFetch> fetches_;
   DistributedStats stats_;
 
   // Checkpoint sets (distributed_checkpoint.cpp).

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "motes/api.h"
 #include "motes/status.h"
@@ -347,6 +348,29 @@ class Device {
   /// free_host(); nullptr when none can be had.
   [[nodiscard]] virtual void* allocate_host(std::size_t bytes);
   virtual void free_host(void* memory);
+
+  /// Device-direct halo exchange between the processes of one host (a run over MPI ranks,
+  /// docs/scale-out.md): each device keeps an *outbox*, device memory other processes' devices
+  /// can read, which publish_halo_outbox fills from HaloData after halo_pack; a neighbour opens
+  /// it by its handle and copies its part straight into its own HaloData before halo_unpack.
+  /// The default (OpenMP, Vulkan): no outbox, and the halo goes through host memory and MPI.
+  ///
+  /// An outbox of at least `bytes` (kept, or grown, for the device's life) and the handle another
+  /// process opens it by; an empty handle when this device cannot share memory that way.
+  [[nodiscard]] virtual Result<std::vector<unsigned char>> share_halo_outbox(std::size_t bytes);
+  /// Queues a copy of HaloData's first `bytes` into the outbox, after the queued kernels.
+  virtual Status publish_halo_outbox(std::size_t bytes);
+  /// Opens another process's outbox by its handle (share_halo_outbox there); its index for
+  /// fetch_peer_outbox. A failure changes nothing else (the caller falls back to host memory).
+  [[nodiscard]] virtual Result<std::size_t> open_peer_outbox(
+      const std::vector<unsigned char>& handle);
+  /// Queues a copy of `bytes` from opened outbox `peer` at byte `from` into HaloData at byte
+  /// `to`, after the queued kernels and before the ones queued next.
+  virtual Status fetch_peer_outbox(std::size_t peer, std::size_t from, std::size_t to,
+                                   std::size_t bytes);
+  /// Closes every opened outbox (waits for the queued copies first). Before an outbox is grown,
+  /// every process that opened it must have closed it (DistributedSimulation agrees on that).
+  virtual void close_peer_outboxes() {}
 
   /// Per-kernel timing (may cost a synchronization per kernel while on).
   virtual void set_timing(bool on) = 0;
