@@ -31,6 +31,7 @@
 #include <sstream>
 #include <vector>
 
+#include "motes/backend/bytes.h"
 #include "motes/simulation.h"
 #include "shared/neighbours.h"
 #include "shared/shape_matching.h"
@@ -117,112 +118,54 @@ struct HeaderV1 {
 };
 static_assert(sizeof(HeaderV1) == kV1HeaderBytes, "checkpoint version 1 header layout");
 
-/// Appends the run record's fields.
-class RecordWriter {
- public:
-  void u64(std::uint64_t v) { raw(&v, sizeof v); }
-  void f64(double v) { raw(&v, sizeof v); }
-  void str(const std::string& s) {
-    const auto n = static_cast<std::uint32_t>(s.size());
-    raw(&n, sizeof n);
-    raw(s.data(), s.size());
-  }
-  void raw(const void* p, std::size_t n) {
-    const auto* c = static_cast<const unsigned char*>(p);
-    bytes.insert(bytes.end(), c, c + n);
-  }
-  std::vector<unsigned char> bytes;
-};
-
-/// Reads the run record's fields; any read past its end sets `bad`.
-class RecordReader {
- public:
-  RecordReader(const unsigned char* p, std::size_t n) : p_(p), n_(n) {}
-  std::uint64_t u64() {
-    std::uint64_t v = 0;
-    raw(&v, sizeof v);
-    return v;
-  }
-  double f64() {
-    double v = 0.0;
-    raw(&v, sizeof v);
-    return v;
-  }
-  std::string str() {
-    std::uint32_t n = 0;
-    raw(&n, sizeof n);
-    if (bad || n > n_ - at_) {
-      bad = true;
-      return {};
-    }
-    std::string s(reinterpret_cast<const char*>(p_ + at_), n);
-    at_ += n;
-    return s;
-  }
-  void raw(void* out, std::size_t n) {
-    if (bad || n > n_ - at_) {
-      bad = true;
-      return;
-    }
-    // `out` may be an empty vector's data(): a null pointer, which memcpy must not get.
-    if (n == 0) return;
-    std::memcpy(out, p_ + at_, n);
-    at_ += n;
-  }
-  [[nodiscard]] std::size_t left() const { return n_ - at_; }
-  bool bad = false;
-
- private:
-  const unsigned char* p_;
-  std::size_t n_;
-  std::size_t at_ = 0;
-};
+using detail::ByteReader;
+using detail::ByteWriter;
 
 std::vector<unsigned char> encode_record(const std::string& backend, const CheckpointRun& run) {
-  RecordWriter w;
+  ByteWriter w;
   w.str(backend);
   w.str(run.scene_path);
   w.str(run.scene_file);
-  w.u64(run.scene_hash);
+  w.put<std::uint64_t>(run.scene_hash);
   w.str(run.output_dir);
   w.str(run.output_format);
-  w.u64(run.every);
-  w.u64(run.total_steps);
-  w.u64(run.checkpoint_every);
+  w.put<std::uint64_t>(run.every);
+  w.put<std::uint64_t>(run.total_steps);
+  w.put<std::uint64_t>(run.checkpoint_every);
   w.str(run.checkpoint_dir);
-  w.u64(run.series.particles_csv_bytes);
-  w.u64(run.series.bodies_csv_bytes);
-  w.u64(run.series.frame_times.size());
-  for (const double t : run.series.frame_times) w.f64(t);
+  w.put<std::uint64_t>(run.series.particles_csv_bytes);
+  w.put<std::uint64_t>(run.series.bodies_csv_bytes);
+  w.put<std::uint64_t>(run.series.frame_times.size());
+  for (const double t : run.series.frame_times) w.put<double>(t);
   // Only when there is one: a single process's record is what it was before extensions.
   if (!run.extension.empty()) {
-    w.u64(run.extension.size());
+    w.put<std::uint64_t>(run.extension.size());
     w.raw(run.extension.data(), run.extension.size());
   }
   return std::move(w.bytes);
 }
 
 bool decode_record(const unsigned char* p, std::size_t n, CheckpointInfo& info) {
-  RecordReader r(p, n);
+  ByteReader r(p, n);
   CheckpointRun& run = info.run;
   info.backend = r.str();
   run.scene_path = r.str();
   run.scene_file = r.str();
-  run.scene_hash = r.u64();
+  run.scene_hash = r.get<std::uint64_t>();
   run.output_dir = r.str();
   run.output_format = r.str();
-  run.every = r.u64();
-  run.total_steps = r.u64();
-  run.checkpoint_every = r.u64();
+  run.every = r.get<std::uint64_t>();
+  run.total_steps = r.get<std::uint64_t>();
+  run.checkpoint_every = r.get<std::uint64_t>();
   run.checkpoint_dir = r.str();
-  run.series.particles_csv_bytes = r.u64();
-  run.series.bodies_csv_bytes = r.u64();
-  const std::uint64_t frames = r.u64();
+  run.series.particles_csv_bytes = r.get<std::uint64_t>();
+  run.series.bodies_csv_bytes = r.get<std::uint64_t>();
+  const std::uint64_t frames = r.get<std::uint64_t>();
   if (r.bad || frames > r.left() / sizeof(double)) return false;
   run.series.frame_times.resize(frames);
-  for (double& t : run.series.frame_times) t = r.f64();
+  for (double& t : run.series.frame_times) t = r.get<double>();
   if (!r.bad && r.left() > 0) {
-    const std::uint64_t extension = r.u64();
+    const std::uint64_t extension = r.get<std::uint64_t>();
     if (r.bad || extension > r.left()) return false;
     run.extension.resize(static_cast<std::size_t>(extension));
     r.raw(run.extension.data(), run.extension.size());

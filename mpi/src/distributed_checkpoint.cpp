@@ -34,9 +34,9 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
-#include <type_traits>
 
 #include "distributed_internal.h"
+#include "motes/backend/bytes.h"
 #include "motes/distributed.h"
 
 namespace motes {
@@ -55,64 +55,8 @@ Status status_of(const Result<T>& r) {
   return r ? Status::ok() : r.status();
 }
 
-/// Fields appended in the machine's byte order.
-class Writer {
- public:
-  template <typename T>
-  void put(const T& v) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    raw(&v, sizeof v);
-  }
-  void raw(const void* p, std::size_t n) {
-    const auto* c = static_cast<const unsigned char*>(p);
-    bytes.insert(bytes.end(), c, c + n);
-  }
-  void list(const std::vector<std::uint32_t>& v) {
-    put(static_cast<std::uint32_t>(v.size()));
-    raw(v.data(), v.size() * sizeof(std::uint32_t));
-  }
-  std::vector<unsigned char> bytes;
-};
-
-/// Fields read back; a read past the end sets `bad` and gives zeros.
-class Reader {
- public:
-  Reader(const unsigned char* p, std::size_t n) : p_(p), n_(n) {}
-  template <typename T>
-  T get() {
-    static_assert(std::is_trivially_copyable_v<T>);
-    T v{};
-    raw(&v, sizeof v);
-    return v;
-  }
-  void raw(void* out, std::size_t n) {
-    if (bad || n > n_ - at_) {
-      bad = true;
-      return;
-    }
-    if (n == 0) return;  // an empty list's data() may be null, which memcpy may not be given
-    std::memcpy(out, p_ + at_, n);
-    at_ += n;
-  }
-  std::vector<std::uint32_t> list() {
-    const auto n = get<std::uint32_t>();
-    if (bad || n > left() / sizeof(std::uint32_t)) {
-      bad = true;
-      return {};
-    }
-    std::vector<std::uint32_t> v(n);
-    raw(v.data(), v.size() * sizeof(std::uint32_t));
-    return v;
-  }
-  [[nodiscard]] std::size_t left() const { return n_ - at_; }
-  [[nodiscard]] std::size_t at() const { return at_; }
-  bool bad = false;
-
- private:
-  const unsigned char* p_;
-  std::size_t n_;
-  std::size_t at_ = 0;
-};
+using detail::ByteReader;
+using detail::ByteWriter;
 
 /// One rank's line of the manifest, as gathered on rank 0.
 struct RankEntry {
@@ -269,7 +213,7 @@ Result<RankState> read_rank_file(const std::string& path, int rank, const Checkp
   const auto corrupt = [&](const std::string& what) {
     return Status::error(fmt::format("{}: corrupt rank record ({})", path, what));
   };
-  Reader r(ext.data(), ext.size());
+  ByteReader r(ext.data(), ext.size());
   std::array<char, 8> magic{};
   r.raw(magic.data(), magic.size());
   if (r.bad || magic != kRankMagic) return corrupt("it does not start with \"MOTESRK1\"");
@@ -290,13 +234,13 @@ Result<RankState> read_rank_file(const std::string& path, int rank, const Checkp
         path, its_rank, its_ranks, its_step, rank, set.ranks, set.step));
   }
   RankState state;
-  state.bodies = r.list();
+  state.bodies = r.list<std::uint32_t>();
   state.owned.resize(state.bodies.size());
   for (char& o : state.owned) o = static_cast<char>(r.get<std::uint8_t>());
   const auto ranks = static_cast<std::size_t>(set.ranks);
   for (auto* lists : {&state.send, &state.receive}) {
     lists->resize(ranks);
-    for (std::vector<std::uint32_t>& l : *lists) l = r.list();
+    for (std::vector<std::uint32_t>& l : *lists) l = r.list<std::uint32_t>();
   }
   for (std::size_t part = 0; part < 2; ++part) {
     for (auto* counts : {&state.send_counts[part], &state.receive_counts[part]}) {
@@ -381,7 +325,7 @@ Result<CheckpointSetInfo> read_checkpoint_set(const std::string& set) {
         fmt::format("{}: truncated manifest ({} bytes, less than its {}-byte header)", path, size,
                     kManifestHeaderBytes + 8));
   }
-  Reader r(bytes.data() + 12, size - 12);
+  ByteReader r(bytes.data() + 12, size - 12);
   const auto ranks = r.get<std::uint32_t>();
   const auto file_bytes = r.get<std::uint64_t>();
   if (file_bytes > size) {
@@ -434,7 +378,7 @@ Result<CheckpointSetInfo> read_checkpoint_set(const std::string& set) {
   if (!decode_checkpoint_run(bytes.data() + kManifestHeaderBytes, record, info.backend, info.run)) {
     return corrupt("run record");
   }
-  Reader table(bytes.data() + kManifestHeaderBytes + record, body - record);
+  ByteReader table(bytes.data() + kManifestHeaderBytes + record, body - record);
   info.rank.resize(ranks);
   for (CheckpointSetInfo::Rank& k : info.rank) {
     const auto has_file = table.get<std::uint32_t>();
@@ -454,7 +398,7 @@ Result<CheckpointSetInfo> read_checkpoint_set(const std::string& set) {
 }
 
 std::vector<unsigned char> DistributedSimulation::rank_record() const {
-  Writer w;
+  ByteWriter w;
   w.raw(kRankMagic.data(), kRankMagic.size());
   w.put(kCheckpointSetVersion);
   w.put(static_cast<std::uint32_t>(rank_));
@@ -519,7 +463,7 @@ Status DistributedSimulation::save_checkpoint(const std::string& set, const Chec
       if (written_on.empty()) written_on = std::string(e.backend);
     }
     const std::vector<unsigned char> record = encode_checkpoint_run(written_on, run);
-    Writer w;
+    ByteWriter w;
     w.raw(kManifestMagic.data(), kManifestMagic.size());
     w.put(kCheckpointSetVersion);
     w.put(static_cast<std::uint32_t>(size_));
