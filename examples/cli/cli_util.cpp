@@ -134,4 +134,13 @@ CLI::Validator whole_number(std::uint64_t least, std::uint64_t most) {
               : fmt::format("INTEGER >= {}", least));
 }
 
+void add_halo_option(CLI::App* command, std::string& halo) {
+  command
+      ->add_option("--halo", halo,
+                   "under mpirun: how halo copies travel: auto (device to device where every rank "
+                   "is on one host and the backend can: CUDA; else through host memory), host "
+                   "(always through host memory and MPI)")
+      ->check(CLI::IsMember({"auto", "host"}));
+}
+
 }  // namespace motes::cli

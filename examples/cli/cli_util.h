@@ -44,6 +44,9 @@ std::string format_seconds(double seconds);
 /// A rate or count with three significant digits and an SI suffix: "1.23e+07" -> "12.3 M".
 std::string format_si(double value);
 
+/// --halo auto|host of `motes run` and `motes resume` under mpirun (docs/scale-out.md).
+void add_halo_option(CLI::App* command, std::string& halo);
+
 /// Validator for a finite number >= 0 (CLI11's own checks let NaN and infinity through).
 CLI::Validator finite_non_negative();
 /// Validator for a finite number > 0.

@@ -33,6 +33,7 @@ struct ResumeArgs {
   std::uint64_t steps = 0;
   double duration = 0.0;
   std::uint64_t checkpoint_every = 0;
+  std::string halo;
   CLI::Option* steps_option = nullptr;
   CLI::Option* duration_option = nullptr;
   CLI::Option* checkpoint_every_option = nullptr;
@@ -46,6 +47,7 @@ void resume(const ResumeArgs& args) {
   if (mpi_ranks() > 1 || std::filesystem::is_directory(path, ec)) {
     // A checkpoint set of a run over MPI ranks (or anything under mpirun -np N): run_mpi.h.
     DistributedResume d;
+    d.halo_host = args.halo == "host";
     d.path = path;
     d.backend = args.backend;
     d.device = args.device;
@@ -56,6 +58,7 @@ void resume(const ResumeArgs& args) {
     resume_distributed(d);
     return;
   }
+  if (!args.halo.empty()) fail("--halo needs several MPI ranks: mpirun -np N motes resume SET");
   Result<CheckpointInfo> read = read_checkpoint_info(path);
   if (!read) fail(read.message());
   const CheckpointInfo& info = read.value();
@@ -188,6 +191,7 @@ void add_resume_command(CLI::App& app) {
       sub->add_option("--checkpoint-every", args->checkpoint_every,
                       "a checkpoint every K steps (default: as the original run)")
           ->check(whole_number(1));
+  add_halo_option(sub, args->halo);
   sub->callback([args] { resume(*args); });
 }
 

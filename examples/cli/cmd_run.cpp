@@ -42,6 +42,7 @@ struct RunArgs {
   std::uint64_t checkpoint_every = 0;
   std::string checkpoint_dir;
   std::string decomposition;
+  std::string halo;
   RenderArgs render;
   CLI::Option* steps_option = nullptr;
   CLI::Option* duration_option = nullptr;
@@ -103,10 +104,14 @@ void run(const RunArgs& args) {
       args.checkpoint_dir.empty() ? (std::filesystem::path(args.out) / "checkpoints").string()
                                   : args.checkpoint_dir);
 
-  if (mpi_ranks() > 1 || !args.decomposition.empty()) {
+  if (mpi_ranks() > 1 || !args.decomposition.empty() || !args.halo.empty()) {
     // Over MPI ranks (docs/scale-out.md).
-    if (mpi_ranks() == 1) fail("--decomposition needs several MPI ranks: mpirun -np N motes run");
+    if (mpi_ranks() == 1) {
+      fail(fmt::format("{} needs several MPI ranks: mpirun -np N motes run",
+                       args.decomposition.empty() ? "--halo" : "--decomposition"));
+    }
     DistributedRun d;
+    d.halo_host = args.halo == "host";
     if (!args.decomposition.empty()) {
       Result<std::array<int, 3>> cells = parse_decomposition(args.decomposition);
       if (!cells) fail(cells.message());
@@ -220,6 +225,7 @@ void add_run_command(CLI::App& app) {
   sub->add_option("--decomposition", args->decomposition,
                   "under mpirun: bricks along x, y, z as X,Y,Z (their product = the rank count; "
                   "default: the least cut area; docs/scale-out.md)");
+  add_halo_option(sub, args->halo);
   sub->add_option("--checkpoint-dir", args->checkpoint_dir,
                   "directory of the checkpoints (default: OUT/checkpoints)");
   sub->callback([args] { run(*args); });

@@ -155,6 +155,7 @@ void run_distributed(DistributedRun run) {
   const int ranks = mpi_ranks();
   DistributedOptions options;
   options.decomposition = run.decomposition;
+  options.halo = run.halo_host ? DistributedOptions::Halo::Host : DistributedOptions::Halo::Auto;
   Result<std::unique_ptr<DistributedSimulation>> created = DistributedSimulation::create(
       run.scene, MPI_COMM_WORLD, device_opener(run.backend, run.device, run.threads), options);
   if (!created) fail(created.message());  // the same message on every rank, printed by rank 0
@@ -258,7 +259,8 @@ void resume_distributed(const DistributedResume& args) {
 
   const std::string backend = args.backend.empty() ? info.backend : args.backend;
   Result<std::unique_ptr<DistributedSimulation>> resumed = DistributedSimulation::resume(
-      scene.value(), MPI_COMM_WORLD, device_opener(backend, args.device, args.threads), path);
+      scene.value(), MPI_COMM_WORLD, device_opener(backend, args.device, args.threads), path,
+      args.halo_host ? DistributedOptions::Halo::Host : DistributedOptions::Halo::Auto);
   if (!resumed) fail(resumed.message());
   DistributedPlan plan;
   plan.sim = std::move(resumed).value();

@@ -45,6 +45,8 @@ struct DistributedRun {
   OutputFormat format = OutputFormat::Vtu;
   std::string out;
   std::optional<std::array<int, 3>> decomposition;
+  /// --halo host: the halo copies through host memory always (DistributedOptions::Halo::Host).
+  bool halo_host = false;
   double setup_seconds = 0.0;
   /// A checkpoint set every K steps and at the end (0: only when a signal stops the run).
   std::uint64_t checkpoint_every = 0;
@@ -68,6 +70,7 @@ struct DistributedResume {
   std::optional<std::uint64_t> steps;
   std::optional<double> duration;
   std::optional<std::uint64_t> checkpoint_every;
+  bool halo_host = false;  ///< --halo host
 };
 
 /// `mpirun -np N motes resume SET`: goes on with the run of a checkpoint set over the rank count

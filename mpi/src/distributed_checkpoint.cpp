@@ -497,7 +497,8 @@ Status DistributedSimulation::save_checkpoint(const std::string& set, const Chec
 }
 
 Result<std::unique_ptr<DistributedSimulation>> DistributedSimulation::resume(
-    Scene scene, MPI_Comm comm, DeviceOpener open_device, const std::string& set) {
+    Scene scene, MPI_Comm comm, DeviceOpener open_device, const std::string& set,
+    DistributedOptions::Halo halo) {
   int size = 1;
   MPI_Comm_size(comm, &size);
   Result<CheckpointSetInfo> info = read_checkpoint_set(set);
@@ -514,6 +515,7 @@ Result<std::unique_ptr<DistributedSimulation>> DistributedSimulation::resume(
   DistributedOptions options;
   options.decomposition = info->decomposition.cells;
   options.margin = info->margin;
+  options.halo = halo;
   Result<std::unique_ptr<DistributedSimulation>> d =
       create(std::move(scene), comm, std::move(open_device), options);
   if (!d) return d.status();

@@ -1,7 +1,8 @@
 #!/bin/sh
 # `mpirun -np 2 motes run` (docs/scale-out.md): the domino chain and every example scene over two
-# ranks write the same frames as one process, bit for bit; a wrong --decomposition is refused
-# once, with exit 2; the motion guard warns over ranks.
+# ranks write the same frames as one process, bit for bit (also with --halo host); a wrong
+# --decomposition is refused once, with exit 2, and --halo in one process or with a wrong value;
+# the motion guard warns over ranks.
 # Usage: cli_test.sh MPIEXEC MOTES SOURCE_DIR WORK_DIR
 set -eu
 mpiexec=$1 motes=$2 src=$3 work=$4
@@ -16,6 +17,23 @@ grep -q "over 2 MPI ranks (bricks 2 x 1 x 1)" "$work/two.log" || { cat "$work/tw
 cmp "$work/one/particles.csv" "$work/two/particles.csv"
 cmp "$work/one/bodies.csv" "$work/two/bodies.csv"
 echo "2 ranks: particles.csv and bodies.csv equal to one process's"
+# The halo through host memory, asked for (on CUDA the default goes device to device): the same
+# frames, and the summary says which way the halo went.
+# shellcheck disable=SC2086
+shift_np 2 $args --halo host --out "$work/host" > "$work/host.log"
+grep -q "halos .* sent through host memory" "$work/host.log" || { cat "$work/host.log"; exit 1; }
+cmp "$work/one/particles.csv" "$work/host/particles.csv"
+echo "2 ranks, --halo host: particles.csv equal to one process's"
+# --halo means nothing in one process, and takes auto or host only.
+for wrong in "--halo host" "--halo sideways"; do
+  status=0
+  # shellcheck disable=SC2086
+  "$motes" run "$src/examples/scenes/dominoes.json" --steps 1 --format none $wrong \
+    > /dev/null 2> "$work/halo.err" || status=$?
+  [ "$status" -ne 0 ] && grep -q "halo" "$work/halo.err" ||
+    { echo "motes run $wrong in one process: exit $status"; cat "$work/halo.err"; exit 1; }
+  echo "motes run $wrong in one process refused: $(head -1 "$work/halo.err")"
+done
 
 # Every example scene over two ranks (soft bodies, cloth and ropes, attachments, impulse
 # contacts, meshes): frames byte-identical to one process's.

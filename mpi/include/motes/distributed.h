@@ -137,9 +137,10 @@ class DistributedSimulation {
   /// The counters of stats() go on from the set's; its seconds count from the resume. (It
   /// creates the run as create() does, over the set's bricks and margin, then replaces each
   /// rank's simulation with the set's: one simulation of the scene's start is built and dropped.)
-  static Result<std::unique_ptr<DistributedSimulation>> resume(Scene scene, MPI_Comm comm,
-                                                               DeviceOpener open_device,
-                                                               const std::string& set);
+  /// `halo`: how the halo copies travel from now on (DistributedOptions::halo; not in the set).
+  static Result<std::unique_ptr<DistributedSimulation>> resume(
+      Scene scene, MPI_Comm comm, DeviceOpener open_device, const std::string& set,
+      DistributedOptions::Halo halo = DistributedOptions::Halo::Auto);
 
  private:
   DistributedSimulation() = default;
