@@ -274,6 +274,18 @@ Result<std::unique_ptr<DistributedSimulation>> DistributedSimulation::create(
   d->scene_diameter_ = diameter;
   // Every rank's lists have the skin of one process's (Simulation: the scene's largest diameter).
   d->skin_ = Simulation::neighbour_skin(scene.settings, diameter);
+  // Between two list builds a particle moves up to 0.45 skin (a rebuild is due then), also right
+  // after a partition: the halo's two margins must hold that much movement of both particles of a
+  // pair, or a rank could miss a contact across its border.
+  if (std::isnan(options.margin) || std::isinf(options.margin) ||
+      (options.margin >= 0.0 && options.margin < 0.5 * d->skin_)) {
+    return Status::error(fmt::format(
+        "{}: a partition margin of {} m: it must be finite and at least half the neighbour skin "
+        "({} m; a particle moves up to 0.45 skin between list builds, and a smaller margin would "
+        "let ranks miss contacts across their borders), or < 0 for half the largest particle "
+        "diameter ({} m)",
+        scene.source, options.margin, 0.5 * d->skin_, 0.5 * diameter));
+  }
   d->margin_ = options.margin >= 0.0 ? options.margin : 0.5 * diameter;
   d->halo_mode_ = options.halo;
   MPI_Comm host = MPI_COMM_NULL;

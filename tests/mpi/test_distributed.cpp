@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <set>
 #include <string>
 #include <utility>
@@ -205,6 +206,23 @@ TEST(Distributed, RefusesAWrongDecomposition) {
       DistributedSimulation::create(shaken_settle(), MPI_COMM_WORLD, opener(), wrong);
   ASSERT_FALSE(d);
   EXPECT_NE(d.message().find("must multiply to the"), std::string::npos) << d.message();
+}
+
+TEST(Distributed, RefusesAMarginBelowHalfTheSkin) {
+  // shaken_settle's spheres are 1 cm: a skin of 1 mm, so a margin of at least 0.5 mm.
+  for (const double margin : {0.0, 0.0004, std::numeric_limits<double>::quiet_NaN(),
+                              std::numeric_limits<double>::infinity()}) {
+    DistributedOptions small;
+    small.margin = margin;
+    Result<std::unique_ptr<DistributedSimulation>> d =
+        DistributedSimulation::create(shaken_settle(), MPI_COMM_WORLD, opener(), small);
+    ASSERT_FALSE(d) << margin;
+    EXPECT_NE(d.message().find("at least half the neighbour skin (0.0005 m"), std::string::npos)
+        << d.message();
+  }
+  DistributedOptions enough;
+  enough.margin = 0.0005;
+  EXPECT_TRUE(DistributedSimulation::create(shaken_settle(), MPI_COMM_WORLD, opener(), enough));
 }
 
 /// The domino row of impulse_dominoes.json sliding along -x at 0.5 m/s (with friction on the

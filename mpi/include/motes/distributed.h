@@ -40,7 +40,8 @@ struct DistributedOptions {
   /// rebuild where the largest displacement since the last partition plus 0.45 skin exceeds it.
   /// The halo holds every body with a particle within 2 margins (particles grown by their radii)
   /// of what a rank owns, so no contact is missed in between. Larger: rarer partitions, a wider
-  /// halo.
+  /// halo. At least half the neighbour skin (a particle moves up to 0.45 skin between list
+  /// builds): a smaller or non-finite margin is refused.
   double margin = -1.0;
   /// How the halo copies travel. Auto: straight from device to device (Device::share_halo_outbox:
   /// CUDA IPC, over NVLink between GPUs) when every rank runs on one host and every rank's device
