@@ -991,13 +991,25 @@ Result<NeighbourStats> Simulation::neighbour_stats() {
   return out;
 }
 
-Status Simulation::halo_pack() {
-  if (halo_out_count_ == 0) return device_->synchronize();
+void Simulation::queue_halo_pack() {
   shared::StepParams p = params_;
   p.halo_particles = halo_entries_[0];
   p.halo_bodies = halo_entries_[1];
   p.halo_first = 0;
   device_->halo_pack(p);
+}
+
+void Simulation::queue_halo_unpack() {
+  shared::StepParams p = params_;
+  p.halo_particles = halo_entries_[2];
+  p.halo_bodies = halo_entries_[3];
+  p.halo_first = halo_entries_[0] + halo_entries_[1];
+  device_->halo_unpack(p);
+}
+
+Status Simulation::halo_pack() {
+  if (halo_out_count_ == 0) return device_->synchronize();
+  queue_halo_pack();
   return device_->read(Buffer::HaloData, halo_out_.get(), halo_out_count_ * sizeof(vec4));
 }
 
@@ -1007,11 +1019,7 @@ Status Simulation::halo_unpack() {
       !s) {
     return s;
   }
-  shared::StepParams p = params_;
-  p.halo_particles = halo_entries_[2];
-  p.halo_bodies = halo_entries_[3];
-  p.halo_first = halo_entries_[0] + halo_entries_[1];
-  device_->halo_unpack(p);
+  queue_halo_unpack();
   return Status::ok();
 }
 
@@ -1021,11 +1029,7 @@ Result<std::vector<unsigned char>> Simulation::share_halo() {
 
 Status Simulation::halo_pack_direct() {
   if (halo_out_count_ == 0) return device_->synchronize();
-  shared::StepParams p = params_;
-  p.halo_particles = halo_entries_[0];
-  p.halo_bodies = halo_entries_[1];
-  p.halo_first = 0;
-  device_->halo_pack(p);
+  queue_halo_pack();
   if (Status s = device_->publish_halo_outbox(halo_out_count_ * sizeof(vec4)); !s) return s;
   return device_->synchronize();
 }
@@ -1047,11 +1051,7 @@ Status Simulation::halo_unpack_direct(std::span<const HaloFetch> fetches) {
       return s;
     }
   }
-  shared::StepParams p = params_;
-  p.halo_particles = halo_entries_[2];
-  p.halo_bodies = halo_entries_[3];
-  p.halo_first = halo_entries_[0] + halo_entries_[1];
-  device_->halo_unpack(p);
+  queue_halo_unpack();
   return Status::ok();
 }
 

@@ -295,6 +295,9 @@ class Simulation {
   std::array<std::uint32_t, 4> halo_entries_{};
   /// Host memory of the packed halo, sent and received (Device::allocate_host), freed through the
   /// device (before take_device hands it on).
+  /// Queue halo_pack of the send list and halo_unpack of the receive list (HaloData from word 0).
+  void queue_halo_pack();
+  void queue_halo_unpack();
   HostMemory<shared::vec4> halo_out_, halo_in_;
   std::size_t halo_out_count_ = 0;
   std::size_t halo_in_count_ = 0;
