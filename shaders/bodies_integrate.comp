@@ -1,5 +1,6 @@
 #version 450
-// bodies_integrate: one semi-implicit Euler step of every body (shared/body_math.h).
+// bodies_integrate: one semi-implicit Euler step of every body (shared/body_math.h); with
+// MOTES_FLAG_IMPULSE_PUSH the pose moves with BodyVelPush and BodyAngMomPush (body_push_pose).
 #extension GL_GOOGLE_include_directive : require
 #include "kernel_common.glsl"
 #include "shared/body_math.h"
@@ -7,6 +8,17 @@
 void main() {
   uint b = thread_index();
   if (b >= p.body_count) return;
+  if ((p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u) {
+    vec4 pos = body_pos[b];
+    vec4 quat = body_quat[b];
+    vec4 angvel;
+    body_push_pose(pos, quat, angvel, body_inv_inertia[b], body_angmom[b], body_vel_push[b],
+                   body_angmom_push[b], p.gravity_dt);
+    body_pos[b] = pos;
+    body_quat[b] = quat;
+    body_angvel[b] = angvel;
+    return;
+  }
   vec4 pos = body_pos[b];
   vec4 quat = body_quat[b];
   vec4 vel = body_vel[b];

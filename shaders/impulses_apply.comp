@@ -2,7 +2,8 @@
 // impulses_apply: each dynamic body (one thread per body) sums its particles' impulses, counts and
 // moments in particle order and applies them (shared/impulse.h: body_apply_impulse); with
 // MOTES_FLAG_IMPULSE_COUNT it first keeps its velocities and contact count as the start of the
-// impulse stage. As backends/openmp/impulses_apply.cpp.
+// impulse stage; with MOTES_FLAG_IMPULSE_PUSH it keeps the velocities it leaves in BodyVelPush and
+// BodyAngMomPush. As backends/openmp/impulses_apply.cpp.
 #extension GL_GOOGLE_include_directive : require
 #include "kernel_common.glsl"
 
@@ -30,4 +31,8 @@ void main() {
   body_vel[b] = vel;
   body_angmom[b] = angmom;
   body_angvel[b] = angvel;
+  if ((p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u) {
+    body_vel_push[b] = vel;
+    body_angmom_push[b] = angmom;
+  }
 }

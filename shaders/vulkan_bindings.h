@@ -46,14 +46,16 @@
 #define B_HALO_DATA 39
 #define B_PARTITION_REF_POS 40
 #define B_PARTITION_CHECK 41
+#define B_BODY_VEL_PUSH 42
+#define B_BODY_ANGMOM_PUSH 43
 // Scratch buffers of the backend (not part of motes::Buffer).
-#define B_GRID_ARRIVAL 42  // uint (N): arrival rank of a particle in its bucket (atomic, any order)
-#define B_GRID_UNSORTED 43  // uint (N): particle ids grouped by bucket, in arrival order
-#define B_SCAN_SCRATCH 44   // uint: block sums of every level of the bucket-count scan
+#define B_GRID_ARRIVAL 44  // uint (N): arrival rank of a particle in its bucket (atomic, any order)
+#define B_GRID_UNSORTED 45  // uint (N): particle ids grouped by bucket, in arrival order
+#define B_SCAN_SCRATCH 46   // uint: block sums of every level of the bucket-count scan
 // uint: VkDispatchIndirectCommand (4 words each) of every pass of a conditional rebuild, then the
 // same for when it runs (written once at allocate); neighbours_decide copies or zeroes the first.
-#define B_INDIRECT_ARGS 45
-#define B_COUNT 46
+#define B_INDIRECT_ARGS 47
+#define B_COUNT 48
 
 // Threads per workgroup of every kernel; the scan handles 4 elements per thread.
 #define WORKGROUP_SIZE 256

@@ -1,7 +1,8 @@
 // impulses_apply: each dynamic body (one thread per body) sums its particles' impulses, counts and
 // moments in particle order and applies them (shared/impulse.h: body_apply_impulse); with
 // MOTES_FLAG_IMPULSE_COUNT it first keeps its velocities and contact count as the start of the
-// impulse stage. As backends/openmp/impulses_apply.cpp.
+// impulse stage; with MOTES_FLAG_IMPULSE_PUSH it keeps the velocities it leaves in BodyVelPush and
+// BodyAngMomPush. As backends/openmp/impulses_apply.cpp.
 #include "cuda_device.h"
 #include "shared/impulse.h"
 
@@ -25,6 +26,8 @@ struct ApplyBuffers {
   vec4* __restrict__ angvel;
   vec4* __restrict__ vel0;
   vec4* __restrict__ angvel0;
+  vec4* __restrict__ vel_push;     // BodyVelPush (written with MOTES_FLAG_IMPULSE_PUSH)
+  vec4* __restrict__ angmom_push;  // BodyAngMomPush
 };
 
 __global__ void impulses_apply_kernel(shared::StepParams p, ApplyBuffers d) {
@@ -53,6 +56,10 @@ __global__ void impulses_apply_kernel(shared::StepParams p, ApplyBuffers d) {
   d.vel[b] = vel;
   d.angmom[b] = angmom;
   d.angvel[b] = angvel;
+  if ((p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u) {
+    d.vel_push[b] = vel;
+    d.angmom_push[b] = angmom;
+  }
 }
 
 }  // namespace
@@ -64,7 +71,8 @@ void CudaDevice::launch_impulses_apply(const shared::StepParams& p) {
                        buf<vec4>(Buffer::ParticleForce),  buf<vec4>(Buffer::ParticleMoment),
                        buf<vec4>(Buffer::BodyVel),        buf<vec4>(Buffer::BodyAngMom),
                        buf<vec4>(Buffer::BodyAngVel),     buf<vec4>(Buffer::BodyVelStart),
-                       buf<vec4>(Buffer::BodyAngVelStart)};
+                       buf<vec4>(Buffer::BodyAngVelStart), buf<vec4>(Buffer::BodyVelPush),
+                       buf<vec4>(Buffer::BodyAngMomPush)};
   impulses_apply_kernel<<<blocks_for(p.body_count), kBlock, 0, stream_>>>(p, d);
 }
 

@@ -1,6 +1,7 @@
 // impulses_apply: each dynamic body sums its particles' impulses, counts and moments in particle
 // order and applies them (shared/impulse.h: body_apply_impulse); with MOTES_FLAG_IMPULSE_COUNT it
-// first keeps its velocities and contact count as the start of the impulse stage.
+// first keeps its velocities and contact count as the start of the impulse stage; with
+// MOTES_FLAG_IMPULSE_PUSH it keeps the velocities it leaves in BodyVelPush and BodyAngMomPush.
 #include <chrono>
 #include <cstdint>
 
@@ -28,6 +29,9 @@ void OpenMPDevice::impulses_apply(const shared::StepParams& p) {
   vec4* angvel = buf<vec4>(Buffer::BodyAngVel);
   vec4* vel0 = buf<vec4>(Buffer::BodyVelStart);
   vec4* angvel0 = buf<vec4>(Buffer::BodyAngVelStart);
+  const bool push = (p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u;
+  vec4* vel_push = push ? buf<vec4>(Buffer::BodyVelPush) : nullptr;
+  vec4* angmom_push = push ? buf<vec4>(Buffer::BodyAngMomPush) : nullptr;
 
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(bodies))
   for (std::int64_t b = 0; b < bodies; ++b) {
@@ -45,6 +49,10 @@ void OpenMPDevice::impulses_apply(const shared::StepParams& p) {
     }
     shared::body_apply_impulse(com[b], quat[b], inv_inertia[b], vel[b], angmom[b], angvel[b],
                                shared::xyz(sum), m);
+    if (push) {
+      vel_push[b] = vel[b];
+      angmom_push[b] = angmom[b];
+    }
   }
   record(Kernel::ImpulsesApply, start);
 }

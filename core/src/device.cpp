@@ -102,6 +102,10 @@ const char* buffer_name(Buffer b) {
       return "PartitionRefPos";
     case Buffer::PartitionCheck:
       return "PartitionCheck";
+    case Buffer::BodyVelPush:
+      return "BodyVelPush";
+    case Buffer::BodyAngMomPush:
+      return "BodyAngMomPush";
     case Buffer::Count:
       break;
   }
@@ -205,6 +209,8 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
       return {kVec4, s.impulse != 0 || s.absorb != 0 ? std::size_t{s.rigid_particles} : 0};
     case Buffer::BodyVelStart:
     case Buffer::BodyAngVelStart:
+    case Buffer::BodyVelPush:
+    case Buffer::BodyAngMomPush:
       return {kVec4, s.impulse != 0 ? std::size_t{s.bodies} : 0};
     case Buffer::ContactImpulse:
       return {kVec4, s.impulse != 0 ? (std::size_t{s.neighbour_capacity} + s.planes) *

@@ -49,7 +49,7 @@ void read_settings(const Node& node, Settings& s, std::int64_t& max_particles) {
   node.expect_object({"dt", "substeps", "gravity", "particle_diameter", "clamp_attraction",
                       "duration", "output_interval", "max_particles", "neighbour_skin",
                       "neighbour_capacity", "constraint_iterations", "link_damping",
-                      "contact_model", "impulse_iterations", "contact"});
+                      "contact_model", "impulse_iterations", "impulse_substeps", "contact"});
   if (auto v = node.find("dt")) s.dt = v->number(Sign::Positive);
   if (auto v = node.find("substeps")) s.substeps = static_cast<int>(v->integer(1, 1'000'000));
   if (auto v = node.find("gravity")) s.gravity = v->vec3();
@@ -77,6 +77,9 @@ void read_settings(const Node& node, Settings& s, std::int64_t& max_particles) {
   }
   if (auto v = node.find("impulse_iterations")) {
     s.impulse_iterations = static_cast<int>(v->integer(1, 1000));
+  }
+  if (auto v = node.find("impulse_substeps")) {
+    s.impulse_substeps = static_cast<int>(v->integer(1, 64));
   }
   if (auto v = node.find("max_particles")) {
     max_particles = v->integer(1, scene_detail::kParticleLimit);

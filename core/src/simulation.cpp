@@ -131,6 +131,10 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
     return Status::error(fmt::format("{}: impulse_iterations must be at least 1 (got {})",
                                      scene.source, settings_.impulse_iterations));
   }
+  if (impulses && (settings_.impulse_substeps < 1 || settings_.impulse_substeps > 64)) {
+    return Status::error(fmt::format("{}: impulse_substeps must be 1 to 64 (got {})",
+                                     scene.source, settings_.impulse_substeps));
+  }
   const auto is_free_sphere = [impulses](const BodySpec& b) {
     return !impulses && b.kind == BodyKind::Dynamic && !b.soft && b.shape->points.size() == 1 &&
            b.angular_velocity.isZero(0.0);
@@ -580,6 +584,10 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
   const std::int64_t counts[2] = {settings_.substeps, settings_.constraint_iterations};
   h = fnv1a64(counts, sizeof counts, h);
   h = fnv1a64(&settings_.dt, sizeof settings_.dt, h);
+  if (impulses) {  // the impulse stage's sweeps and substeps (not hashed before they existed)
+    const std::int64_t stage[2] = {settings_.impulse_iterations, settings_.impulse_substeps};
+    h = fnv1a64(stage, sizeof stage, h);
+  }
   const auto add = [&h](const auto& v) { h = fnv1a64(v.data(), v.size() * sizeof(v[0]), h); };
   add(plocal);
   add(pbody);
@@ -693,26 +701,45 @@ void Simulation::absorb_attachments() {
 }
 
 void Simulation::step_impulses() {
-  // Forces (soft bodies, cloth, ropes, gravity) move the velocities; then the impulse stage:
-  // count each body's contacts and keep the start velocities, sweep every contact
-  // impulse_iterations times (shared/impulse.h); then the poses from the final velocities.
+  // Forces (soft bodies, cloth, ropes) are summed once; then the impulse stage runs its own
+  // substeps on the contacts the lists hold (docs/architecture.md, "Impulse contacts"). Each:
+  // gravity and forces into the velocities; the counting pass (every contact in reach counted,
+  // the start velocities kept, the warm start applied); sweeps with position correction, the
+  // velocities they leave kept for the pose; relaxing sweeps without it, whose velocities the
+  // bodies keep; the pose; the particles follow.
   Device& d = *device_;
-  shared::StepParams velocity = params_;
+  const int substeps = settings_.impulse_substeps;
+  const int sweeps = (settings_.impulse_iterations + substeps - 1) / substeps;
+  const int correcting = (sweeps + 1) / 2;
+  const int relaxing = sweeps - correcting;
+  shared::StepParams sub = params_;
+  sub.gravity_dt.w = params_.gravity_dt.w / static_cast<float>(substeps);
+  shared::StepParams velocity = sub;
   velocity.flags |= MOTES_FLAG_BODY_VELOCITY;
-  shared::StepParams count = params_;
+  shared::StepParams count = sub;
   count.flags |= MOTES_FLAG_IMPULSE_COUNT;
-  shared::StepParams pose = params_;
+  shared::StepParams last = sub;  // the last correcting sweep keeps its velocities for the pose
+  if (relaxing > 0) last.flags |= MOTES_FLAG_IMPULSE_PUSH;
+  shared::StepParams relax = sub;
+  relax.flags |= MOTES_FLAG_IMPULSE_RELAX;
+  shared::StepParams pose = last;
   pose.flags |= MOTES_FLAG_BODY_POSE;
   d.bodies_reduce(params_);
-  d.bodies_integrate(velocity);
-  d.impulses_compute(count);
-  d.impulses_apply(count);
-  for (int it = 0; it < settings_.impulse_iterations; ++it) {
-    d.impulses_compute(params_);
-    d.impulses_apply(params_);
+  for (int s = 0; s < substeps; ++s) {
+    d.bodies_integrate(velocity);
+    d.impulses_compute(count);
+    d.impulses_apply(count);
+    for (int it = 0; it < correcting; ++it) {
+      d.impulses_compute(sub);
+      d.impulses_apply(it + 1 == correcting ? last : sub);
+    }
+    for (int it = 0; it < relaxing; ++it) {
+      d.impulses_compute(relax);
+      d.impulses_apply(relax);
+    }
+    d.bodies_integrate(pose);
+    d.particles_update(sub);
   }
-  d.bodies_integrate(pose);
-  d.particles_update(params_);
 }
 
 Status Simulation::clear_contact_history() {

@@ -60,6 +60,23 @@ MOTES_FN void body_integrate(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
   angvel = vec4(w, 0.0f);
 }
 
+/// The pose half of body_integrate (MOTES_FLAG_BODY_POSE) moved with other velocities than the
+/// body's own: with MOTES_FLAG_IMPULSE_PUSH the impulse stage moves a body with the velocities its
+/// sweeps with position correction left (vel_push, angmom_push) and keeps the relaxed ones
+/// (shared/impulse.h); w then comes from the body's own angular momentum at the new orientation.
+MOTES_FN void body_push_pose(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
+                             MOTES_OUT(vec4) angvel, vec4 inv_inertia, vec4 angmom, vec4 vel_push,
+                             vec4 angmom_push, vec4 gravity_dt) {
+  vec4 v = vel_push;
+  vec4 l = angmom_push;
+  vec4 w = vec4(0.0f);
+  body_integrate(pos_invm, quat, v, l, w, inv_inertia, vec4(0.0f), vec4(0.0f), gravity_dt,
+                 MOTES_FLAG_BODY_POSE);
+  angvel = pos_invm.w == 0.0f
+               ? vec4(0.0f)
+               : vec4(body_angular_velocity(quat, inv_inertia, xyz(angmom)), 0.0f);
+}
+
 /// One semi-implicit Euler step of a free particle (a one-particle body that does not spin), the
 /// linear half of body_integrate with the same arithmetic: v += dt (F/m + g); x += dt v.
 /// Static particles (vel.w, the inverse mass, == 0) are left untouched.

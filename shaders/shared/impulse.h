@@ -21,8 +21,19 @@
 
 MOTES_SHARED_BEGIN
 
-/// Fraction of an overlap (beyond the slop) removed per substep by a separating velocity.
-#define MOTES_IMPULSE_BIAS 0.2f
+/// Position correction of an overlapping contact (beyond the slop) as a soft constraint (Catto's
+/// "soft step", Box2D v3): a spring-damper at a quarter of the substep rate (omega h = pi / 2),
+/// damping ratio zeta = 10, solved implicitly. With a1 = 2 zeta + omega h, a2 = omega h a1,
+/// a3 = 1 / (1 + a2): the contact asks for a separating speed of MOTES_IMPULSE_BIAS of the overlap
+/// per substep (omega h / a1), weighs its velocity error by MOTES_IMPULSE_MASS_SCALE (a2 a3) and
+/// gives back MOTES_IMPULSE_LEAK (a3) of its accumulated normal impulse per sweep. The leak keeps
+/// the impulse of a body wedged between two others bounded (rigid targets that cannot all be met
+/// would make it grow without end, sweep after sweep, substep after substep).
+#define MOTES_IMPULSE_BIAS 0.0728205f
+#define MOTES_IMPULSE_MASS_SCALE 0.9713330f
+#define MOTES_IMPULSE_LEAK 0.0286670f
+/// The most an overlap is corrected per substep, as a fraction of r_a + r_b.
+#define MOTES_IMPULSE_PUSH_MAX 0.005f
 /// Overlap left alone, as a fraction of r_a + r_b: resting contacts keep it without jitter.
 #define MOTES_IMPULSE_SLOP 0.002f
 /// A contact closing faster than this many substeps' worth of gravity bounces (restitution);
@@ -77,24 +88,48 @@ MOTES_FN float impulse_inverse_mass(ImpulseBody b, vec3 r, vec3 d) {
   return max(b.vel0.w, 1.0f) * k;
 }
 
+/// The change of the velocity of a body's material point at arm r that a unit impulse along d
+/// makes, as a contact sees it (times the body's contact count: mass splitting):
+/// n (d / m + (I^-1 (r x d)) x r). Its dot product with d is impulse_inverse_mass. 0 for a wall.
+MOTES_FN vec3 impulse_response(ImpulseBody b, vec3 r, vec3 d) {
+  vec3 w = body_angular_velocity(b.quat, b.inv_inertia, cross(r, d));
+  return (d * b.com.w + cross(w, r)) * max(b.vel0.w, 1.0f);
+}
+
 /// Velocity of a body's material point at arm r: v + w x r.
 MOTES_FN vec3 impulse_point_velocity(vec4 vel, vec4 angvel, vec3 r) {
   return xyz(vel) + cross(xyz(angvel), r);
 }
 
 /// The normal velocity (separating > 0) a contact must reach in this substep, from its
-/// separation sep (< 0: overlap) and its normal velocity vn0 at the start of the stage:
+/// separation sep (< 0: overlap) and its normal velocity vn0 at the start of the substep:
 /// - apart (sep > 0): approach by at most the gap (speculative contact: touch, don't pass);
-/// - overlapping: separate at MOTES_IMPULSE_BIAS of the overlap beyond the slop per substep;
+/// - overlapping, in the sweeps with position correction: separate at MOTES_IMPULSE_BIAS of the
+///   overlap beyond the slop per substep (at most MOTES_IMPULSE_PUSH_MAX of r_a + r_b); in the
+///   relaxing sweeps (MOTES_FLAG_IMPULSE_RELAX): 0, so the speed of that correction moves the
+///   pose but is not kept;
 /// - closing faster than resting contacts do, with e > 0: bounce at -e vn0 (Newton's law).
+/// soft: 1 where the correction is soft (an overlap, no bounce, not relaxing), else 0.
 MOTES_FN float impulse_target(float sep, float rsum, float vn0, float restitution,
-                              vec4 gravity_dt) {
+                              vec4 gravity_dt, uint flags, MOTES_OUT(float) soft) {
   float dt = gravity_dt.w;
-  float target = sep > 0.0f ? -sep / dt
-                            : MOTES_IMPULSE_BIAS * max(-sep - MOTES_IMPULSE_SLOP * rsum, 0.0f) / dt;
+  soft = 0.0f;
+  float target = -sep / dt;
+  if (sep <= 0.0f) {
+    target = 0.0f;
+    if ((flags & MOTES_FLAG_IMPULSE_RELAX) == 0u) {
+      float overlap = max(-sep - MOTES_IMPULSE_SLOP * rsum, 0.0f);
+      target = min(MOTES_IMPULSE_BIAS * overlap, MOTES_IMPULSE_PUSH_MAX * rsum) / dt;
+      soft = 1.0f;
+    }
+  }
   float bounce_speed = MOTES_IMPULSE_BOUNCE_SUBSTEPS * length(xyz(gravity_dt)) * dt;
   if (restitution > 0.0f && vn0 < -bounce_speed && vn0 * dt < -sep) {
-    target = max(target, -restitution * vn0);
+    float bounce = -restitution * vn0;
+    if (bounce > target) {
+      target = bounce;
+      soft = 0.0f;
+    }
   }
   return target;
 }
@@ -110,16 +145,18 @@ MOTES_FN vec3 plane_contact_point(vec4 xa, vec4 normal_offset) {
 /// The impulse on body a of a contact between bodies a and b at point c, normal n (unit, from b
 /// towards a), separation sep, r_a + r_b = rsum (on b: its negation), as a change of the contact's
 /// accumulated impulse acc (xyz: the total impulse on a in this substep; w: its normal part, >= 0).
-/// Returns (the change, counted): counted is 1 when the contact counts for mass splitting (it
-/// touches, or needs an impulse at the start of the stage), else 0.
-/// - Counting pass (MOTES_FLAG_IMPULSE_COUNT): warm start. A counted contact starts from the
-///   total of the last substep (acc), its tangential part capped at mu times its normal part;
-///   one not counted starts from zero.
-/// - Iterations: the normal total grows by what brings the normal velocity to impulse_target and
-///   is clamped at zero (a contact pushes, never pulls, but may take back what it pushed too
-///   much); the tangential total grows by what stops the sliding at c and is capped at mu times
-///   the normal total (law.friction < 0: no cap; 0: none). Only totals are clamped, so the
-///   iterations converge to the simultaneous solution (projected Gauss-Seidel's rule, applied
+/// Returns (the change, counted): every contact within reach counts for mass splitting (1), so a
+/// body is never seen lighter than its contacts can make it (fewer would let the sweeps overshoot,
+/// and grow, as soon as a contact that was apart at the count starts to push).
+/// - Counting pass (MOTES_FLAG_IMPULSE_COUNT): warm start. A contact that touches or needs an
+///   impulse at the start of the substep starts from the total of the last substep (acc), its
+///   tangential part capped at mu times its normal part; one that does not starts from zero.
+/// - Sweeps: the normal total grows by what brings the normal velocity to impulse_target (soft
+///   where impulse_target says so) and is clamped at zero (a contact pushes, never pulls, but may
+///   take back what it pushed too much); then, from the velocity that leaves (the contact solved
+///   as one block), the tangential total grows by what stops the sliding at c and is capped at mu
+///   times the normal total (law.friction < 0: no cap; 0: none). Only totals are clamped, so the
+///   sweeps converge to the simultaneous solution (projected Gauss-Seidel's rule, applied
 ///   Jacobi-style).
 /// With acc = 0 on entry every time (a contact without a slot), this is the plain impulse.
 MOTES_FN vec4 contact_impulse(ImpulseBody a, ImpulseBody b, vec3 c, vec3 n, float sep, float rsum,
@@ -129,25 +166,32 @@ MOTES_FN vec4 contact_impulse(ImpulseBody a, ImpulseBody b, vec3 c, vec3 n, floa
   vec3 u0 =
       impulse_point_velocity(a.vel0, a.angvel0, ra) - impulse_point_velocity(b.vel0, b.angvel0, rb);
   float vn0 = dot(u0, n);
-  float target = impulse_target(sep, rsum, vn0, law.restitution, gravity_dt);
-  float counts = sep <= 0.0f || target > vn0 ? 1.0f : 0.0f;
+  float soft = 0.0f;
+  float target = impulse_target(sep, rsum, vn0, law.restitution, gravity_dt, flags, soft);
+  float counts = 1.0f;
   vec3 old_total = xyz(acc);
   float jn = acc.w;
   vec3 jt = old_total - n * dot(old_total, n);
   if ((flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
-    if (counts == 0.0f) {
+    if (sep > 0.0f && target <= vn0) {
       jn = 0.0f;
     }
   } else {
     vec3 u =
         impulse_point_velocity(a.vel, a.angvel, ra) - impulse_point_velocity(b.vel, b.angvel, rb);
     float vn = dot(u, n);
-    float kn = impulse_inverse_mass(a, ra, n) + impulse_inverse_mass(b, rb, n);
+    vec3 response = impulse_response(a, ra, n) + impulse_response(b, rb, n);
+    float kn = dot(response, n);
     if (!(kn > 0.0f)) {
       return vec4(0.0f, 0.0f, 0.0f, counts);
     }
-    jn = max(jn + (target - vn) / kn, 0.0f);
-    vec3 vt = u - n * vn;
+    float scale = soft > 0.0f ? MOTES_IMPULSE_MASS_SCALE : 1.0f;
+    float leak = soft > 0.0f ? MOTES_IMPULSE_LEAK : 0.0f;
+    float jn_new = max(jn + scale * (target - vn) / kn - leak * jn, 0.0f);
+    // Friction sees the velocity the normal impulse leaves.
+    u += response * (jn_new - jn);
+    jn = jn_new;
+    vec3 vt = u - n * dot(u, n);
     float vt2 = dot(vt, vt);
     if (vt2 > 0.0f && law.friction != 0.0f) {
       float vt_len = sqrt(vt2);

@@ -28,6 +28,11 @@ MOTES_SHARED_BEGIN
 /// from where the lists were built. Set on the last sweep of a substep only: the positions of the
 /// earlier sweeps are not the ones contacts see, and the test reads 32 B per projection more.
 #define MOTES_FLAG_SKIN_CHECK 64u
+/// impulses_compute: a relaxing sweep (shared/impulse.h, impulse_target).
+#define MOTES_FLAG_IMPULSE_RELAX 128u
+/// impulses_apply: keep the velocities this sweep leaves (BodyVelPush, BodyAngMomPush) as those
+/// the pose moves with; bodies_integrate with MOTES_FLAG_BODY_POSE: move with them.
+#define MOTES_FLAG_IMPULSE_PUSH 256u
 
 /// Launch parameters of every kernel family; travels with the launch (push constants).
 struct StepParams {

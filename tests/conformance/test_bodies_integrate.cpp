@@ -28,9 +28,29 @@ constexpr double kBodiesIntegrateTolerance = 1.0e-10;
 
 class BodiesIntegrate : public DeviceTest {
  protected:
-  void run_case(const std::string& layout, World w) {
+  /// push: the impulse stage's pose (MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_PUSH), moved with
+  /// random BodyVelPush and BodyAngMomPush (written too) while the bodies keep their velocities.
+  void run_case(const std::string& layout, World w, bool push = false) {
+    std::vector<vec4> vel_push, angmom_push;
     motes_ref::Bodies want = w.bodies;
-    motes_ref::bodies_integrate(want, w.params);
+    if (push) {
+      Rng rng(static_cast<std::uint32_t>(w.sizes.bodies) + 5u);
+      for (std::size_t b = 0; b < w.bodies.size(); ++b) {
+        vel_push.emplace_back(rng.uniform(-2.0f, 2.0f), rng.uniform(-2.0f, 2.0f),
+                              rng.uniform(-2.0f, 2.0f), 0.0f);
+        // Some bodies do not turn with the push (L = 0: the no-rotation branch).
+        // |L| up to 1e-3 with I^-1 up to 1e5: |w| up to 100 rad/s, as random_bodies' own.
+        angmom_push.push_back(rng.chance(0.2f) ? vec4(0.0f)
+                                               : vec4(rng.uniform(-1e-3f, 1e-3f),
+                                                      rng.uniform(-1e-3f, 1e-3f),
+                                                      rng.uniform(-1e-3f, 1e-3f), 0.0f));
+      }
+      w.sizes.impulse = 1;
+      w.params.flags |= MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_PUSH;
+      motes_ref::bodies_push_pose(want, vel_push, angmom_push, w.params);
+    } else {
+      motes_ref::bodies_integrate(want, w.params);
+    }
     ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
     ASSERT_NO_FATAL_FAILURE(
         poison_all_but({Buffer::BodyPos, Buffer::BodyQuat, Buffer::BodyVel, Buffer::BodyAngMom,
@@ -42,6 +62,10 @@ class BodiesIntegrate : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyInvInertia, w.bodies.inv_inertia));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyForce, w.bodies.force));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyTorque, w.bodies.torque));
+    if (push) {
+      ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyVelPush, vel_push));
+      ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyAngMomPush, angmom_push));
+    }
     device().bodies_integrate(w.params);
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     motes_ref::Bodies got;
@@ -67,6 +91,7 @@ TEST_P(BodiesIntegrate, One) { run_case("random", random_bodies(52, 1)); }
 TEST_P(BodiesIntegrate, Random31) { run_case("random", random_bodies(53, 31)); }
 TEST_P(BodiesIntegrate, Random1234) { run_case("random", random_bodies(54, 1234)); }
 TEST_P(BodiesIntegrate, Random65536) { run_case("random", random_bodies(55, 65536)); }
+TEST_P(BodiesIntegrate, PushPose1234) { run_case("push pose", random_bodies(56, 1234), true); }
 
 INSTANTIATE_TEST_SUITE_P(Conformance, BodiesIntegrate, testing::ValuesIn(device_params()),
                          param_name);

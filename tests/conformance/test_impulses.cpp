@@ -1,13 +1,16 @@
 // impulses_compute and impulses_apply against the oracle, as the core runs them: the counting
 // pass (compute, apply: each body's contacts counted, the stage's start kept and the warm start
-// applied), then three iterations (compute, apply). Written: the particles, the bodies' state and
+// applied), then three sweeps with position correction (compute, apply; the last apply with
+// MOTES_FLAG_IMPULSE_PUSH: BodyVelPush and BodyAngMomPush kept), then two relaxing sweeps
+// (MOTES_FLAG_IMPULSE_RELAX). Written: the particles, the bodies' state and
 // mass properties, the lists and grid of the oracle (built at the particles' positions, with
 // skin 1 mm: every pair within the impulse margin is listed), ContactLaws (frictionless, capped
 // and uncapped friction, restitution 0 to 0.9) and Planes, NeighbourState (builds = 7), and the
 // contacts' memory of the last substep: random accumulated impulses in every ContactImpulse slot
 // and ImpulseStamp = 7 for most particles (their slots are warm-started) and 6 for the others
 // (their slots are void: lists rebuilt). Every other buffer is poisoned. Read back: the bodies'
-// velocities, angular momenta and angular velocities, BodyVelStart and BodyAngVelStart, every
+// velocities, angular momenta and angular velocities, BodyVelStart and BodyAngVelStart,
+// BodyVelPush and BodyAngMomPush, every
 // ContactImpulse slot, ImpulseStamp, and the last iteration's ParticleForce and ParticleMoment of
 // the rigid particles. Each case runs with K = 16 and again with K = 2, where most particles walk
 // the grid and their contacts keep no memory.
@@ -38,6 +41,7 @@ using motes::Buffer;
 constexpr double kImpulsesTolerance = 1.0e-7;
 constexpr uint kBuilds = 7;
 constexpr int kIterations = 3;
+constexpr int kRelaxing = 2;
 
 class Impulses : public DeviceTest {
  protected:
@@ -65,12 +69,20 @@ class Impulses : public DeviceTest {
 
     StepParams count = w.params;
     count.flags |= MOTES_FLAG_IMPULSE_COUNT;
+    StepParams last = w.params;
+    last.flags |= MOTES_FLAG_IMPULSE_PUSH;
+    StepParams relax = w.params;
+    relax.flags |= MOTES_FLAG_IMPULSE_RELAX;
     motes_ref::Bodies want = w.bodies;
     motes_ref::impulses_compute(w.particles, want, nb, w.laws, w.planes, count, s);
     motes_ref::impulses_apply(want, count, s);
     for (int it = 0; it < kIterations; ++it) {
       motes_ref::impulses_compute(w.particles, want, nb, w.laws, w.planes, w.params, s);
-      motes_ref::impulses_apply(want, w.params, s);
+      motes_ref::impulses_apply(want, it + 1 == kIterations ? last : w.params, s);
+    }
+    for (int it = 0; it < kRelaxing; ++it) {
+      motes_ref::impulses_compute(w.particles, want, nb, w.laws, w.planes, relax, s);
+      motes_ref::impulses_apply(want, relax, s);
     }
 
     ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
@@ -110,16 +122,22 @@ class Impulses : public DeviceTest {
     device().impulses_apply(count);
     for (int it = 0; it < kIterations; ++it) {
       device().impulses_compute(w.params);
-      device().impulses_apply(w.params);
+      device().impulses_apply(it + 1 == kIterations ? last : w.params);
+    }
+    for (int it = 0; it < kRelaxing; ++it) {
+      device().impulses_compute(relax);
+      device().impulses_apply(relax);
     }
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
-    std::vector<vec4> vel, angmom, angvel, vel0, angvel0, acc, force, moment;
+    std::vector<vec4> vel, angmom, angvel, vel0, angvel0, vel_push, angmom_push, acc, force, moment;
     std::vector<uint> stamp;
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyVel, vel));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngMom, angmom));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngVel, angvel));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyVelStart, vel0));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngVelStart, angvel0));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyVelPush, vel_push));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngMomPush, angmom_push));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::ContactImpulse, acc));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::ImpulseStamp, stamp));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticleForce, force));
@@ -149,6 +167,8 @@ class Impulses : public DeviceTest {
     check_close("BodyAngVel", angvel, want.angvel, kImpulsesTolerance);
     check_close("BodyVelStart", vel0, s.vel0, kImpulsesTolerance);
     check_close("BodyAngVelStart", angvel0, s.angvel0, kImpulsesTolerance);
+    check_close("BodyVelPush", vel_push, s.vel_push, kImpulsesTolerance);
+    check_close("BodyAngMomPush", angmom_push, s.angmom_push, kImpulsesTolerance);
     check_close("ContactImpulse", acc, s.acc, kImpulsesTolerance);
     check_identical("ImpulseStamp", stamp, s.stamp);
     check_close("ParticleForce (impulses)", slice(force, 0, nr), s.impulse, kImpulsesTolerance);

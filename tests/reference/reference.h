@@ -110,6 +110,10 @@ void bodies_reduce(const std::vector<vec4>& particle_pos, const std::vector<vec4
 
 /// bodies_integrate: shared::body_integrate on every body, with p.gravity_dt.
 void bodies_integrate(Bodies& bodies, const StepParams& p);
+/// bodies_integrate with MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_PUSH: shared::body_push_pose on
+/// every body, moved with vel_push and angmom_push (BodyVelPush, BodyAngMomPush).
+void bodies_push_pose(Bodies& bodies, const std::vector<vec4>& vel_push,
+                      const std::vector<vec4>& angmom_push, const StepParams& p);
 
 /// particles_update: ParticlePos/Vel xyz of the rigid particles [0, particles.rigid) from the body
 /// pose (shared::particle_position and particle_velocity); w (radius, inverse mass) kept. Returns
@@ -168,6 +172,8 @@ struct ImpulseState {
   uint builds = 0;            ///< NeighbourState[MOTES_NEIGHBOUR_BUILDS]
   std::vector<vec4> impulse;  ///< Nr: ParticleForce (xyz impulse, w counted contacts)
   std::vector<vec4> moment;   ///< Nr: ParticleMoment
+  std::vector<vec4> vel_push;     ///< B: BodyVelPush (written with MOTES_FLAG_IMPULSE_PUSH)
+  std::vector<vec4> angmom_push;  ///< B: BodyAngMomPush
 };
 
 /// impulses_compute: for every dynamic rigid particle i (static ones get 0), the contacts with the
@@ -183,7 +189,8 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
 
 /// impulses_apply: each dynamic body's particles' impulses, counts and moments summed in float in
 /// particle order; the counting pass first keeps vel0 = (vel, count) and angvel0 = angvel; then
-/// shared::body_apply_impulse (static bodies: angvel from angmom only).
+/// shared::body_apply_impulse (static bodies: angvel from angmom only); with
+/// MOTES_FLAG_IMPULSE_PUSH, vel_push and angmom_push = what it leaves.
 void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s);
 
 /// halo_pack: for each particle entry k < p.halo_particles, the particle i = index[p.halo_first +

@@ -78,6 +78,11 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
 
 void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s) {
   const bool counting = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
+  const bool push = (p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u;
+  if (push) {
+    s.vel_push.resize(bodies.size(), vec4(0.0f));
+    s.angmom_push.resize(bodies.size(), vec4(0.0f));
+  }
   for (std::size_t b = 0; b < bodies.size(); ++b) {
     vec4 sum(0.0f);
     vec3 m(0.0f);
@@ -94,6 +99,10 @@ void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s) {
     motes::shared::body_apply_impulse(bodies.pos[b], bodies.quat[b], bodies.inv_inertia[b],
                                       bodies.vel[b], bodies.angmom[b], bodies.angvel[b], xyz(sum),
                                       m);
+    if (push) {
+      s.vel_push[b] = bodies.vel[b];
+      s.angmom_push[b] = bodies.angmom[b];
+    }
   }
 }
 

@@ -93,6 +93,9 @@ enum class Buffer : std::uint32_t {
   PartitionRefPos,
   /// uint (1 when Sizes::partition, else 0): particles_displacement's word (shared/halo.h).
   PartitionCheck,
+  // Impulse contacts again (after the others: checkpoints name buffers by their number).
+  BodyVelPush,     ///< vec4 (B): BodyVel after the impulse sweeps with position correction
+  BodyAngMomPush,  ///< vec4 (B): BodyAngMom after the impulse sweeps with position correction
   Count
 };
 
