@@ -6,6 +6,7 @@
 // BodyAngMomPush. As backends/openmp/impulses_apply.cpp.
 #extension GL_GOOGLE_include_directive : require
 #include "kernel_common.glsl"
+#include "shared/neighbours.h"
 
 void main() {
   uint b = thread_index();
@@ -23,6 +24,12 @@ void main() {
   if ((p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
     body_vel_start[b] = vec4(xyz(body_vel[b]), sum.w);
     body_angvel_start[b] = body_angvel[b];
+    // The counting pass has read every slot: the body's particles' slots are now this build's.
+    if (com.w != 0.0f) {
+      uint builds = neighbour_state[MOTES_NEIGHBOUR_BUILDS];
+      uint end = body_first[b + 1u];
+      for (uint i = body_first[b]; i < end; ++i) impulse_stamp[i] = builds;
+    }
   }
   vec4 vel = body_vel[b];
   vec4 angmom = body_angmom[b];

@@ -14,15 +14,8 @@
 #include "grid_walk.glsl"
 
 ImpulseBody impulse_body(uint b) {
-  ImpulseBody s;
-  s.com = body_pos[b];
-  s.quat = body_quat[b];
-  s.inv_inertia = body_inv_inertia[b];
-  s.vel = body_vel[b];
-  s.angvel = body_angvel[b];
-  s.vel0 = body_vel_start[b];
-  s.angvel0 = body_angvel_start[b];
-  return impulse_body_for(s, p.flags);
+  return impulse_body_of(body_pos[b], body_quat[b], body_inv_inertia[b], body_vel[b],
+                         body_angvel[b], body_vel_start[b], body_angvel_start[b], p.flags);
 }
 
 void main() {
@@ -40,7 +33,7 @@ void main() {
   uint law_base = particle_material[i] * p.material_count;
   uint builds = neighbour_state[MOTES_NEIGHBOUR_BUILDS];
   bool counting = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
-  bool slots_valid = !counting || impulse_stamp[i] == builds;
+  uint own_stamp = impulse_stamp[i];
   uint nr = p.rigid_particle_count;
   vec4 sum = vec4(0.0f);
   vec3 moment_sum = vec3(0.0f);
@@ -51,7 +44,9 @@ void main() {
       if (j >= p.rigid_particle_count) continue;
       bool slotted = impulse_pair_slotted(c, neighbour_count[j], p.neighbour_capacity);
       uint slot = k * nr + i;
-      vec4 a = slotted && slots_valid ? contact_impulse_acc[slot] : vec4(0.0f);
+      bool valid = !counting ||
+                   impulse_slots_valid(own_stamp, impulse_stamp[j], particle_vel[j].w, builds);
+      vec4 a = slotted && valid ? contact_impulse_acc[slot] : vec4(0.0f);
       vec4 xj = particle_pos[j];
       vec4 r = pair_impulse(own, xi, impulse_body(particle_body[j]), xj, i < j, margin,
                             contact_laws[pair_law_index(i, particle_material[i], j,
@@ -90,7 +85,6 @@ void main() {
     contact_impulse_acc[slot] = a;
     impulse_add(sum, moment_sum, r, plane_contact_point(xi, pl.normal_offset), own.com);
   }
-  if (counting) impulse_stamp[i] = builds;
   particle_force[i] = sum;
   particle_moment[i] = vec4(moment_sum, 0.0f);
 }

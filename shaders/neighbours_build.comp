@@ -25,6 +25,8 @@ void main() {
     vec4 pi = particle_pos[i];
     neighbour_ref_pos[i] = pi;
     uint c = 0u;
+    uint old_count = neighbour_count[i];
+    bool same = true;
     if (particle_vel[i].w != 0.0f) {  // static particles never move and get no force
       uint body_i = particle_body[i];
       uint lo[27];
@@ -37,9 +39,20 @@ void main() {
               !neighbour_within(pi, sorted_pos[t], p.neighbour_skin)) {
             continue;
           }
-          if (c < p.neighbour_capacity) neighbour_list[c * p.particle_count + i] = j;
+          if (c < p.neighbour_capacity) {
+            uint at = c * p.particle_count + i;
+            same = same && neighbour_list[at] == j;
+            neighbour_list[at] = j;
+          }
           ++c;
         }
+      }
+      // Impulse contacts: a list that comes out as it was keeps its contacts' memory.
+      uint built = neighbour_state[MOTES_NEIGHBOUR_BUILDS] - 1u;  // the build was counted at its start
+      if ((p.flags & MOTES_FLAG_IMPULSE) != 0u && i < p.rigid_particle_count &&
+          impulse_stamp[i] == built &&
+          neighbour_keeps_slots(old_count, c, same, p.neighbour_capacity)) {
+        impulse_stamp[i] = built + 1u;
       }
     }
     neighbour_count[i] = c;

@@ -5,6 +5,7 @@
 // BodyAngMomPush. As backends/openmp/impulses_apply.cpp.
 #include "cuda_device.h"
 #include "shared/impulse.h"
+#include "shared/neighbours.h"
 
 namespace motes::cuda {
 
@@ -28,6 +29,8 @@ struct ApplyBuffers {
   vec4* __restrict__ angvel0;
   vec4* __restrict__ vel_push;     // BodyVelPush (written with MOTES_FLAG_IMPULSE_PUSH)
   vec4* __restrict__ angmom_push;  // BodyAngMomPush
+  uint* __restrict__ stamp;        // ImpulseStamp (written by the counting pass)
+  const uint* __restrict__ state;  // NeighbourState
 };
 
 __global__ void impulses_apply_kernel(shared::StepParams p, ApplyBuffers d) {
@@ -47,6 +50,12 @@ __global__ void impulses_apply_kernel(shared::StepParams p, ApplyBuffers d) {
   if ((p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
     d.vel0[b] = vec4(shared::xyz(d.vel[b]), sum.w);
     d.angvel0[b] = d.angvel[b];
+    // The counting pass has read every slot: the body's particles' slots are now this build's.
+    if (com.w != 0.0f) {
+      const uint builds = d.state[MOTES_NEIGHBOUR_BUILDS];
+      const uint end = d.first[b + 1];
+      for (uint i = d.first[b]; i < end; ++i) d.stamp[i] = builds;
+    }
   }
   vec4 vel = d.vel[b];
   vec4 angmom = d.angmom[b];
@@ -66,13 +75,14 @@ __global__ void impulses_apply_kernel(shared::StepParams p, ApplyBuffers d) {
 
 void CudaDevice::launch_impulses_apply(const shared::StepParams& p) {
   if (p.body_count == 0) return;
-  const ApplyBuffers d{buf<uint>(Buffer::BodyFirst),      buf<vec4>(Buffer::BodyPos),
-                       buf<vec4>(Buffer::BodyQuat),       buf<vec4>(Buffer::BodyInvInertia),
-                       buf<vec4>(Buffer::ParticleForce),  buf<vec4>(Buffer::ParticleMoment),
-                       buf<vec4>(Buffer::BodyVel),        buf<vec4>(Buffer::BodyAngMom),
-                       buf<vec4>(Buffer::BodyAngVel),     buf<vec4>(Buffer::BodyVelStart),
+  const ApplyBuffers d{buf<uint>(Buffer::BodyFirst),       buf<vec4>(Buffer::BodyPos),
+                       buf<vec4>(Buffer::BodyQuat),        buf<vec4>(Buffer::BodyInvInertia),
+                       buf<vec4>(Buffer::ParticleForce),   buf<vec4>(Buffer::ParticleMoment),
+                       buf<vec4>(Buffer::BodyVel),         buf<vec4>(Buffer::BodyAngMom),
+                       buf<vec4>(Buffer::BodyAngVel),      buf<vec4>(Buffer::BodyVelStart),
                        buf<vec4>(Buffer::BodyAngVelStart), buf<vec4>(Buffer::BodyVelPush),
-                       buf<vec4>(Buffer::BodyAngMomPush)};
+                       buf<vec4>(Buffer::BodyAngMomPush),  buf<uint>(Buffer::ImpulseStamp),
+                       buf<uint>(Buffer::NeighbourState)};
   impulses_apply_kernel<<<blocks_for(p.body_count), kBlock, 0, stream_>>>(p, d);
 }
 

@@ -45,20 +45,13 @@ struct ImpulseInputs {
 
 /// The state of body b that its contacts read.
 __device__ shared::ImpulseBody impulse_body(const ImpulseInputs& in, uint b, uint flags) {
-  shared::ImpulseBody s;
-  s.com = in.com[b];
-  s.quat = in.quat[b];
-  s.inv_inertia = in.inv_inertia[b];
-  s.vel = in.body_vel[b];
-  s.angvel = in.body_angvel[b];
-  s.vel0 = in.vel0[b];
-  s.angvel0 = in.angvel0[b];
-  return shared::impulse_body_for(s, flags);
+  return shared::impulse_body_of(in.com[b], in.quat[b], in.inv_inertia[b], in.body_vel[b],
+                                 in.body_angvel[b], in.vel0[b], in.angvel0[b], flags);
 }
 
 __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
                                         vec4* __restrict__ impulse, vec4* __restrict__ moment,
-                                        vec4* __restrict__ acc, uint* __restrict__ stamp) {
+                                        vec4* __restrict__ acc, const uint* __restrict__ stamp) {
   const std::uint64_t t = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
   if (t >= p.rigid_particle_count) return;
   const auto i = static_cast<uint>(t);
@@ -74,7 +67,7 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
   const shared::ContactLaw* law_row = in.laws + std::size_t{in.material[i]} * p.material_count;
   const uint builds = in.state[MOTES_NEIGHBOUR_BUILDS];
   const bool counting = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
-  const bool slots_valid = !counting || stamp[i] == builds;
+  const uint own_stamp = stamp[i];
   const std::size_t nr = p.rigid_particle_count;
   vec4 sum(0.0f);
   vec3 moment_sum(0.0f);
@@ -84,7 +77,9 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
     if (j >= p.rigid_particle_count) return;
     const vec4 xj = in.pos[j];
     const shared::ImpulseBody other = impulse_body(in, in.body[j], p.flags);
-    vec4 a = slot != nullptr && slots_valid ? *slot : vec4(0.0f);
+    const bool valid =
+        !counting || shared::impulse_slots_valid(own_stamp, stamp[j], in.vel[j].w, builds);
+    vec4 a = slot != nullptr && valid ? *slot : vec4(0.0f);
     const vec4 r = shared::pair_impulse(
         own, xi, other, xj, i < j, margin,
         in.laws[shared::pair_law_index(i, in.material[i], j, in.material[j], p.material_count)],
@@ -116,7 +111,6 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
     shared::impulse_add(sum, moment_sum, r, shared::plane_contact_point(xi, pl.normal_offset),
                         own.com);
   }
-  if (counting) stamp[i] = builds;
   impulse[i] = sum;
   moment[i] = vec4(moment_sum, 0.0f);
 }

@@ -7,6 +7,7 @@
 // conditional rebuild (cuda_launch.cpp).
 #include "cuda_device.h"
 #include "grid_walk.cuh"
+#include "shared/impulse.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
 
@@ -40,6 +41,7 @@ struct BuildOutputs {
   uint* __restrict__ count;
   vec4* __restrict__ ref;
   uint* __restrict__ state;
+  uint* __restrict__ stamp;  ///< ImpulseStamp (impulse contacts; else null)
 };
 
 __global__ void neighbours_build_kernel(shared::StepParams p, BuildInputs in, BuildOutputs out) {
@@ -55,6 +57,8 @@ __global__ void neighbours_build_kernel(shared::StepParams p, BuildInputs in, Bu
     const vec4 pi = in.pos[i];
     out.ref[i] = pi;
     uint c = 0;
+    const uint old_count = out.count[i];
+    bool same = true;
     if (in.vel[i].w != 0.0f) {  // static particles never move and get no force
       const uint body_i = in.body[i];
       const std::size_t stride = p.particle_count;
@@ -66,10 +70,20 @@ __global__ void neighbours_build_kernel(shared::StepParams p, BuildInputs in, Bu
               !shared::neighbour_within(pi, in.spos[t], p.neighbour_skin)) {
             continue;
           }
-          if (c < p.neighbour_capacity) out.list[std::size_t{c} * stride + i] = j;
+          if (c < p.neighbour_capacity) {
+            uint& entry = out.list[std::size_t{c} * stride + i];
+            same = same && entry == j;
+            entry = j;
+          }
           ++c;
         }
       });
+      // Impulse contacts: a list that comes out as it was keeps its contacts' memory.
+      const uint built = out.state[MOTES_NEIGHBOUR_BUILDS] - 1u;  // neighbours_begin counted this
+      if (out.stamp != nullptr && i < p.rigid_particle_count && out.stamp[i] == built &&
+          shared::neighbour_keeps_slots(old_count, c, same, p.neighbour_capacity)) {
+        out.stamp[i] = built + 1u;
+      }
     }
     out.count[i] = c;
     if (c > p.neighbour_capacity) atomicAdd(&block_over, 1u);
@@ -98,7 +112,10 @@ void CudaDevice::launch_neighbours_build(const shared::StepParams& p) {
                        buf<uint>(Buffer::GridCellStart), buf<vec4>(Buffer::SortedPos),
                        buf<uint>(Buffer::SortedBody),    buf<uint>(Buffer::LinkExclusions)};
   const BuildOutputs out{buf<uint>(Buffer::NeighbourList), buf<uint>(Buffer::NeighbourCount),
-                         buf<vec4>(Buffer::NeighbourRefPos), state};
+                         buf<vec4>(Buffer::NeighbourRefPos), state,
+                         (p.flags & MOTES_FLAG_IMPULSE) != 0u && sizes_.impulse != 0
+                             ? buf<uint>(Buffer::ImpulseStamp)
+                             : nullptr};
   neighbours_build_kernel<<<blocks_for(p.particle_count), kBlock, 0, stream_>>>(p, in, out);
 }
 

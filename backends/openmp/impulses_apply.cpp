@@ -7,6 +7,7 @@
 
 #include "openmp_device.h"
 #include "shared/impulse.h"
+#include "shared/neighbours.h"
 
 namespace motes::openmp {
 
@@ -30,15 +31,30 @@ void OpenMPDevice::impulses_apply(const shared::StepParams& p) {
   vec4* vel0 = buf<vec4>(Buffer::BodyVelStart);
   vec4* angvel0 = buf<vec4>(Buffer::BodyAngVelStart);
   const bool push = (p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u;
+  // The counting pass has read every slot: the bodies' particles' slots are now this build's.
+  uint* stamp = count_only ? buf<uint>(Buffer::ImpulseStamp) : nullptr;
+  const uint builds = count_only ? buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_BUILDS] : 0u;
   vec4* vel_push = push ? buf<vec4>(Buffer::BodyVelPush) : nullptr;
   vec4* angmom_push = push ? buf<vec4>(Buffer::BodyAngMomPush) : nullptr;
 
+  // In the impulse stage (after a counting pass of impulses_compute at these sizes), the
+  // particles it found touching something; not when applying what attachments did
+  // (MOTES_FLAG_ABSORB: every particle may have some).
+  const std::uint8_t* touches =
+      (p.flags & MOTES_FLAG_ABSORB) == 0u &&
+              impulse_touches_.size() == std::size_t{p.rigid_particle_count} &&
+              p.rigid_particle_count > 0
+          ? impulse_touches_.data()
+          : nullptr;
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(bodies))
   for (std::int64_t b = 0; b < bodies; ++b) {
     vec4 sum(0.0f);
     vec3 m(0.0f);
     if (com[b].w != 0.0f) {
       for (uint i = first[b]; i < first[b + 1]; ++i) {
+        // A particle the counting pass found touching nothing has zeros, whose sum changes
+        // nothing: skip reading them.
+        if (touches != nullptr && touches[i] == 0) continue;
         sum = sum + impulse[i];
         m += shared::xyz(moment[i]);
       }
@@ -46,6 +62,9 @@ void OpenMPDevice::impulses_apply(const shared::StepParams& p) {
     if (count_only) {  // the stage's start, then the warm start
       vel0[b] = vec4(shared::xyz(vel[b]), sum.w);
       angvel0[b] = angvel[b];
+      if (com[b].w != 0.0f) {
+        for (uint i = first[b]; i < first[b + 1]; ++i) stamp[i] = builds;
+      }
     }
     shared::body_apply_impulse(com[b], quat[b], inv_inertia[b], vel[b], angmom[b], angvel[b],
                                shared::xyz(sum), m);

@@ -5,7 +5,8 @@
 // the lower particle id first, so the two particles of a contact get bitwise opposite impulses;
 // each keeps the contact's accumulated impulse in its own slot of ContactImpulse (the same bits
 // on both sides). The counting pass reads the slots only while the lists are those that wrote them
-// (ImpulseStamp), and stamps them.
+// (ImpulseStamp), and stamps them. The sweeps visit only the particles that the counting pass
+// found with a contact within reach (the others' results are zeros that stay so).
 #include <chrono>
 #include <cstdint>
 
@@ -20,25 +21,6 @@ namespace motes::openmp {
 using shared::uint;
 using shared::vec3;
 using shared::vec4;
-
-namespace {
-
-/// The state of body b that its contacts read.
-shared::ImpulseBody impulse_body(const vec4* com, const vec4* quat, const vec4* inv_inertia,
-                                 const vec4* vel, const vec4* angvel, const vec4* vel0,
-                                 const vec4* angvel0, uint b, uint flags) {
-  shared::ImpulseBody s;
-  s.com = com[b];
-  s.quat = quat[b];
-  s.inv_inertia = inv_inertia[b];
-  s.vel = vel[b];
-  s.angvel = angvel[b];
-  s.vel0 = vel0[b];
-  s.angvel0 = angvel0[b];
-  return shared::impulse_body_for(s, flags);
-}
-
-}  // namespace
 
 void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
@@ -73,20 +55,71 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
   const uint builds = buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_BUILDS];
   const bool counting = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
   const std::size_t nr = p.rigid_particle_count;
+  // Each body's frame (centre, world inverse inertia) once per substep: poses do not move
+  // between a counting pass and its sweeps.
+  const auto bodies = static_cast<std::int64_t>(p.body_count);
+  if (counting || impulse_frames_.size() != std::size_t(bodies)) {
+    impulse_frames_.resize(std::size_t(bodies));
+    shared::ImpulseBody* frames = impulse_frames_.data();
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(bodies))
+    for (std::int64_t b = 0; b < bodies; ++b) {
+      frames[b] = shared::impulse_body_frame(com[b], quat[b], inv_inertia[b]);
+    }
+  }
+  const shared::ImpulseBody* frames = impulse_frames_.data();
+  const auto impulse_body = [&](uint b) {
+    shared::ImpulseBody s = frames[b];
+    shared::impulse_body_state(s, body_vel[b], body_angvel[b], vel0[b], angvel0[b], p.flags);
+    return s;
+  };
 
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
-  for (std::int64_t i = 0; i < n; ++i) {
+  // One particle's contacts: its list (or the grid beyond K), then the planes.
+  const auto particle = [&](std::int64_t i) {
     const vec4 xi = pos[i];
     if (vel[i].w == 0.0f) {  // static particle: its impulse is never used
       impulse[i] = vec4(0.0f);
       moment[i] = vec4(0.0f);
-      continue;
+      return false;
+    }
+    const uint c = count[i];
+    if (counting && c <= capacity) {
+      // Nothing within reach (the common case: most particles touch nothing): the result of the
+      // full evaluation below, without building the bodies: every slot of a contact out of reach
+      // is cleared, no impulse, no count.
+      const float reach_add = margin;
+      bool touches = false;
+      for (uint k = 0; k < c && !touches; ++k) {
+        const uint j = list[std::size_t{k} * stride + std::size_t(i)];
+        if (j >= p.rigid_particle_count) continue;
+        const vec4 xj = pos[j];
+        const vec3 d = shared::xyz(xi) - shared::xyz(xj);
+        const float dist2 = shared::dot(d, d);
+        const float reach = xi.w + xj.w + reach_add;
+        touches = dist2 < reach * reach && dist2 != 0.0f;
+      }
+      for (uint k = 0; k < p.plane_count && !touches; ++k) {
+        const vec4 no = planes[k].normal_offset;
+        touches = shared::dot(shared::xyz(no), shared::xyz(xi)) - no.w - xi.w < margin;
+      }
+      if (!touches) {
+        for (uint k = 0; k < c; ++k) {
+          const uint j = list[std::size_t{k} * stride + std::size_t(i)];
+          if (j < p.rigid_particle_count && shared::impulse_pair_slotted(c, count[j], capacity)) {
+            acc[std::size_t{k} * nr + std::size_t(i)] = vec4(0.0f);
+          }
+        }
+        for (uint k = 0; k < p.plane_count; ++k) {
+          acc[(std::size_t{capacity} + k) * nr + std::size_t(i)] = vec4(0.0f);
+        }
+        impulse[i] = vec4(0.0f);
+        moment[i] = vec4(0.0f);
+        return false;
+      }
     }
     const uint bi = body[i];
-    const shared::ImpulseBody own =
-        impulse_body(com, quat, inv_inertia, body_vel, body_angvel, vel0, angvel0, bi, p.flags);
+    const shared::ImpulseBody own = impulse_body(bi);
     const shared::ContactLaw* law_row = laws + std::size_t{material[i]} * materials;
-    const bool slots_valid = !counting || stamp[i] == builds;
+    const uint own_stamp = stamp[i];
     vec4 sum(0.0f);
     vec3 moment_sum(0.0f);
     // The impulse of the contact with particle j (rigid particles only), added in order; its
@@ -94,9 +127,10 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     auto add_contact = [&](uint j, vec4* slot) {
       if (j >= p.rigid_particle_count) return;
       const vec4 xj = pos[j];
-      const shared::ImpulseBody other = impulse_body(com, quat, inv_inertia, body_vel, body_angvel,
-                                                     vel0, angvel0, body[j], p.flags);
-      vec4 a = slot != nullptr && slots_valid ? *slot : vec4(0.0f);
+      const shared::ImpulseBody other = impulse_body(body[j]);
+      const bool valid =
+          !counting || shared::impulse_slots_valid(own_stamp, stamp[j], vel[j].w, builds);
+      vec4 a = slot != nullptr && valid ? *slot : vec4(0.0f);
       const vec4 r = shared::pair_impulse(
           own, xi, other, xj, static_cast<uint>(i) < j, margin,
           laws[shared::pair_law_index(uint(i), material[i], j, material[j], materials)],
@@ -104,7 +138,6 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
       if (slot != nullptr) *slot = a;
       shared::impulse_add(sum, moment_sum, r, shared::pair_contact_point(xi, xj), own.com);
     };
-    const uint c = count[i];
     if (c <= capacity) {
       for (uint k = 0; k < c; ++k) {
         const uint j = list[std::size_t{k} * stride + std::size_t(i)];
@@ -128,9 +161,30 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
       shared::impulse_add(sum, moment_sum, r, shared::plane_contact_point(xi, pl.normal_offset),
                           own.com);
     }
-    if (counting) stamp[i] = builds;
     impulse[i] = sum;
     moment[i] = vec4(moment_sum, 0.0f);
+    return true;
+  };
+
+  if (counting) {
+    impulse_touches_.resize(std::size_t(n));
+    std::uint8_t* touches = impulse_touches_.data();
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel_heavy(n))
+    for (std::int64_t i = 0; i < n; ++i) touches[i] = particle(i) ? 1 : 0;
+    impulse_active_.clear();
+    for (std::int64_t i = 0; i < n; ++i) {
+      if (touches[i] != 0) impulse_active_.push_back(static_cast<uint>(i));
+    }
+  } else if (impulse_touches_.size() != std::size_t(n)) {
+    // No counting pass at these sizes yet: every particle.
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
+    for (std::int64_t i = 0; i < n; ++i) particle(i);
+  } else {
+    // The sweeps of this substep: only the particles the counting pass found touching.
+    const auto active = static_cast<std::int64_t>(impulse_active_.size());
+    const uint* ids = impulse_active_.data();
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel_heavy(active))
+    for (std::int64_t a = 0; a < active; ++a) particle(ids[a]);
   }
   record(Kernel::ImpulsesCompute, start);
 }

@@ -7,6 +7,7 @@
 
 #include "grid_walk.h"
 #include "openmp_device.h"
+#include "shared/impulse.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
 
@@ -42,6 +43,12 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
   vec4* ref = buf<vec4>(Buffer::NeighbourRefPos);
   uint over = 0;
   uint most = 0;
+  // Impulse contacts: a rigid particle whose list comes out as it was keeps its contacts' memory
+  // (shared/impulse.h: neighbour_keeps_slots): its stamp moves on to this build.
+  const bool stamps = (p.flags & MOTES_FLAG_IMPULSE) != 0u && sizes_.impulse != 0;
+  uint* stamp = stamps ? buf<uint>(Buffer::ImpulseStamp) : nullptr;
+  uint* state = buf<uint>(Buffer::NeighbourState);
+  const uint built = state[MOTES_NEIGHBOUR_BUILDS];  // the last build's count; this one's + 1
 
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n)) \
     reduction(+ : over) reduction(max : most)
@@ -54,6 +61,8 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
     }
     const uint body_i = body[i];
     const GridRanges ranges = grid_walk(p, pi, cell_start);
+    const uint old_count = count[i];
+    bool same = true;
     uint c = 0;
     for (int r = 0; r < ranges.count; ++r) {
       for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
@@ -63,15 +72,22 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
             !shared::neighbour_within(pi, spos[t], p.neighbour_skin)) {
           continue;
         }
-        if (c < capacity) list[std::size_t{c} * stride + static_cast<std::size_t>(i)] = j;
+        if (c < capacity) {
+          uint& entry = list[std::size_t{c} * stride + static_cast<std::size_t>(i)];
+          same = same && entry == j;
+          entry = j;
+        }
         ++c;
       }
     }
     count[i] = c;
+    if (stamps && static_cast<std::size_t>(i) < sizes_.rigid_particles && stamp[i] == built &&
+        shared::neighbour_keeps_slots(old_count, c, same, capacity)) {
+      stamp[i] = built + 1u;
+    }
     over += c > capacity ? 1u : 0u;
     most = std::max(most, c);
   }
-  uint* state = buf<uint>(Buffer::NeighbourState);
   state[MOTES_NEIGHBOUR_REBUILD] = 0;
   state[MOTES_NEIGHBOUR_BUILDS] += 1;
   state[MOTES_NEIGHBOUR_OVER_CAPACITY] = over;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "motes/backend/device.h"
+#include "shared/impulse.h"
 
 namespace motes::openmp {
 
@@ -80,6 +81,11 @@ class OpenMPDevice final : public Device {
   [[nodiscard]] bool parallel(std::int64_t items) const {
     return threads_ > 1 && items >= min_parallel_;
   }
+  /// For loops whose items cost about 16 times a particle's share of a light pass (an impulse
+  /// particle with its contacts, ~100 ns or more): threads pay off at a 16th of the items.
+  [[nodiscard]] bool parallel_heavy(std::int64_t items) const {
+    return threads_ > 1 && items * 16 >= min_parallel_;
+  }
   template <typename T>
   T* buf(Buffer b) {
     return reinterpret_cast<T*>(buffers_[static_cast<std::size_t>(b)].data());
@@ -96,6 +102,13 @@ class OpenMPDevice final : public Device {
   Sizes sizes_;
   std::vector<AlignedBuffer> buffers_;
   std::vector<std::uint32_t> sorted_keys_, keys_tmp_, ids_tmp_, histograms_;
+  /// impulses_compute: the rigid particles with a contact within reach at the last counting pass,
+  /// ascending, and per particle whether it has one. Positions do not move between a counting
+  /// pass and its sweeps, so the sweeps visit only these: the others' impulses stay 0.
+  std::vector<std::uint32_t> impulse_active_;
+  std::vector<std::uint8_t> impulse_touches_;
+  /// impulses_compute: each body's shared::impulse_body_frame, made by the counting pass.
+  std::vector<shared::ImpulseBody> impulse_frames_;
   bool timing_ = false;
   KernelTimes times_;
 };

@@ -132,8 +132,8 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
                                      scene.source, settings_.impulse_iterations));
   }
   if (impulses && (settings_.impulse_substeps < 1 || settings_.impulse_substeps > 64)) {
-    return Status::error(fmt::format("{}: impulse_substeps must be 1 to 64 (got {})",
-                                     scene.source, settings_.impulse_substeps));
+    return Status::error(fmt::format("{}: impulse_substeps must be 1 to 64 (got {})", scene.source,
+                                     settings_.impulse_substeps));
   }
   const auto is_free_sphere = [impulses](const BodySpec& b) {
     return !impulses && b.kind == BodyKind::Dynamic && !b.soft && b.shape->points.size() == 1 &&
@@ -694,7 +694,7 @@ void Simulation::absorb_attachments() {
   shared::StepParams absorb = params_;
   absorb.flags = (absorb.flags | MOTES_FLAG_ABSORB) & ~MOTES_FLAG_IMPULSE_COUNT;
   shared::StepParams apply = params_;
-  apply.flags &= ~MOTES_FLAG_IMPULSE_COUNT;
+  apply.flags = (apply.flags | MOTES_FLAG_ABSORB) & ~MOTES_FLAG_IMPULSE_COUNT;
   d.particles_update(absorb);
   d.impulses_apply(apply);
   d.particles_update(params_);
@@ -704,13 +704,16 @@ void Simulation::step_impulses() {
   // Forces (soft bodies, cloth, ropes) are summed once; then the impulse stage runs its own
   // substeps on the contacts the lists hold (docs/architecture.md, "Impulse contacts"). Each:
   // gravity and forces into the velocities; the counting pass (every contact in reach counted,
-  // the start velocities kept, the warm start applied); sweeps with position correction, the
-  // velocities they leave kept for the pose; relaxing sweeps without it, whose velocities the
+  // the start velocities kept, the warm start applied); a sweep with position correction, the
+  // velocities it leaves kept for the pose; relaxing sweeps without it, whose velocities the
   // bodies keep; the pose; the particles follow.
   Device& d = *device_;
   const int substeps = settings_.impulse_substeps;
   const int sweeps = (settings_.impulse_iterations + substeps - 1) / substeps;
-  const int correcting = (sweeps + 1) / 2;
+  // One sweep with the position correction (soft: it moves an overlap by a fraction per substep
+  // whatever the sweeps), the rest without it: the velocities the bodies keep converge further
+  // and carry no push-out speed (docs/architecture.md, "Impulse contacts").
+  const int correcting = 1;
   const int relaxing = sweeps - correcting;
   shared::StepParams sub = params_;
   sub.gravity_dt.w = params_.gravity_dt.w / static_cast<float>(substeps);

@@ -72,9 +72,8 @@ MOTES_FN void body_push_pose(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
   vec4 w = vec4(0.0f);
   body_integrate(pos_invm, quat, v, l, w, inv_inertia, vec4(0.0f), vec4(0.0f), gravity_dt,
                  MOTES_FLAG_BODY_POSE);
-  angvel = pos_invm.w == 0.0f
-               ? vec4(0.0f)
-               : vec4(body_angular_velocity(quat, inv_inertia, xyz(angmom)), 0.0f);
+  angvel = pos_invm.w == 0.0f ? vec4(0.0f)
+                              : vec4(body_angular_velocity(quat, inv_inertia, xyz(angmom)), 0.0f);
 }
 
 /// One semi-implicit Euler step of a free particle (a one-particle body that does not spin), the

@@ -2,7 +2,8 @@
 //
 // Rules for every header in shaders/shared/ (see docs/architecture.md):
 //  - GLSL-spelled types only: float, int, uint, vec3, vec4, uvec4; no swizzles (write v.x, v.y).
-//  - Functions are declared MOTES_FN; out-parameters use MOTES_OUT(T) / MOTES_INOUT(T).
+//  - Functions are declared MOTES_FN; out-parameters use MOTES_OUT(T) / MOTES_INOUT(T); large
+//    read-only structs MOTES_IN(T) (a const reference in C++ and CUDA: no copy per call).
 //  - Float literals carry the f suffix (valid GLSL 4.50 and C++), so C++ never widens to double.
 //  - No pointers, templates, references or overloads that differ only by return type.
 //  - Types live in namespace motes::shared in C++ (MOTES_SHARED_BEGIN/END), globally in GLSL.
@@ -25,6 +26,7 @@
 #endif
 #define MOTES_INOUT(T) T&
 #define MOTES_OUT(T) T&
+#define MOTES_IN(T) const T&
 #define MOTES_SHARED_BEGIN \
   namespace motes {        \
   namespace shared {
@@ -106,6 +108,7 @@ MOTES_SHARED_END
 #define MOTES_FN
 #define MOTES_INOUT(T) inout T
 #define MOTES_OUT(T) out T
+#define MOTES_IN(T) in T
 #define MOTES_SHARED_BEGIN
 #define MOTES_SHARED_END
 vec3 xyz(vec4 v) { return vec3(v.x, v.y, v.z); }

@@ -48,31 +48,75 @@ MOTES_FN float impulse_margin(float skin) { return 0.1f * skin; }
 /// What a contact needs to know of one of its bodies. A plane or a static body has com.w == 0 and
 /// inv_inertia == 0, and so takes no part in the contact's effective mass.
 struct ImpulseBody {
-  vec4 com;          // xyz: centre of mass, w: inverse mass
-  vec4 quat;         // orientation, body (principal) frame to world
-  vec4 inv_inertia;  // inverse principal moments (body frame)
-  vec4 vel;          // linear velocity now (this iteration)
-  vec4 angvel;       // angular velocity now
-  vec4 vel0;         // xyz: linear velocity at the start of the impulse stage, w: its contacts
-  vec4 angvel0;      // angular velocity at the start of the impulse stage
+  vec4 com;       // xyz: centre of mass, w: inverse mass
+  vec4 inv_diag;  // world inverse inertia I^-1 = R diag(inverse moments) R^T: xx, yy, zz
+  vec4 inv_off;   // its off-diagonal terms: xy, xz, yz
+  vec4 vel;       // linear velocity now (this iteration)
+  vec4 angvel;    // angular velocity now
+  vec4 vel0;      // xyz: linear velocity at the start of the impulse stage, w: its contacts
+  vec4 angvel0;   // angular velocity at the start of the impulse stage
 };
 
-/// A body as the contacts of an impulse iteration see it: in the counting pass
-/// (MOTES_FLAG_IMPULSE_COUNT) the stage starts now, so its start is its present state.
-MOTES_FN ImpulseBody impulse_body_for(ImpulseBody b, uint flags) {
-  if ((flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
-    b.vel0 = vec4(xyz(b.vel), 1.0f);
-    b.angvel0 = b.angvel;
-  }
+/// The part of a body as contacts see it that a substep's sweeps do not change: its centre and
+/// inverse mass, and its inverse inertia turned to the world once (a contact applies it four
+/// times). Velocities zero: impulse_body_state fills them.
+MOTES_FN ImpulseBody impulse_body_frame(vec4 com, vec4 quat, vec4 inv_inertia) {
+  ImpulseBody b;
+  b.com = com;
+  // Columns of R: the body axes in the world; I^-1 = sum over k of inv_k c_k c_k^T.
+  vec3 c0 = quat_rotate(quat, vec3(1.0f, 0.0f, 0.0f));
+  vec3 c1 = quat_rotate(quat, vec3(0.0f, 1.0f, 0.0f));
+  vec3 c2 = quat_rotate(quat, vec3(0.0f, 0.0f, 1.0f));
+  vec3 a0 = c0 * inv_inertia.x;
+  vec3 a1 = c1 * inv_inertia.y;
+  vec3 a2 = c2 * inv_inertia.z;
+  b.inv_diag =
+      vec4(a0.x * c0.x + a1.x * c1.x + a2.x * c2.x, a0.y * c0.y + a1.y * c1.y + a2.y * c2.y,
+           a0.z * c0.z + a1.z * c1.z + a2.z * c2.z, 0.0f);
+  b.inv_off = vec4(a0.x * c0.y + a1.x * c1.y + a2.x * c2.y, a0.x * c0.z + a1.x * c1.z + a2.x * c2.z,
+                   a0.y * c0.z + a1.y * c1.z + a2.y * c2.z, 0.0f);
+  b.vel = vec4(0.0f);
+  b.angvel = vec4(0.0f);
+  b.vel0 = vec4(0.0f);
+  b.angvel0 = vec4(0.0f);
   return b;
+}
+
+/// A body's velocities now and at the substep's start into b; in the counting pass
+/// (MOTES_FLAG_IMPULSE_COUNT) the substep starts now, so its start is its present state.
+MOTES_FN void impulse_body_state(MOTES_INOUT(ImpulseBody) b, vec4 vel, vec4 angvel, vec4 vel0,
+                                 vec4 angvel0, uint flags) {
+  b.vel = vel;
+  b.angvel = angvel;
+  b.vel0 = vel0;
+  b.angvel0 = angvel0;
+  if ((flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
+    b.vel0 = vec4(xyz(vel), 1.0f);
+    b.angvel0 = angvel;
+  }
+}
+
+/// A body as the contacts of an impulse sweep see it, from its buffers' values.
+MOTES_FN ImpulseBody impulse_body_of(vec4 com, vec4 quat, vec4 inv_inertia, vec4 vel, vec4 angvel,
+                                     vec4 vel0, vec4 angvel0, uint flags) {
+  ImpulseBody b = impulse_body_frame(com, quat, inv_inertia);
+  impulse_body_state(b, vel, angvel, vel0, angvel0, flags);
+  return b;
+}
+
+/// The body's world inverse inertia applied to v: I^-1 v.
+MOTES_FN vec3 impulse_inverse_inertia(MOTES_IN(ImpulseBody) b, vec3 v) {
+  return vec3(b.inv_diag.x * v.x + b.inv_off.x * v.y + b.inv_off.y * v.z,
+              b.inv_off.x * v.x + b.inv_diag.y * v.y + b.inv_off.z * v.z,
+              b.inv_off.y * v.x + b.inv_off.z * v.y + b.inv_diag.z * v.z);
 }
 
 /// A body that takes no part: a plane.
 MOTES_FN ImpulseBody impulse_wall() {
   ImpulseBody w;
   w.com = vec4(0.0f);
-  w.quat = vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  w.inv_inertia = vec4(0.0f);
+  w.inv_diag = vec4(0.0f);
+  w.inv_off = vec4(0.0f);
   w.vel = vec4(0.0f);
   w.angvel = vec4(0.0f);
   w.vel0 = vec4(0.0f);
@@ -82,17 +126,23 @@ MOTES_FN ImpulseBody impulse_wall() {
 
 /// 1/m + (r x d) . I^-1 (r x d): the inverse mass a unit impulse along d at arm r meets, times
 /// the body's contact count (mass splitting). 0 for a wall or a static body.
-MOTES_FN float impulse_inverse_mass(ImpulseBody b, vec3 r, vec3 d) {
+MOTES_FN float impulse_inverse_mass(MOTES_IN(ImpulseBody) b, vec3 r, vec3 d) {
+  if (b.com.w == 0.0f) {
+    return 0.0f;  // a wall or a static body (inverse inertia 0 too): what the terms would give
+  }
   vec3 rd = cross(r, d);
-  float k = b.com.w + dot(rd, body_angular_velocity(b.quat, b.inv_inertia, rd));
+  float k = b.com.w + dot(rd, impulse_inverse_inertia(b, rd));
   return max(b.vel0.w, 1.0f) * k;
 }
 
 /// The change of the velocity of a body's material point at arm r that a unit impulse along d
 /// makes, as a contact sees it (times the body's contact count: mass splitting):
 /// n (d / m + (I^-1 (r x d)) x r). Its dot product with d is impulse_inverse_mass. 0 for a wall.
-MOTES_FN vec3 impulse_response(ImpulseBody b, vec3 r, vec3 d) {
-  vec3 w = body_angular_velocity(b.quat, b.inv_inertia, cross(r, d));
+MOTES_FN vec3 impulse_response(MOTES_IN(ImpulseBody) b, vec3 r, vec3 d) {
+  if (b.com.w == 0.0f) {
+    return vec3(0.0f);
+  }
+  vec3 w = impulse_inverse_inertia(b, cross(r, d));
   return (d * b.com.w + cross(w, r)) * max(b.vel0.w, 1.0f);
 }
 
@@ -109,18 +159,20 @@ MOTES_FN vec3 impulse_point_velocity(vec4 vel, vec4 angvel, vec3 r) {
 ///   relaxing sweeps (MOTES_FLAG_IMPULSE_RELAX): 0, so the speed of that correction moves the
 ///   pose but is not kept;
 /// - closing faster than resting contacts do, with e > 0: bounce at -e vn0 (Newton's law).
-/// soft: 1 where the correction is soft (an overlap, no bounce, not relaxing), else 0.
-MOTES_FN float impulse_target(float sep, float rsum, float vn0, float restitution,
-                              vec4 gravity_dt, uint flags, MOTES_OUT(float) soft) {
+/// soft: 1 in the sweeps with position correction unless the contact bounces, apart or not (the
+/// soft step's scale and leak then do not switch as a resting contact's gap crosses 0, where two
+/// backends' roundings of sep would otherwise part their trajectories), else 0.
+MOTES_FN float impulse_target(float sep, float rsum, float vn0, float restitution, vec4 gravity_dt,
+                              uint flags, MOTES_OUT(float) soft) {
   float dt = gravity_dt.w;
   soft = 0.0f;
   float target = -sep / dt;
+  if ((flags & MOTES_FLAG_IMPULSE_RELAX) == 0u) soft = 1.0f;
   if (sep <= 0.0f) {
     target = 0.0f;
     if ((flags & MOTES_FLAG_IMPULSE_RELAX) == 0u) {
       float overlap = max(-sep - MOTES_IMPULSE_SLOP * rsum, 0.0f);
       target = min(MOTES_IMPULSE_BIAS * overlap, MOTES_IMPULSE_PUSH_MAX * rsum) / dt;
-      soft = 1.0f;
     }
   }
   float bounce_speed = MOTES_IMPULSE_BOUNCE_SUBSTEPS * length(xyz(gravity_dt)) * dt;
@@ -159,8 +211,9 @@ MOTES_FN vec3 plane_contact_point(vec4 xa, vec4 normal_offset) {
 ///   sweeps converge to the simultaneous solution (projected Gauss-Seidel's rule, applied
 ///   Jacobi-style).
 /// With acc = 0 on entry every time (a contact without a slot), this is the plain impulse.
-MOTES_FN vec4 contact_impulse(ImpulseBody a, ImpulseBody b, vec3 c, vec3 n, float sep, float rsum,
-                              ContactLaw law, vec4 gravity_dt, uint flags, MOTES_INOUT(vec4) acc) {
+MOTES_FN vec4 contact_impulse(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, vec3 c, vec3 n,
+                              float sep, float rsum, ContactLaw law, vec4 gravity_dt, uint flags,
+                              MOTES_INOUT(vec4) acc) {
   vec3 ra = c - xyz(a.com);
   vec3 rb = c - xyz(b.com);
   vec3 u0 =
@@ -222,9 +275,9 @@ MOTES_FN vec4 contact_impulse(ImpulseBody a, ImpulseBody b, vec3 c, vec3 n, floa
 /// opposite impulses and bitwise equal totals: call with a = the lower id and negate for b.
 /// Zero (not counted, acc zeroed) when their gap is margin (impulse_margin) or more, or their
 /// centres coincide.
-MOTES_FN vec4 particle_contact_impulse(ImpulseBody a, vec4 xa, ImpulseBody b, vec4 xb, float margin,
-                                       ContactLaw law, vec4 gravity_dt, uint flags,
-                                       MOTES_INOUT(vec4) acc) {
+MOTES_FN vec4 particle_contact_impulse(MOTES_IN(ImpulseBody) a, vec4 xa, MOTES_IN(ImpulseBody) b,
+                                       vec4 xb, float margin, ContactLaw law, vec4 gravity_dt,
+                                       uint flags, MOTES_INOUT(vec4) acc) {
   vec3 d = xyz(xa) - xyz(xb);
   float dist2 = dot(d, d);
   float rsum = xa.w + xb.w;
@@ -247,9 +300,9 @@ MOTES_FN uint pair_law_index(uint i, uint mi, uint j, uint mj, uint materials) {
 /// The impulse on body `own` (w: counted) of its particle xi and particle xj of body `other`;
 /// own_first: xi has the lower particle id (see particle_contact_impulse). acc: the contact's
 /// accumulated impulse, as the lower id sees it (the same bits in both particles' slots).
-MOTES_FN vec4 pair_impulse(ImpulseBody own, vec4 xi, ImpulseBody other, vec4 xj, bool own_first,
-                           float margin, ContactLaw law, vec4 gravity_dt, uint flags,
-                           MOTES_INOUT(vec4) acc) {
+MOTES_FN vec4 pair_impulse(MOTES_IN(ImpulseBody) own, vec4 xi, MOTES_IN(ImpulseBody) other, vec4 xj,
+                           bool own_first, float margin, ContactLaw law, vec4 gravity_dt,
+                           uint flags, MOTES_INOUT(vec4) acc) {
   if (own_first) {
     return particle_contact_impulse(own, xi, other, xj, margin, law, gravity_dt, flags, acc);
   }
@@ -260,8 +313,8 @@ MOTES_FN vec4 pair_impulse(ImpulseBody own, vec4 xi, ImpulseBody other, vec4 xj,
 /// The impulse on body a of its particle xa and a static half-space plane (solid where
 /// dot(normal, x) < offset), at the particle's point nearest the plane, as a change of the
 /// contact's accumulated impulse acc (contact_impulse).
-MOTES_FN vec4 plane_contact_impulse(ImpulseBody a, vec4 xa, vec4 normal_offset, float margin,
-                                    ContactLaw law, vec4 gravity_dt, uint flags,
+MOTES_FN vec4 plane_contact_impulse(MOTES_IN(ImpulseBody) a, vec4 xa, vec4 normal_offset,
+                                    float margin, ContactLaw law, vec4 gravity_dt, uint flags,
                                     MOTES_INOUT(vec4) acc) {
   vec3 np = xyz(normal_offset);
   float sep = dot(np, xyz(xa)) - normal_offset.w - xa.w;
@@ -279,6 +332,26 @@ MOTES_FN vec4 plane_contact_impulse(ImpulseBody a, vec4 xa, vec4 normal_offset, 
 /// memory (acc = 0 each time), and stay bitwise opposite.
 MOTES_FN bool impulse_pair_slotted(uint ci, uint cj, uint capacity) {
   return ci <= capacity && cj <= capacity;
+}
+
+/// True when the contact of particle i (stamp si) and particle j (stamp sj; static: its inverse
+/// mass vj_inv_mass is 0) may start from its accumulated impulse at the counting pass of build
+/// `builds`: both particles' slots were written under this build, or under the last one with the
+/// same list (neighbour_keeps_slots moved their stamp on). Both particles of a pair decide alike,
+/// so their slots keep holding the same bits. A static particle evaluates no contact (no list):
+/// only i's side counts then.
+MOTES_FN bool impulse_slots_valid(uint si, uint sj, float vj_inv_mass, uint builds) {
+  return si == builds && (vj_inv_mass == 0.0f || sj == builds);
+}
+
+/// neighbours_build, for a rigid particle whose slots were valid under the last build (its stamp
+/// equals that build's count): true when its new list is the old one, entry for entry (the same
+/// count, the same particles in the same order), so its slots still name the same contacts and
+/// its stamp moves on to the new build. A particle near nothing that moved keeps its list: a
+/// rebuild that something far away asked for does not cost a resting stack its memory.
+MOTES_FN bool neighbour_keeps_slots(uint old_count, uint new_count, bool same_entries,
+                                    uint capacity) {
+  return old_count == new_count && new_count <= capacity && same_entries;
 }
 
 /// Adds a contact's impulse r (w: counted) at point c to a particle's sums: the impulse and count

@@ -23,6 +23,8 @@ MOTES_SHARED_BEGIN
 /// particles_update: first hand what the constraints did to each rigid particle to its body, as
 /// an impulse (shared/body_math.h: particle_absorbed_impulse) into ParticleForce and its moment
 /// into ParticleMoment (cloth and ropes attached to rigid bodies); then the pose as always.
+/// impulses_apply: the impulses to apply are those (every particle may have one), not the
+/// impulse stage's.
 #define MOTES_FLAG_ABSORB 32u
 /// constraints_solve: also ask for a neighbour-list rebuild when a particle it moved is too far
 /// from where the lists were built. Set on the last sweep of a substep only: the positions of the

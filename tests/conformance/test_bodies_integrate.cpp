@@ -40,10 +40,10 @@ class BodiesIntegrate : public DeviceTest {
                               rng.uniform(-2.0f, 2.0f), 0.0f);
         // Some bodies do not turn with the push (L = 0: the no-rotation branch).
         // |L| up to 1e-3 with I^-1 up to 1e5: |w| up to 100 rad/s, as random_bodies' own.
-        angmom_push.push_back(rng.chance(0.2f) ? vec4(0.0f)
-                                               : vec4(rng.uniform(-1e-3f, 1e-3f),
-                                                      rng.uniform(-1e-3f, 1e-3f),
-                                                      rng.uniform(-1e-3f, 1e-3f), 0.0f));
+        angmom_push.push_back(rng.chance(0.2f)
+                                  ? vec4(0.0f)
+                                  : vec4(rng.uniform(-1e-3f, 1e-3f), rng.uniform(-1e-3f, 1e-3f),
+                                         rng.uniform(-1e-3f, 1e-3f), 0.0f));
       }
       w.sizes.impulse = 1;
       w.params.flags |= MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_PUSH;

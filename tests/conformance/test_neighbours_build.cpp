@@ -12,6 +12,12 @@
 // pair across the cutoff; the order is the canonical walk, which the oracle writes differently (as
 // the first occurrence of each bucket among the 27 cells, then grid order), by brute force.
 //
+// With impulse contacts (ImpulseStampKept*), the lists of the last build are written too, most of
+// them equal to the new ones and some changed (an entry replaced, two swapped, one dropped), with
+// ImpulseStamp at the last build's count for most rigid particles: the stamps read back must
+// equal the oracle's (motes_ref::impulse_stamps_after_build: moved on where the list is unchanged),
+// bitwise.
+//
 // neighbours_update: with the rebuild word 0 nothing may be written (every grid and list buffer
 // comes back poisoned); with it set, the grid and the lists must equal the oracle's.
 #include <gtest/gtest.h>
@@ -111,6 +117,81 @@ class NeighboursBuild : public ListTest {
 
     begin_case("neighbours_build/" + layout, n);
     check_lists(list, count, ref, state, want, w.params.neighbour_capacity);
+    end_case();
+  }
+};
+
+class NeighboursBuildStamps : public ListTest {
+ protected:
+  void run_case(const std::string& layout, World w) {
+    w.sizes.impulse = 1;
+    const motes_ref::Grid g = motes_ref::grid_build(w.particles, w.params);
+    const motes_ref::Neighbours want = motes_ref::neighbours_build(w.particles, g, w.params);
+    const std::size_t n = w.particles.size();
+    const std::size_t nr = w.particles.rigid;
+    const uint capacity = w.params.neighbour_capacity;
+    // The last build's lists: the new ones, some changed.
+    Rng rng(static_cast<std::uint32_t>(n) + 91u);
+    std::vector<uint> old_list = list_buffer(want, capacity);
+    std::vector<uint> old_count = want.count;
+    std::size_t changed = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const uint c = std::min(old_count[i], capacity);
+      if (c == 0 || !rng.chance(0.3f)) continue;
+      ++changed;
+      const float how = rng.unit();
+      if (how < 0.4f) {
+        old_list[std::size_t{rng.below(c)} * n + i] = rng.below(static_cast<uint>(n));
+      } else if (how < 0.7f && c >= 2) {
+        std::swap(old_list[0 * n + i], old_list[std::size_t{c - 1} * n + i]);
+      } else {
+        old_count[i] -= 1;
+      }
+    }
+    const uint built = kBuildsBefore;
+    std::vector<uint> stamp(nr);
+    for (uint& s : stamp) s = rng.chance(0.8f) ? built : built - 1u;
+    std::vector<uint> want_stamp = stamp;
+    motes_ref::impulse_stamps_after_build(w.particles, old_list, old_count, want, w.params, built,
+                                          want_stamp);
+    std::size_t moved = 0;
+    for (std::size_t i = 0; i < nr; ++i) moved += want_stamp[i] != stamp[i] ? 1 : 0;
+
+    ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
+    ASSERT_NO_FATAL_FAILURE(
+        poison_all_but({Buffer::ParticlePos, Buffer::ParticleVel, Buffer::ParticleBody,
+                        Buffer::GridOrder, Buffer::GridCellStart, Buffer::SortedPos,
+                        Buffer::SortedBody, Buffer::NeighbourState, Buffer::LinkExclusions,
+                        Buffer::NeighbourList, Buffer::NeighbourCount, Buffer::ImpulseStamp}));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::LinkExclusions, w.link_exclusions));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleVel, w.particles.vel));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleBody, w.particles.body));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::GridOrder, g.order));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::GridCellStart, g.cell_start));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::SortedPos, g.sorted_pos));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::SortedBody, g.sorted_body));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourList, old_list));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourCount, old_count));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ImpulseStamp, stamp));
+    ASSERT_NO_FATAL_FAILURE(
+        write(Buffer::NeighbourState, std::vector<uint>{1u, kBuildsBefore, 77u, 88u}));
+    device().neighbours_build(w.params);
+    ASSERT_NO_FATAL_FAILURE(finish_kernel());
+
+    std::vector<uint> list, count, state, got_stamp;
+    std::vector<vec4> ref;
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourList, list));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourCount, count));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourRefPos, ref));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourState, state));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::ImpulseStamp, got_stamp));
+
+    begin_case("neighbours_build/" + layout, n);
+    check_lists(list, count, ref, state, want, capacity);
+    check_identical("ImpulseStamp", got_stamp, want_stamp);
+    check_that("some lists changed and some stamps moved on",
+               n < 31 || (changed > 0 && moved > 0 && moved < nr));
     end_case();
   }
 };
@@ -237,6 +318,16 @@ class NeighboursUpdate : public ListTest {
     end_case();
   }
 };
+
+TEST_P(NeighboursBuildStamps, Random1234) {
+  run_case("impulse stamps", random_world(211, 1234, MOTES_FLAG_IMPULSE, kTestSkin));
+}
+TEST_P(NeighboursBuildStamps, CapacityTwo) {
+  run_case("impulse stamps K = 2",
+           with_capacity(random_world(212, 1234, MOTES_FLAG_IMPULSE, kTestSkin), 2));
+}
+INSTANTIATE_TEST_SUITE_P(Conformance, NeighboursBuildStamps, testing::ValuesIn(device_params()),
+                         param_name);
 
 TEST_P(NeighboursUpdate, NoRebuild) {
   run_case("random", random_world(221, 1234, 0, kTestSkin), false);

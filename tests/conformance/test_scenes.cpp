@@ -41,8 +41,16 @@
 // as well, so their velocities take the cloth's bound.
 //
 // Impulse dominoes (impulse_dominoes.json) 0.2 s in, against openmp only: the oracle's whole
-// step has no impulse stage (the impulses/* cases check the kernels against their oracle). Its
-// positions and velocities meet the rigid bounds above.
+// step has no impulse stage (the impulses/* cases check the kernels against their oracle). After
+// 1 step and after 10 (not 50), within the rigid bounds of 1 and of 50 steps. The impulse solver
+// makes discrete decisions (a contact within reach or not counts for mass splitting; a parting
+// contact drops its warm start), so a difference of rounding that tips one parts the two
+// trajectories by a contact's share of an impulse, and the warm start, kept from list build to
+// list build, carries it on. Measured on openmp alone, the start velocities of half the particles
+// and bodies moved by one ulp: at most 1.3e-7 m/s apart through step 10, then 1e-5 to 2e-4 after
+// the first such decision (steps 12 to 20) and 1e-4 to 2.5e-3 by step 50, whatever the split of
+// sweeps; Vulkan (lavapipe) against openmp: 6e-8 m/s after 1 step, 4.4e-5 after 10, 5.4e-4 after
+// 50. Beyond 10 steps the comparison would measure the scene's chaos, not the backend.
 //
 // Every kind at once (mixed.json: a rigid die and a soft cube landing in a cloth hammock, a rope
 // across it) right after the first touch: the soft, cloth and rope particles take the cloth's
@@ -209,7 +217,8 @@ class Scenes : public DeviceTest {
 
   /// `contacts`: the window must have contacts (pendulum.json has none: it tests the ropes'
   /// attachments to their bobs).
-  void run_window(const std::string& name, bool contacts = true) {
+  /// `last`: the second comparison's step (50; fewer where the scene's own chaos would decide).
+  void run_window(const std::string& name, bool contacts = true, std::uint64_t last = 50) {
     const motes::Result<Window>& w = window(name);
     ASSERT_TRUE(w) << name << ": " << w.message();
     std::unique_ptr<motes::Simulation> sim;
@@ -226,7 +235,7 @@ class Scenes : public DeviceTest {
     const bool impulses = w.value().scene.settings.contact_model == motes::ContactModel::Impulses;
 
     std::uint64_t done = 0;
-    for (const std::uint64_t steps : {std::uint64_t{1}, std::uint64_t{50}}) {
+    for (const std::uint64_t steps : {std::uint64_t{1}, last}) {
       ASSERT_TRUE(sim->step(steps - done));
       oracle.step(steps - done);
       if (reference) {
@@ -303,7 +312,7 @@ class Scenes : public DeviceTest {
 };
 
 TEST_P(Scenes, DominoesWindow) { run_window("dominoes.json"); }
-TEST_P(Scenes, ImpulseDominoesWindow) { run_window("impulse_dominoes.json"); }
+TEST_P(Scenes, ImpulseDominoesWindow) { run_window("impulse_dominoes.json", true, 10); }
 TEST_P(Scenes, DiceWindow) { run_window("dice.json"); }
 TEST_P(Scenes, BunnyWindow) { run_window("bunny.json"); }
 TEST_P(Scenes, SettleWindow) { run_window("settle_pressed"); }

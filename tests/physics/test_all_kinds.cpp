@@ -1,10 +1,19 @@
 // Every kind of object in one gravity-free collision (issue 11, two-way coupling): a rigid box, a
 // one-particle rigid sphere, a soft box, a cloth and a rope, thrown at one point from six sides,
 // meet in the one collision grid. Whatever one object takes from another, the other gets back in
-// the same step, so the total linear momentum, sum of m v over every object, must stay as it was:
-// 1e-6 relative after 0.1 s (the objects meet after about 0.02 s and tangle). Run with the force
-// law everywhere, and with impulse contacts between the rigid bodies (the other pairs keep the
-// force law). Each object must have changed its velocity, or it did not take part.
+// the same step, so the total linear momentum, sum of m v over every object, must stay as it was
+// up to single-precision rounding after 0.1 s (the objects meet after about 0.02 s and tangle).
+// Run with the force law everywhere, and with impulse contacts between the rigid bodies (the other
+// pairs keep the force law). Each object must have changed its velocity, or it did not take part.
+//
+// The rounding: every pair's impulses are bitwise opposite, but each body adds its particles'
+// impulses in float and rounds v += J / m, so every sweep leaves an error of about 6e-8 of the
+// impulse it applied, a random walk over the sweeps. Measured (openmp, the rigid box's start
+// velocity scaled by 1 + 3e-7 k for k = 0..9, which changes nothing but the rounding): the force
+// law drifts 0.9e-7 to 8.0e-7 of the total, the impulse model (16 sweeps a step, 4 of them in
+// each of 4 substeps) 1.7e-7 to 3.1e-6. Bounds: 1e-6 for the force law, 1e-5 for impulses. A real
+// leak shows far above: one contact's impulse applied to one side only (m dv ~ 1e-3 kg m/s against
+// a total of 0.021) is 5e-2.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -114,7 +123,7 @@ TEST_P(AllKinds, GravityFreeCollisionKeepsMomentum) {
   std::printf(
       "[all kinds] total momentum (%.6g, %.6g, %.6g) -> (%.6g, %.6g, %.6g): %.2e relative\n",
       p0.x(), p0.y(), p0.z(), p1.x(), p1.y(), p1.z(), drift);
-  EXPECT_LT(drift, 1e-6);
+  EXPECT_LT(drift, GetParam() == motes::ContactModel::Impulses ? 1e-5 : 1e-6);
 }
 
 INSTANTIATE_TEST_SUITE_P(ContactModels, AllKinds,

@@ -165,14 +165,14 @@ bool clusters_goal(Particles& particles, const std::vector<ClusterMember>& membe
 /// The state of the impulse stage (MOTES_FLAG_IMPULSE) that impulses_compute and impulses_apply
 /// read or write besides the particles and bodies.
 struct ImpulseState {
-  std::vector<vec4> vel0;     ///< B: BodyVelStart (w: the body's counted contacts)
-  std::vector<vec4> angvel0;  ///< B: BodyAngVelStart
-  std::vector<vec4> acc;      ///< (K + P) x Nr: ContactImpulse, slot k of particle i at k Nr + i
-  std::vector<uint> stamp;    ///< Nr: ImpulseStamp
-  uint builds = 0;            ///< NeighbourState[MOTES_NEIGHBOUR_BUILDS]
-  std::vector<vec4> impulse;  ///< Nr: ParticleForce (xyz impulse, w counted contacts)
-  std::vector<vec4> moment;   ///< Nr: ParticleMoment
-  std::vector<vec4> vel_push;     ///< B: BodyVelPush (written with MOTES_FLAG_IMPULSE_PUSH)
+  std::vector<vec4> vel0;      ///< B: BodyVelStart (w: the body's counted contacts)
+  std::vector<vec4> angvel0;   ///< B: BodyAngVelStart
+  std::vector<vec4> acc;       ///< (K + P) x Nr: ContactImpulse, slot k of particle i at k Nr + i
+  std::vector<uint> stamp;     ///< Nr: ImpulseStamp
+  uint builds = 0;             ///< NeighbourState[MOTES_NEIGHBOUR_BUILDS]
+  std::vector<vec4> impulse;   ///< Nr: ParticleForce (xyz impulse, w counted contacts)
+  std::vector<vec4> moment;    ///< Nr: ParticleMoment
+  std::vector<vec4> vel_push;  ///< B: BodyVelPush (written with MOTES_FLAG_IMPULSE_PUSH)
   std::vector<vec4> angmom_push;  ///< B: BodyAngMomPush
 };
 
@@ -181,17 +181,28 @@ struct ImpulseState {
 /// from its list, or walks in the grid beyond K), each with shared::pair_impulse (lower id first)
 /// and the accumulated impulse of i's slot k (shared::impulse_pair_slotted; an unslotted contact
 /// starts from 0 and keeps nothing), then the planes (slot K + k) with plane_contact_impulse; the
-/// counting pass reads slots only when stamp[i] == builds, and sets stamp[i]. Summed in float in
-/// that order (shared::impulse_add), as the contract says.
+/// counting pass reads a pair's slot only when shared::impulse_slots_valid (both particles'
+/// stamps are builds, or the other is static). Summed in float in that order
+/// (shared::impulse_add), as the contract says.
 void impulses_compute(const Particles& particles, const Bodies& bodies, const Neighbours& nb,
                       const std::vector<ContactLaw>& laws, const std::vector<PlaneData>& planes,
                       const StepParams& p, ImpulseState& s);
 
 /// impulses_apply: each dynamic body's particles' impulses, counts and moments summed in float in
-/// particle order; the counting pass first keeps vel0 = (vel, count) and angvel0 = angvel; then
+/// particle order; the counting pass first keeps vel0 = (vel, count) and angvel0 = angvel and
+/// stamps the dynamic bodies' particles with builds; then
 /// shared::body_apply_impulse (static bodies: angvel from angmom only); with
 /// MOTES_FLAG_IMPULSE_PUSH, vel_push and angmom_push = what it leaves.
 void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s);
+
+/// What neighbours_build does to ImpulseStamp (impulse contacts): each rigid particle i whose
+/// stamp is `built` (the last build's count) and whose new list `now` equals its old one
+/// (old_list: the NeighbourList buffer before the build, entry k at k N + i; old_count: the
+/// NeighbourCount before) by shared::neighbour_keeps_slots gets stamp built + 1; the others keep
+/// theirs. Static particles (no list) keep theirs.
+void impulse_stamps_after_build(const Particles& particles, const std::vector<uint>& old_list,
+                                const std::vector<uint>& old_count, const Neighbours& now,
+                                const StepParams& p, uint built, std::vector<uint>& stamp);
 
 /// halo_pack: for each particle entry k < p.halo_particles, the particle i = index[p.halo_first +
 /// k]: data[2k] = its position, data[2k + 1] = its velocity; then for each body entry j <

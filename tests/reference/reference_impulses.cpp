@@ -15,15 +15,9 @@ using motes::shared::xyz;
 namespace {
 
 ImpulseBody impulse_body(const Bodies& bodies, const ImpulseState& s, uint b, uint flags) {
-  ImpulseBody out;
-  out.com = bodies.pos[b];
-  out.quat = bodies.quat[b];
-  out.inv_inertia = bodies.inv_inertia[b];
-  out.vel = bodies.vel[b];
-  out.angvel = bodies.angvel[b];
-  out.vel0 = s.vel0[b];
-  out.angvel0 = s.angvel0[b];
-  return motes::shared::impulse_body_for(out, flags);
+  return motes::shared::impulse_body_of(bodies.pos[b], bodies.quat[b], bodies.inv_inertia[b],
+                                        bodies.vel[b], bodies.angvel[b], s.vel0[b], s.angvel0[b],
+                                        flags);
 }
 
 }  // namespace
@@ -41,7 +35,6 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
     if (particles.vel[i].w == 0.0f) continue;
     const vec4 xi = particles.pos[i];
     const ImpulseBody own = impulse_body(bodies, s, particles.body[i], p.flags);
-    const bool valid = !counting || s.stamp[i] == s.builds;
     vec4 sum(0.0f);
     vec3 moment(0.0f);
     const std::vector<uint>& list = nb.lists[i];
@@ -50,6 +43,8 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
       if (j >= nr) continue;
       const bool slotted = motes::shared::impulse_pair_slotted(nb.count[i], nb.count[j], capacity);
       vec4& slot = s.acc[k * nr + i];  // only touched when slotted (then k < K)
+      const bool valid = !counting || motes::shared::impulse_slots_valid(
+                                          s.stamp[i], s.stamp[j], particles.vel[j].w, s.builds);
       vec4 a = slotted && valid ? slot : vec4(0.0f);
       const uint law = motes::shared::pair_law_index(static_cast<uint>(i), particles.material[i], j,
                                                      particles.material[j], p.material_count);
@@ -70,7 +65,6 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
       motes::shared::impulse_add(sum, moment, r,
                                  motes::shared::plane_contact_point(xi, pl.normal_offset), own.com);
     }
-    if (counting) s.stamp[i] = s.builds;
     s.impulse[i] = sum;
     s.moment[i] = vec4(moment, 0.0f);
   }
@@ -95,6 +89,9 @@ void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s) {
     if (counting) {
       s.vel0[b] = vec4(xyz(bodies.vel[b]), sum.w);
       s.angvel0[b] = bodies.angvel[b];
+      if (bodies.pos[b].w != 0.0f) {
+        for (uint i = bodies.first[b]; i < bodies.first[b + 1]; ++i) s.stamp[i] = s.builds;
+      }
     }
     motes::shared::body_apply_impulse(bodies.pos[b], bodies.quat[b], bodies.inv_inertia[b],
                                       bodies.vel[b], bodies.angmom[b], bodies.angvel[b], xyz(sum),
@@ -102,6 +99,24 @@ void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s) {
     if (push) {
       s.vel_push[b] = bodies.vel[b];
       s.angmom_push[b] = bodies.angmom[b];
+    }
+  }
+}
+
+void impulse_stamps_after_build(const Particles& particles, const std::vector<uint>& old_list,
+                                const std::vector<uint>& old_count, const Neighbours& now,
+                                const StepParams& p, uint built, std::vector<uint>& stamp) {
+  const std::size_t n = now.count.size();
+  for (std::size_t i = 0; i < stamp.size() && i < n; ++i) {
+    if (stamp[i] != built || particles.vel[i].w == 0.0f) continue;
+    const std::vector<uint>& list = now.lists[i];
+    bool same = true;
+    for (std::size_t k = 0; k < list.size() && k < p.neighbour_capacity; ++k) {
+      same = same && old_list[k * n + i] == list[k];
+    }
+    if (motes::shared::neighbour_keeps_slots(old_count[i], now.count[i], same,
+                                             p.neighbour_capacity)) {
+      stamp[i] = built + 1u;
     }
   }
 }

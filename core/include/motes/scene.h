@@ -58,8 +58,8 @@ struct Settings {
   /// Rigid-body contacts by forces (default) or by impulses ("contact_model": "impulse").
   ContactModel contact_model = ContactModel::Forces;
   /// Impulse contacts: sweeps over every contact per substep, spread over impulse_substeps (each
-  /// gets ceil(impulse_iterations / impulse_substeps): the first half correct overlaps, the rest
-  /// relax; docs/architecture.md, "Impulse contacts").
+  /// gets ceil(impulse_iterations / impulse_substeps): the first corrects overlaps, the rest relax;
+  /// docs/architecture.md, "Impulse contacts").
   int impulse_iterations = 16;
   /// Impulse contacts: the impulse stage's own substeps per substep (the contacts found once).
   int impulse_substeps = 4;

@@ -1,0 +1,65 @@
+// Seeded random impulse scenes for the property tests (test_impulse_properties.cpp): domino
+// chains, piles, stacks and pyramids, drops onto piles and into corners, and bodies wedged
+// between the floor and others, each from one seed, each set at its own place on one floor so
+// that many run side by side in one simulation (a batch) without touching.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "motes/scene.h"
+
+namespace motes_props {
+
+/// The kinds of scene, as issue 25 lists them.
+enum class Kind { Chain, Pile, Stack, Drop, Wedge };
+inline constexpr Kind kKinds[] = {Kind::Chain, Kind::Pile, Kind::Stack, Kind::Drop, Kind::Wedge};
+
+const char* kind_name(Kind k);
+std::optional<Kind> kind_from_name(std::string_view name);
+
+/// Every case shares these: 1 cm particles, dt = 0.5 ms, impulse contacts with the default sweeps
+/// and substeps, gravity -9.81 m/s^2 along y, one floor plane at y = 0.
+inline constexpr double kDiameter = 0.01;
+inline constexpr double kDt = 5.0e-4;
+
+/// One generated scene.
+struct Case {
+  Kind kind = Kind::Chain;
+  std::uint32_t seed = 0;
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< where it stands on the floor
+  motes::Material material;                          ///< its bodies' (friction, restitution)
+  std::vector<motes::BodySpec> bodies;               ///< world positions, static walls included
+  /// Every dynamic body must be at rest over [rest_from, duration]: drift below 1% of a diameter
+  /// and speed below kRestSpeed, except the bodies that may roll.
+  bool settles = false;
+  double rest_from = 0.0;
+  double duration = 3.0;       ///< simulated seconds the case needs
+  std::vector<bool> may_roll;  ///< per body: a sphere or a rod of spheres rolls forever
+  std::string summary;         ///< one line: what was drawn
+};
+
+/// Rest: speed below this (m/s) at the end, besides the drift bound.
+inline constexpr double kRestSpeed = 2.0e-3;
+
+/// The case of `kind` drawn from `seed` (the same on every machine: its own generator, no
+/// std::uniform_*_distribution, whose results the standard leaves to the library). Its origin
+/// depends on the seed only (slot seed % 256 of a 16 x 16 grid, 2 m apart), so a case runs to the
+/// same bits alone or in a batch of other seeds.
+Case make_case(Kind kind, std::uint32_t seed);
+
+/// Cases side by side in one scene: the floor, one material per case (and the floor's), the
+/// bodies of case k at [first_body[k], first_body[k + 1]).
+struct Batch {
+  motes::Scene scene;
+  std::vector<std::size_t> first_body;
+};
+
+/// Fails (empty scene, error in `why`) if two cases share a slot (seeds equal modulo 256).
+Batch make_batch(const std::vector<Case>& cases, std::string& why);
+
+}  // namespace motes_props

@@ -1,0 +1,326 @@
+// Property tests of impulse contacts (issue 25; docs/validation.md, "Random impulse scenes"):
+// scenes drawn from seeds (random_scenes.h: domino chains, piles, stacks and pyramids with
+// offsets, drops onto piles and into corners, bodies wedged between the floor and others) run
+// on every backend, many side by side in one simulation, each checked on its own:
+// - energy: its kinetic + potential energy never rises above its start by more than
+//   kEnergyMargin of its energy scale (its start's kinetic energy + m g h of its bodies above the
+//   floor): impulses with restitution at most 1 and Coulomb friction cannot add energy;
+// - no guard warning: no particle travels more than Simulation::kSafeTravel of its diameter per
+//   substep (what the motion guard warns about), nothing is NaN or infinite;
+// - rest, where the scene should settle: over [rest_from, end] no particle of a body that does not
+//   roll drifts 1% of a diameter, and each such body ends slower than kRestSpeed.
+// A failure prints the seed and how to replay it (alone, or its whole batch: the same bits).
+//
+// Environment: MOTES_PROPERTY_SEEDS (seeds per kind; default: openmp 40, vulkan 8, cuda 8),
+// MOTES_PROPERTY_FIRST (first seed, default 1), MOTES_PROPERTY_KIND (only this kind),
+// MOTES_PROPERTY_BATCH (cases per simulation, default 20), MOTES_PROPERTY_SEED (one seed alone);
+// to look into a failure, MOTES_PROPERTY_TRACE=1 (each case's fastest body every 25 ms, the
+// particles that drifted) and MOTES_PROPERTY_ITERATIONS / MOTES_PROPERTY_SUBSTEPS (the scene's
+// impulse_iterations and impulse_substeps instead of the defaults).
+// scripts/gpu/run-suite.sh runs thousands on the GPU machine.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "motes/devices.h"
+#include "motes/simulation.h"
+#include "random_scenes.h"
+
+namespace motes_props {
+namespace {
+
+/// Energy may rise above the start by this fraction of the case's energy scale: what the position
+/// correction may lift (overlaps pushed out) and float rounding, not what an instability gives.
+constexpr double kEnergyMargin = 0.01;
+constexpr int kChunk = 50;  // steps between looks at the state (25 ms)
+
+Eigen::Vector3d v3(const motes::shared::vec4& v) {
+  return {static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z)};
+}
+double vlen(const motes::shared::vec4& v) { return v3(v).norm(); }
+
+/// What one case did.
+struct Outcome {
+  double scale = 0.0;   // J
+  double rise = 0.0;    // largest energy rise above the start, fraction of the scale
+  double travel = 0.0;  // largest travel per substep, in diameters
+  double drift = 0.0;   // largest drift over the rest window, in diameters (settling cases)
+  double speed = 0.0;   // fastest non-rolling body at the end (settling cases)
+  std::string failure;  // empty: passed
+};
+
+int env_int(const char* name, int fallback) {
+  const char* v = std::getenv(name);
+  return v != nullptr && *v != '\0' ? std::atoi(v) : fallback;
+}
+
+/// Energy of case k (bodies [first, last)) in a snapshot: 1/2 m v^2 + 1/2 L.w + m g y.
+double case_energy(const motes::Snapshot& s, std::size_t first, std::size_t last) {
+  double e = 0.0;
+  for (std::size_t b = first; b < last; ++b) {
+    const double inv_m = static_cast<double>(s.body_pos[b].w);
+    if (inv_m == 0.0) continue;
+    e += 0.5 * v3(s.body_vel[b]).squaredNorm() / inv_m;
+    e += 0.5 * v3(s.body_angmom[b]).dot(v3(s.body_angvel[b]));
+    e += 9.81 * static_cast<double>(s.body_pos[b].y) / inv_m;
+  }
+  return e;
+}
+
+/// Runs `cases` side by side on `backend`; one outcome per case.
+std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Case>& cases,
+                               std::string& skip) {
+  std::vector<Outcome> out(cases.size());
+  std::string why;
+  Batch batch = make_batch(cases, why);
+  if (!why.empty()) {
+    for (Outcome& o : out) o.failure = why;
+    return out;
+  }
+  // Experiments: other sweeps or substeps than the defaults every scene gets.
+  if (const int v = env_int("MOTES_PROPERTY_ITERATIONS", 0); v > 0) {
+    batch.scene.settings.impulse_iterations = v;
+  }
+  if (const int v = env_int("MOTES_PROPERTY_SUBSTEPS", 0); v > 0) {
+    batch.scene.settings.impulse_substeps = v;
+  }
+  motes::Result<std::unique_ptr<motes::Device>> device = motes::open_device(backend, -1, {});
+  if (!device) {
+    skip = device.message();
+    return out;
+  }
+  auto sim = motes::Simulation::create(batch.scene, std::move(device).value());
+  if (!sim) {
+    for (Outcome& o : out) o.failure = sim.message();
+    return out;
+  }
+  motes::Simulation& s = *sim.value();
+  const std::vector<std::size_t>& first = batch.first_body;
+  const std::vector<motes::BodyInfo>& info = s.bodies();
+  const auto particles_of = [&](std::size_t k) {
+    const motes::BodyInfo& a = info[first[k]];
+    const motes::BodyInfo& z = info[first[k + 1] - 1];
+    return std::pair<std::size_t, std::size_t>{a.first_particle,
+                                               z.first_particle + z.particle_count};
+  };
+  motes::Result<motes::Snapshot> start = s.snapshot();
+  if (!start) {
+    for (Outcome& o : out) o.failure = start.message();
+    return out;
+  }
+  std::vector<double> e0(cases.size());
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    e0[k] = case_energy(*start, first[k], first[k + 1]);
+    out[k].scale = e0[k];  // m g h above the floor (y = 0) + the start's kinetic energy
+  }
+  const double h = s.settings().dt / s.settings().substeps;
+  std::vector<std::vector<motes::shared::vec4>> rest_pos(cases.size());
+  const bool trace = env_int("MOTES_PROPERTY_TRACE", 0) != 0;  // the fastest body every look
+  const double duration = batch.scene.settings.duration;
+  const auto steps = static_cast<std::uint64_t>(std::llround(duration / s.settings().dt));
+  for (std::uint64_t done = 0; done < steps;) {
+    const std::uint64_t n = std::min<std::uint64_t>(kChunk, steps - done);
+    motes::Status st = s.step(n);
+    done += n;
+    motes::Result<motes::Snapshot> snap = st ? s.snapshot() : motes::Result<motes::Snapshot>(st);
+    if (!snap) {
+      for (Outcome& o : out) {
+        if (o.failure.empty()) o.failure = "the run stopped: " + snap.message();
+      }
+      return out;
+    }
+    const double t = s.time();
+    if (trace) {
+      for (std::size_t k = 0; k < cases.size(); ++k) {
+        double fastest = 0.0;
+        std::size_t which = 0;
+        for (std::size_t b = first[k]; b < first[k + 1]; ++b) {
+          const double v = vlen(snap->body_vel[b]);
+          if (v > fastest) {
+            fastest = v;
+            which = b - first[k];
+          }
+        }
+        const std::size_t b = first[k] + which;
+        const motes::shared::vec4 x = snap->body_pos[b], v = snap->body_vel[b],
+                                  w = snap->body_angvel[b];
+        std::printf(
+            "trace %s %u t %.3f fastest body %zu (%u particles) at %.3g m/s: x (%.4f %.4f "
+            "%.4f) v (%.4f %.4f %.4f) w (%.3f %.3f %.3f)\n",
+            kind_name(cases[k].kind), cases[k].seed, t, which, info[b].particle_count, fastest,
+            double{x.x}, double{x.y}, double{x.z}, double{v.x}, double{v.y}, double{v.z},
+            double{w.x}, double{w.y}, double{w.z});
+      }
+    }
+    for (std::size_t k = 0; k < cases.size(); ++k) {
+      Outcome& o = out[k];
+      if (t > std::max(cases[k].duration, duration) + 1e-9) continue;
+      const double rise = (case_energy(*snap, first[k], first[k + 1]) - e0[k]) / o.scale;
+      if (!(rise == rise)) {
+        o.failure =
+            o.failure.empty() ? fmt::format("non-finite state at t = {:.3f} s", t) : o.failure;
+        continue;
+      }
+      o.rise = std::max(o.rise, rise);
+      const auto [lo, hi] = particles_of(k);
+      for (std::size_t i = lo; i < hi; ++i) {
+        const double d = 2.0 * static_cast<double>(snap->particle_pos[i].w);
+        const double travel = vlen(snap->particle_vel[i]) * h / d;
+        if (!(travel == travel)) o.travel = 1e30;
+        o.travel = std::max(o.travel, travel);
+      }
+      if (cases[k].settles && rest_pos[k].empty() && t >= cases[k].rest_from - 1e-9) {
+        rest_pos[k].assign(snap->particle_pos.begin() + static_cast<std::ptrdiff_t>(lo),
+                           snap->particle_pos.begin() + static_cast<std::ptrdiff_t>(hi));
+      }
+      if (cases[k].settles && t >= cases[k].duration - 1e-9) {
+        for (std::size_t b = first[k]; b < first[k + 1]; ++b) {
+          const std::size_t c = b - first[k];
+          if (cases[k].may_roll[c] || info[b].kind == motes::BodyKind::Static) continue;
+          const motes::BodyInfo& bi = info[b];
+          for (std::size_t i = bi.first_particle; i < bi.first_particle + bi.particle_count; ++i) {
+            const motes::shared::vec4 a = rest_pos[k][i - lo];
+            const double dx = (v3(snap->particle_pos[i]) - v3(a)).norm();
+            o.drift = std::max(o.drift, dx / (2.0 * static_cast<double>(a.w)));
+            if (trace && dx > 0.005 * 2.0 * static_cast<double>(a.w)) {
+              std::printf("trace %s %u body %zu particle %zu drifted %.3g d\n",
+                          kind_name(cases[k].kind), cases[k].seed, c, i - bi.first_particle,
+                          dx / (2.0 * static_cast<double>(a.w)));
+            }
+            o.speed = std::max(o.speed, vlen(snap->particle_vel[i]));
+          }
+        }
+      }
+    }
+  }
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    Outcome& o = out[k];
+    if (!o.failure.empty()) continue;
+    if (o.rise > kEnergyMargin) {
+      o.failure = fmt::format("energy rose {:.3g} of its scale ({:.3g} J), more than {}", o.rise,
+                              o.scale, kEnergyMargin);
+    } else if (o.travel > motes::Simulation::kSafeTravel) {
+      o.failure = fmt::format(
+          "a particle travelled {:.3g} of its diameter per substep (the guard "
+          "warns above {})",
+          o.travel, motes::Simulation::kSafeTravel);
+    } else if (cases[k].settles && o.drift >= 0.01) {
+      o.failure = fmt::format("not at rest: a particle drifted {:.3g} d over [{:.2f}, {:.2f}] s",
+                              o.drift, cases[k].rest_from, cases[k].duration);
+    } else if (cases[k].settles && o.speed >= kRestSpeed) {
+      o.failure = fmt::format("not at rest: a body ends at {:.3g} m/s", o.speed);
+    }
+  }
+  return out;
+}
+
+/// Runs `cases` in batches of `per_batch` and reports every failure.
+void check_cases(const std::string& backend, const std::vector<Case>& cases,
+                 const std::string& label, std::size_t per_batch) {
+  std::size_t failed = 0;
+  Outcome worst;
+  std::uint32_t worst_rise_seed = 0, worst_drift_seed = 0;
+  for (std::size_t at = 0; at < cases.size(); at += per_batch) {
+    const std::vector<Case> part(
+        cases.begin() + static_cast<std::ptrdiff_t>(at),
+        cases.begin() + static_cast<std::ptrdiff_t>(std::min(cases.size(), at + per_batch)));
+    std::string skip;
+    const std::vector<Outcome> got = run_batch(backend, part, skip);
+    if (!skip.empty()) GTEST_SKIP() << "no " << backend << " device: " << skip;
+    for (std::size_t k = 0; k < part.size(); ++k) {
+      const Case& c = part[k];
+      const Outcome& o = got[k];
+      if (o.rise > worst.rise) {
+        worst.rise = o.rise;
+        worst_rise_seed = c.seed;
+      }
+      if (o.drift > worst.drift) {
+        worst.drift = o.drift;
+        worst_drift_seed = c.seed;
+      }
+      worst.travel = std::max(worst.travel, o.travel);
+      if (o.failure.empty()) continue;
+      ++failed;
+      ADD_FAILURE() << fmt::format(
+          "{} seed {} on {} ({}): {}\n  replay alone: MOTES_PROPERTY_KIND={} "
+          "MOTES_PROPERTY_SEED={}; its batch: MOTES_PROPERTY_KIND={} MOTES_PROPERTY_FIRST={} "
+          "MOTES_PROPERTY_SEEDS={} MOTES_PROPERTY_BATCH={}",
+          kind_name(c.kind), c.seed, backend, c.summary, o.failure, kind_name(c.kind), c.seed,
+          kind_name(c.kind), part.front().seed, part.size(), part.size());
+    }
+  }
+  std::printf(
+      "%s on %s: %zu cases, %zu failed; largest energy rise %.3g of the scale (seed %u), "
+      "drift %.3g d (seed %u), travel %.3g d per substep\n",
+      label.c_str(), backend.c_str(), cases.size(), failed, worst.rise, worst_rise_seed,
+      worst.drift, worst_drift_seed, worst.travel);
+}
+
+int default_seeds(const std::string& backend) { return backend == "openmp" ? 40 : 8; }
+
+using Param = std::tuple<std::string, Kind>;
+
+class RandomImpulseScenes : public ::testing::TestWithParam<Param> {};
+
+TEST_P(RandomImpulseScenes, KeepEnergyStayQuietAndComeToRest) {
+  const auto& [backend, kind] = GetParam();
+  if (const char* only = std::getenv("MOTES_PROPERTY_KIND"); only != nullptr && *only != '\0') {
+    if (only != std::string(kind_name(kind))) GTEST_SKIP() << "MOTES_PROPERTY_KIND=" << only;
+  }
+  std::vector<Case> cases;
+  if (const int one = env_int("MOTES_PROPERTY_SEED", -1); one >= 0) {
+    cases.push_back(make_case(kind, static_cast<std::uint32_t>(one)));
+  } else {
+    const int first = env_int("MOTES_PROPERTY_FIRST", 1);
+    const int count = env_int("MOTES_PROPERTY_SEEDS", default_seeds(backend));
+    for (int s = first; s < first + count; ++s) {
+      cases.push_back(make_case(kind, static_cast<std::uint32_t>(s)));
+    }
+  }
+  check_cases(backend, cases, kind_name(kind),
+              static_cast<std::size_t>(std::max(1, env_int("MOTES_PROPERTY_BATCH", 20))));
+}
+
+std::string param_name(const ::testing::TestParamInfo<Param>& p) {
+  return std::get<0>(p.param) + "_" + kind_name(std::get<1>(p.param));
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, RandomImpulseScenes,
+                         ::testing::Combine(::testing::Values("openmp", "vulkan", "cuda"),
+                                            ::testing::ValuesIn(kKinds)),
+                         param_name);
+
+/// Seeds that failed once, kept on every backend: while issue 25's fixes were made, piles 1, 3 and
+/// 9 crept (the warm start lost at every list build), pyramids 2 and 4 and drop 8 drifted, drop 2
+/// slid 2.5 d, drop 3's energy rose 1.1% and wedge 5's box walked 3.7 d out of its gap (sweeps
+/// split otherwise than now, or no leak).
+struct Kept {
+  Kind kind;
+  std::uint32_t seed;
+};
+const Kept kKept[] = {{Kind::Pile, 1},  {Kind::Pile, 3},  {Kind::Pile, 9},
+                      {Kind::Stack, 2}, {Kind::Stack, 4}, {Kind::Drop, 2},
+                      {Kind::Drop, 3},  {Kind::Drop, 8},  {Kind::Wedge, 5}};
+
+class KeptImpulseSeeds : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(KeptImpulseSeeds, StillPass) {
+  std::vector<Case> cases;
+  for (const Kept& k : kKept) cases.push_back(make_case(k.kind, k.seed));
+  check_cases(GetParam(), cases, "kept seeds", 1);  // one at a time: seeds may share a place
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, KeptImpulseSeeds, ::testing::Values("openmp", "vulkan", "cuda"));
+
+}  // namespace
+}  // namespace motes_props
