@@ -6,8 +6,8 @@
 # the summary's guard line is missing, counts no check or does not say `no warning`. Words after
 # the check count (an energy check's, say) are fine; a count of warnings is not.
 # Usage: scene_to_end_test.sh MOTES SCENE BACKEND DURATION|full FULL_DURATION WHY LOG
-#   DURATION: simulated seconds (--duration), or `full` for the scene's own; FULL_DURATION and WHY
-#   only label the result. CUDA without a CUDA device (or in a build without CUDA) exits 77, which
+#   DURATION: simulated seconds (--duration), `steps:N` (--steps N), or `full` for the scene's own;
+#   FULL_DURATION and WHY only label the result. CUDA without a CUDA device (or in a build without CUDA) exits 77, which
 #   ctest reports as skipped (SKIP_RETURN_CODE). With MOTES_SCENE_TABLE=FILE set, a Markdown row
 #   `| scene | backend | steps | wall time | steps/s | guard line | verdict |` is appended to FILE
 #   (scripts/gpu/run-suite.sh scenes).
@@ -42,7 +42,10 @@ finish() {
 # No files; --out only takes the checkpoint that a run stopped by a signal writes (a time limit).
 args=(run "$scene" --backend "$backend" --format none --out "${log%.log}-out")
 what="the full ${full} s"
-if [ "$duration" != full ]; then
+if [[ $duration == steps:* ]]; then
+  args+=(--steps "${duration#steps:}")
+  what="the first ${duration#steps:} steps of the scene's ${full} s (${why})"
+elif [ "$duration" != full ]; then
   args+=(--duration "$duration")
   what="${duration} s of the scene's ${full} s (shortened: ${why})"
 fi
