@@ -39,13 +39,15 @@ expect 1 "FAILED: tunnelling on openmp.*warning line.*motes: warning: step" real
 sed 's/\[1000, 0, 0\]/[0, 0, 0]/' "$work/tunnelling.json" >"$work/calm.json"
 expect 0 "calm on openmp: 500 steps.*no warning" real-calm "$motes" "$work/calm.json" openmp
 
-# A stand-in for motes printing SUMMARY_GUARDS as the guard line, STEPS done, exit EXIT.
+# A stand-in for motes printing GUARDS as the guard line, STEPS done, an extra summary line
+# EXTRA, exit EXIT.
 fake() {
-  local label=$1 guards=$2 steps=${3:-100} exit=${4:-0}
+  local label=$1 guards=$2 steps=${3:-100} exit=${4:-0} extra=${5:-}
   cat >"$work/$label-motes" <<EOF
 #!/usr/bin/env bash
 echo "motes: done"
 echo "  steps           $steps of 100"
+[ -z "$extra" ] || echo "  $extra"
 [ -z "$guards" ] || echo "  guards          $guards"
 exit $exit
 EOF
@@ -66,6 +68,11 @@ expect 1 "exited with 2" stopped "$(fake stopped "6 motion checks, no warning" 1
   "$work/calm.json" openmp
 expect 0 "no warning" energy-words "$(fake energy-words \
   "6 motion checks (energy at most 0.2% above its start), no warning")" "$work/calm.json" openmp
+expect 0 "no warning" energy-line "$(fake energy-line "6 motion checks, no warning" 100 0 \
+  "energy          at most 0.2% above its start, no warning")" "$work/calm.json" openmp
+expect 1 "warning line.*energy +2 warnings" energy-line-counted "$(fake energy-line-counted \
+  "6 motion checks, no warning" 100 0 "energy          2 warnings, no warning since step 9")" \
+  "$work/calm.json" openmp
 # CUDA without a device: reported skipped, never passed.
 cat >"$work/nocuda-motes" <<'EOF'
 #!/usr/bin/env bash
