@@ -2,10 +2,11 @@
 # Runs on the GPU machine, in the repository root, after scripts/gpu/bundle.sh built gpu-bundle/
 # here and it travelled along: devices, the conformance suite on every backend side by side
 # (openmp, cuda, vulkan with the validation layer on), compute-sanitizer's memcheck and racecheck
-# over the suite's CUDA cases, and the benchmarks, each part under its own time limit so that one
-# slow part cannot lose the others' results. Results go to ${OUT:-gpu-out}/ (at most 8 files come
-# back from the GPU machine): conformance.txt, conformance.md, sanitize.txt, bench.txt, bench.json,
-# bench.md (scripts/gpu/bench-tables.py).
+# over the suite's CUDA cases, the benchmarks, and every example scene to its end on CUDA and
+# Vulkan, each part under its own time limit so that one slow part cannot lose the others'
+# results. Results go to ${OUT:-gpu-out}/ (at most 8 files come back from the GPU machine):
+# conformance.txt, conformance.md, sanitize.txt, bench.txt, bench.json, bench.md
+# (scripts/gpu/bench-tables.py), scenes.md.
 # Usage: scripts/gpu/run-suite.sh [conformance|unit|sanitize|bench|mpi|scenes|scaling|all]...
 #   (default all but scaling, which needs several GPUs; all writes 9 files, one more than come
 #   back from the GPU machine in one call, so run scenes in a call of its own, as its time asks)
