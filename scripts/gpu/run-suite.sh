@@ -2,13 +2,22 @@
 # Runs on the GPU machine, in the repository root, after scripts/gpu/bundle.sh built gpu-bundle/
 # here and it travelled along: devices, the conformance suite on every backend side by side
 # (openmp, cuda, vulkan with the validation layer on), compute-sanitizer's memcheck and racecheck
-# over the suite's CUDA cases, and the benchmarks, each part under its own time limit so that one
-# slow part cannot lose the others' results. Results go to ${OUT:-gpu-out}/ (at most 8 files come
-# back from the GPU machine): conformance.txt, conformance.md, sanitize.txt, bench.txt, bench.json,
-# bench.md (scripts/gpu/bench-tables.py).
-# Usage: scripts/gpu/run-suite.sh [conformance|unit|sanitize|bench|mpi|scaling|all]...
-#   (default all but scaling, which needs several GPUs)
+# over the suite's CUDA cases, the benchmarks, and every example scene to its end on CUDA and
+# Vulkan, each part under its own time limit so that one slow part cannot lose the others'
+# results. Results go to ${OUT:-gpu-out}/ (at most 8 files come back from the GPU machine):
+# conformance.txt, conformance.md, sanitize.txt, bench.txt, bench.json, bench.md
+# (scripts/gpu/bench-tables.py), scenes.md.
+# Usage: scripts/gpu/run-suite.sh [conformance|unit|sanitize|bench|mpi|scenes|scaling|all]...
+#   (default all but scaling, which needs several GPUs; all writes 9 files, one more than come
+#   back from the GPU machine in one call, so run scenes in a call of its own, as its time asks)
 #   unit: the unit tests' CUDA cases (checkpoint resume on CUDA, the CLI on CUDA), into unit.txt
+#   scenes: every examples/scenes/*.json to its end (its settings.duration) on CUDA and on Vulkan
+#     with the validation layer (MOTES_SCENE_BACKENDS, default "cuda vulkan"), one after another,
+#     each checked as CI checks openmp and lavapipe (tests/scenes/scene_to_end_test.sh: exit code
+#     0, no warning line, every step done, the summary's guard line says "no warning"), into
+#     scenes.md: a row per run (scene, backend, steps, wall time, steps/s, guard line, verdict),
+#     then the output of each run that failed. Any warning, failure or run cut off fails the part.
+#     LIMIT_SCENE seconds a run (default 240), LIMIT_SCENES seconds for them all (default 540)
 #   mpi: the MPI tests on CUDA and Vulkan (MOTES_MPI_BACKENDS) at 1, 2 and 4 ranks (sharing the
 #     machine's GPUs), and W1 over 1, 2, 4 ranks (motes_mpi_bench, MOTES_MPI_SIZES; empty: none),
 #     into mpi.txt
@@ -98,6 +107,52 @@ if want scaling; then
       --halo "${halo:-auto}" ||
       status=1
   done
+fi
+if want scenes; then
+  # Every example scene to its end, each run under its own limit and all under the part's (runs
+  # not started by then are listed as not run, and fail the part).
+  table=$out/scenes.md logs=${TMPDIR:-/tmp}/motes-scenes
+  rm -rf "$logs" && mkdir -p "$logs"
+  {
+    echo "# Every example scene to its end on $(nvidia-smi --query-gpu=name --format=csv,noheader |
+      head -n 1) ($(date -u +%F), $(motes --version 2>&1 | head -n 1))"
+    echo
+    echo "| scene | backend | steps | wall time | steps/s | guard line | verdict |"
+    echo "|---|---|---|---|---|---|---|"
+  } >"$table"
+  scenes_status=0 deadline=$((SECONDS + ${LIMIT_SCENES:-540}))
+  for backend in ${MOTES_SCENE_BACKENDS:-cuda vulkan}; do
+    for scene in examples/scenes/*.json; do
+      name=$(basename "$scene" .json)
+      full=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["settings"]["duration"])' "$scene")
+      limit=$((deadline - SECONDS))
+      [ "$limit" -le "${LIMIT_SCENE:-240}" ] || limit=${LIMIT_SCENE:-240}
+      if [ "$limit" -le 0 ]; then
+        echo "| $name | $backend | - | - | - | - | FAIL: not run, LIMIT_SCENES ran out |" >>"$table"
+        scenes_status=1
+        continue
+      fi
+      rc=0
+      MOTES_VULKAN_VALIDATION=1 MOTES_SCENE_TABLE=$table timeout -k 10 "$limit" bash \
+        tests/scenes/scene_to_end_test.sh "$(command -v motes)" "$scene" "$backend" full "$full" "" \
+        "$logs/$name-$backend.log" >"$logs/$name-$backend.out" 2>&1 || rc=$?
+      head -n 1 "$logs/$name-$backend.out"
+      if [ "$rc" -eq 124 ]; then
+        echo "| $name | $backend | - | > $limit s | - | - | FAIL: cut off at its limit of $limit s |" \
+          >>"$table"
+        echo "$name on $backend: cut off at its limit of $limit s"
+      fi
+      if [ "$rc" -ne 0 ]; then
+        scenes_status=1
+        { echo; echo "## $name on $backend: exit $rc"; echo; echo '```'
+          cat "$logs/$name-$backend.out"; tail -n 40 "$logs/$name-$backend.log"; echo '```'
+        } >>"$logs/failures.md"
+      fi
+    done
+  done
+  [ ! -f "$logs/failures.md" ] || cat "$logs/failures.md" >>"$table"
+  echo "== scenes: exit $scenes_status ($out/scenes.md)"
+  [ "$scenes_status" -eq 0 ] || status=1
 fi
 if want sanitize; then
   sanitizer=$(command -v compute-sanitizer || echo /usr/local/cuda/bin/compute-sanitizer)
