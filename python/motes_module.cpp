@@ -255,11 +255,34 @@ PYBIND11_MODULE(motes, m) {
             out["particle"] = r.particle;
             out["safe_dt"] = r.safe_dt;
             out["warning"] = r.warning;
+            out["kinetic_energy"] = r.kinetic_energy;
+            out["potential_energy"] = r.potential_energy;
+            out["energy"] = r.energy;
+            out["energy0"] = r.reference.energy();
+            out["contact_energy0"] = r.reference.contact;
+            out["reference_step"] = r.reference.step;
+            out["margin"] = r.reference.margin_at(r.kinetic_energy);
+            out["rise"] = r.rise;
+            out["largest_rise"] = r.largest_rise;
+            out["largest_kinetic"] = r.largest_kinetic;
+            const auto index = [](std::uint32_t i) -> py::object {
+              if (i == motes::MechanicalEnergy::kNone) return py::none();
+              return py::int_(i);
+            };
+            out["largest_kinetic_body"] = index(r.largest_kinetic_body);
+            out["largest_kinetic_particle"] = index(r.largest_kinetic_particle);
+            out["speed_limit"] = r.speed_limit;
             return out;
           },
-          "The motion guard (docs/reliability.md): the fastest particle's travel per substep (in "
-          "diameters), speed, diameter, body, particle and the largest safe dt, with a tunnelling "
-          "warning past a quarter diameter; raises on a NaN or a runaway speed.");
+          "The motion and energy guards (docs/reliability.md): the fastest particle's travel per "
+          "substep (in diameters), speed, diameter, body, particle and the largest safe dt, with "
+          "a tunnelling warning past a quarter diameter; the scene's kinetic and potential energy "
+          "(J) against the reference taken at the first check (or the first after "
+          "set_body_velocities): energy0 (its stored contact "
+          "energy included), the margin, the rise above energy0 now and the largest since, the "
+          "body (and particle, None for a rigid body) with the most kinetic energy, and the "
+          "speed no particle may exceed. Raises on a NaN, on energy more than the margin above "
+          "energy0, and on a particle faster than that energy allows.");
 
   py::class_<motes::FrameWriter>(m, "FrameWriter", "Output files of the frames of a run")
       .def(py::init([](const std::string& directory, const std::string& format,

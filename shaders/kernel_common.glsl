@@ -62,6 +62,7 @@ layout(std430, binding = B_PARTITION_REF_POS) readonly buffer PartitionRefPosBuf
 layout(std430, binding = B_PARTITION_CHECK) buffer PartitionCheckBuf { uint partition_check[]; };
 layout(std430, binding = B_BODY_VEL_PUSH) buffer BodyVelPushBuf { vec4 body_vel_push[]; };
 layout(std430, binding = B_BODY_ANGMOM_PUSH) buffer BodyAngMomPushBuf { vec4 body_angmom_push[]; };
+layout(std430, binding = B_ENERGY_PARTIALS) buffer EnergyPartialsBuf { uint energy_partials[]; };
 layout(std430, binding = B_GRID_ARRIVAL) buffer GridArrivalBuf { uint grid_arrival[]; };
 layout(std430, binding = B_GRID_UNSORTED) buffer GridUnsortedBuf { uint grid_unsorted[]; };
 layout(std430, binding = B_SCAN_SCRATCH) buffer ScanScratchBuf { uint scan_scratch[]; };

@@ -69,6 +69,7 @@ class CudaDevice final : public Device {
   }
   void impulses_apply(const shared::StepParams& p) override { enqueue(Kernel::ImpulsesApply, p); }
   void particles_check(const shared::StepParams& p) override { enqueue(Kernel::ParticlesCheck, p); }
+  void energy_reduce(const shared::StepParams& p) override { enqueue(Kernel::EnergyReduce, p); }
   void halo_pack(const shared::StepParams& p) override { enqueue(Kernel::HaloPack, p); }
   void halo_unpack(const shared::StepParams& p) override { enqueue(Kernel::HaloUnpack, p); }
   void particles_displacement(const shared::StepParams& p) override {
@@ -142,6 +143,7 @@ class CudaDevice final : public Device {
   void launch_impulses_compute(const shared::StepParams& p);
   void launch_impulses_apply(const shared::StepParams& p);
   void launch_particles_check(const shared::StepParams& p);
+  void launch_energy_reduce(const shared::StepParams& p);
   void launch_halo_pack(const shared::StepParams& p);
   void launch_halo_unpack(const shared::StepParams& p);
   void launch_particles_displacement(const shared::StepParams& p);

@@ -74,6 +74,11 @@ void CudaDevice::enqueue(Kernel k, const shared::StepParams& p) {
     error_ = Status::error("cuda: " + why);
     return;
   }
+  // energy_reduce writes a block per 256 items: no more than EnergyPartials holds.
+  if (std::string why = energy_launch_error(k, p, sizes_); !why.empty()) {
+    error_ = Status::error("cuda: " + why);
+    return;
+  }
   pending_.push_back({k, p});
 }
 
@@ -128,6 +133,9 @@ std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t
       return 1;
     case Kernel::ParticlesCheck:
       launch_particles_check(p);
+      return 1;
+    case Kernel::EnergyReduce:
+      launch_energy_reduce(p);
       return 1;
     case Kernel::HaloPack:
       launch_halo_pack(p);

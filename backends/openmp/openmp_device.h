@@ -60,6 +60,7 @@ class OpenMPDevice final : public Device {
   void particles_update(const shared::StepParams& p) override;
   void particles_integrate(const shared::StepParams& p) override;
   void particles_check(const shared::StepParams& p) override;
+  void energy_reduce(const shared::StepParams& p) override;
   void constraints_solve(const shared::StepParams& p) override;
   void clusters_fit(const shared::StepParams& p) override;
   void clusters_goal(const shared::StepParams& p) override;

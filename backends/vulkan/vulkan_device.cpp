@@ -42,17 +42,18 @@ static_assert(B_PARTITION_REF_POS == static_cast<int>(Buffer::PartitionRefPos));
 static_assert(B_PARTITION_CHECK == static_cast<int>(Buffer::PartitionCheck));
 static_assert(B_BODY_VEL_PUSH == static_cast<int>(Buffer::BodyVelPush));
 static_assert(B_BODY_ANGMOM_PUSH == static_cast<int>(Buffer::BodyAngMomPush));
+static_assert(B_ENERGY_PARTIALS == static_cast<int>(Buffer::EnergyPartials));
 static_assert(B_GRID_ARRIVAL == static_cast<int>(Buffer::Count));
 
 namespace {
 
 constexpr const char* kPipelineShaders[kPipelineCount] = {
-    "neighbours_decide",   "grid_build_clear",    "grid_build_count",      "grid_build_scan_block",
-    "grid_build_scan_add", "grid_build_scatter",  "grid_build_place",      "neighbours_begin",
-    "neighbours_build",    "contacts_compute",    "bodies_reduce",         "bodies_integrate",
-    "particles_update",    "particles_integrate", "clusters_fit",          "clusters_goal",
-    "constraints_solve",   "impulses_compute",    "impulses_apply",        "particles_check",
-    "halo_pack",           "halo_unpack",         "particles_displacement"};
+    "neighbours_decide",   "grid_build_clear",    "grid_build_count",       "grid_build_scan_block",
+    "grid_build_scan_add", "grid_build_scatter",  "grid_build_place",       "neighbours_begin",
+    "neighbours_build",    "contacts_compute",    "bodies_reduce",          "bodies_integrate",
+    "particles_update",    "particles_integrate", "clusters_fit",           "clusters_goal",
+    "constraints_solve",   "impulses_compute",    "impulses_apply",         "particles_check",
+    "halo_pack",           "halo_unpack",         "particles_displacement", "energy_reduce"};
 
 const char* binding_name(std::uint32_t binding) {
   if (binding < kBufferCount) return buffer_name(static_cast<Buffer>(binding));
@@ -701,6 +702,7 @@ void VulkanDevice::particles_check(const shared::StepParams& p) {
   enqueue(Kernel::ParticlesCheck, p);
 }
 void VulkanDevice::halo_pack(const shared::StepParams& p) { enqueue(Kernel::HaloPack, p); }
+void VulkanDevice::energy_reduce(const shared::StepParams& p) { enqueue(Kernel::EnergyReduce, p); }
 void VulkanDevice::halo_unpack(const shared::StepParams& p) { enqueue(Kernel::HaloUnpack, p); }
 void VulkanDevice::particles_displacement(const shared::StepParams& p) {
   enqueue(Kernel::ParticlesDisplacement, p);

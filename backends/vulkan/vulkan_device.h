@@ -46,6 +46,7 @@ enum class Pipeline : std::uint32_t {
   HaloPack,
   HaloUnpack,
   ParticlesDisplacement,
+  EnergyReduce,
   Count
 };
 constexpr std::size_t kPipelineCount = static_cast<std::size_t>(Pipeline::Count);
@@ -86,6 +87,7 @@ class VulkanDevice final : public Device {
   void particles_update(const shared::StepParams& p) override;
   void particles_integrate(const shared::StepParams& p) override;
   void particles_check(const shared::StepParams& p) override;
+  void energy_reduce(const shared::StepParams& p) override;
   void halo_pack(const shared::StepParams& p) override;
   void halo_unpack(const shared::StepParams& p) override;
   void particles_displacement(const shared::StepParams& p) override;
@@ -185,6 +187,7 @@ class VulkanDevice final : public Device {
   void record_neighbours_build(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_particles_integrate(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_particles_check(VkCommandBuffer cb, const shared::StepParams& p) const;
+  void record_energy_reduce(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_halo_pack(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_halo_unpack(VkCommandBuffer cb, const shared::StepParams& p) const;
   void record_particles_displacement(VkCommandBuffer cb, const shared::StepParams& p) const;

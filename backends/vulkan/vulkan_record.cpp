@@ -34,6 +34,11 @@ void VulkanDevice::enqueue(Kernel k, const shared::StepParams& p) {
     if (error_) error_ = Status::error("vulkan: " + why);
     return;
   }
+  // energy_reduce writes a block per 256 items: no more than EnergyPartials holds.
+  if (std::string why = energy_launch_error(k, p, sizes_); !why.empty()) {
+    if (error_) error_ = Status::error("vulkan: " + why);
+    return;
+  }
   pending_.push_back({k, p});
 }
 
@@ -197,6 +202,9 @@ Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool ti
         break;
       case Kernel::ParticlesCheck:
         record_particles_check(cb, p);
+        break;
+      case Kernel::EnergyReduce:
+        record_energy_reduce(cb, p);
         break;
       case Kernel::HaloPack:
         record_halo_pack(cb, p);

@@ -617,6 +617,7 @@ Status Simulation::load_state(const std::string& path) {
   if (Status s = d.synchronize(); !s) return s;
   steps_ = h.step;
   time_ = h.time;
+  rebase_energy();  // the energy guard measures from the checkpoint's state
   return Status::ok();
 }
 
@@ -643,6 +644,7 @@ Status Simulation::load_state_v1(const std::string& path, const std::vector<unsi
     at += n;
   }
   if (Status s = restore(state); !s) return s;
+  rebase_energy();
   steps_ = h.step;
   time_ = h.time;
   return Status::ok();

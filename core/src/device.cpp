@@ -10,6 +10,7 @@
 #include <new>
 #include <vector>
 
+#include "shared/energy.h"
 #include "shared/halo.h"
 #include "shared/links.h"
 #include "shared/shape_matching.h"
@@ -106,6 +107,8 @@ const char* buffer_name(Buffer b) {
       return "BodyVelPush";
     case Buffer::BodyAngMomPush:
       return "BodyAngMomPush";
+    case Buffer::EnergyPartials:
+      return "EnergyPartials";
     case Buffer::Count:
       break;
   }
@@ -142,6 +145,8 @@ const char* kernel_name(Kernel k) {
       return "impulses_apply";
     case Kernel::ParticlesCheck:
       return "particles_check";
+    case Kernel::EnergyReduce:
+      return "energy_reduce";
     case Kernel::HaloPack:
       return "halo_pack";
     case Kernel::HaloUnpack:
@@ -228,6 +233,11 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
       return {kVec4, s.partition != 0 ? std::size_t{s.particles} : 0};
     case Buffer::PartitionCheck:
       return {kUint, s.partition != 0 ? std::size_t{1} : 0};
+    case Buffer::EnergyPartials:
+      return {kUint, MOTES_ENERGY_HEADER +
+                         std::size_t{MOTES_ENERGY_WORDS} *
+                             shared::energy_blocks(shared::energy_items(
+                                 s.bodies, s.particles, std::min(s.rigid_particles, s.particles)))};
     case Buffer::Count:
       break;
   }
@@ -295,6 +305,24 @@ std::string halo_launch_error(Kernel k, const shared::StepParams& p, const Sizes
       "vec4s of HaloData) on buffers allocated for {} words and {} vec4s",
       kernel_name(k), p.halo_particles, p.halo_bodies, p.halo_first, words, vec4s, sizes.halo_index,
       sizes.halo_data);
+}
+
+std::string energy_launch_error(Kernel k, const shared::StepParams& p, const Sizes& sizes) {
+  if (k != Kernel::EnergyReduce) return {};
+  const std::uint64_t allocated = shared::energy_items(
+      sizes.bodies, sizes.particles, std::min(sizes.rigid_particles, sizes.particles));
+  if (p.body_count <= sizes.bodies && p.rigid_particle_count <= p.particle_count &&
+      p.particle_count <= sizes.particles &&
+      shared::energy_blocks(
+          shared::energy_items(p.body_count, p.particle_count, p.rigid_particle_count)) <=
+          shared::energy_blocks(static_cast<shared::uint>(allocated))) {
+    return {};
+  }
+  return fmt::format(
+      "{} launched with {} bodies and particles [{}, {}) on buffers allocated for {} bodies and "
+      "{} particles ({} rigid)",
+      kernel_name(k), p.body_count, p.rigid_particle_count, p.particle_count, sizes.bodies,
+      sizes.particles, sizes.rigid_particles);
 }
 
 void* Device::allocate_host(std::size_t bytes) {

@@ -1,16 +1,56 @@
-// Simulation::check_motion: the run-time motion guard (docs/reliability.md, "Guards while
-// running"). The device reduces every particle to four words (Device::particles_check,
-// shared/motion_check.h); the host turns them into a warning (tunnelling) or an error (a state
-// that is not finite, or speeds no cause in the scene can give).
+// Simulation::check_motion: the run-time motion and energy guards (docs/reliability.md, "Guards
+// while running"). The device reduces every particle to four words (Device::particles_check,
+// shared/motion_check.h) and every body and free particle to a few words per block of 256
+// (Device::energy_reduce, shared/energy.h); the host turns them into a warning (tunnelling) or an
+// error (a state that is not finite, energy no cause in the scene can give, or a particle faster
+// than any energy the scene may have could make it).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
+#include <string>
+#include <tuple>
+#include <vector>
 
 #include "motes/simulation.h"
+#include "shared/energy.h"
 #include "shared/motion_check.h"
 
 namespace motes {
+
+namespace {
+
+/// |xyz| in double.
+double norm3(const shared::vec4& v) {
+  const auto x = static_cast<double>(v.x);
+  const auto y = static_cast<double>(v.y);
+  const auto z = static_cast<double>(v.z);
+  return std::sqrt(x * x + y * y + z * z);
+}
+
+/// Text for the fastest particle of scene body `b` in a snapshot: "particle P at V m/s", with the
+/// body's spin when it has one.
+std::string fastest_of_body(const Snapshot& s, const BodyInfo& info, std::uint32_t b) {
+  std::uint32_t fastest = info.first_particle;
+  double speed = -1.0;
+  for (std::uint32_t k = info.first_particle;
+       k < info.first_particle + info.particle_count && k < s.particle_vel.size(); ++k) {
+    const double u = norm3(s.particle_vel[k]);
+    if (u > speed) {
+      speed = u;
+      fastest = k;
+    }
+  }
+  std::string text = fmt::format("particle {} at {:.4g} m/s", fastest, speed);
+  if (b < s.body_angvel.size()) {
+    const double spin = norm3(s.body_angvel[b]);
+    if (spin > 0.0) text += fmt::format(", spinning at {:.4g} rad/s", spin);
+  }
+  return text;
+}
+
+}  // namespace
 
 std::pair<std::uint32_t, std::uint32_t> Simulation::locate_particle(std::uint32_t i) const {
   for (std::uint32_t b = 0; b < bodies_.size(); ++b) {
@@ -25,11 +65,44 @@ std::pair<std::uint32_t, std::uint32_t> Simulation::locate_particle(std::uint32_
   return {0, i};
 }
 
+std::pair<std::uint32_t, std::uint32_t> Simulation::locate_item(std::uint32_t j) const {
+  if (j == MOTES_ENERGY_NONE) return {MechanicalEnergy::kNone, MechanicalEnergy::kNone};
+  if (j < sizes_.bodies) return {rigid_scene_body_[j], MechanicalEnergy::kNone};
+  return locate_particle(sizes_.rigid_particles + (j - sizes_.bodies));
+}
+
+Result<Simulation::DeviceEnergy> Simulation::read_energy() {
+  std::vector<std::uint32_t> words(buffer_layout(Buffer::EnergyPartials, sizes_).count);
+  if (Status s = device_->read(Buffer::EnergyPartials, words.data(), words.size() * 4); !s) {
+    return s;
+  }
+  // The blocks in order, in double: the first block's largest item wins a tie (the lowest item).
+  DeviceEnergy e;
+  bool any = false;
+  for (std::size_t at = MOTES_ENERGY_HEADER; at + MOTES_ENERGY_WORDS <= words.size();
+       at += MOTES_ENERGY_WORDS) {
+    e.kinetic += static_cast<double>(std::bit_cast<float>(words[at + MOTES_ENERGY_KINETIC]));
+    e.potential += static_cast<double>(std::bit_cast<float>(words[at + MOTES_ENERGY_POTENTIAL]));
+    const std::uint32_t item = words[at + MOTES_ENERGY_MAX_ITEM];
+    const auto largest =
+        static_cast<double>(std::bit_cast<float>(words[at + MOTES_ENERGY_MAX_KINETIC]));
+    if (item != MOTES_ENERGY_NONE && (!any || largest > e.largest_kinetic)) {
+      any = true;
+      e.largest_kinetic = largest;
+      e.largest_item = item;
+    }
+  }
+  return e;
+}
+
 Result<MotionReport> Simulation::check_motion() {
   Device& d = *device_;
   d.particles_check(params_);
+  d.energy_reduce(params_);
   std::uint32_t words[MOTES_MOTION_WORDS] = {};
   if (Status s = d.read(Buffer::MotionCheck, words, sizeof words); !s) return s;
+  Result<DeviceEnergy> energy = read_energy();
+  if (!energy) return energy.status();
   MotionReport r;
   r.step = steps_;
   r.time = time_;
@@ -49,11 +122,52 @@ Result<MotionReport> Simulation::check_motion() {
         "gone unstable (dt {:.4g} s at substeps {} too large for the contact stiffness?)",
         steps_, time_, particle, b, bodies_[b].name, detail, settings_.dt, settings_.substeps));
   }
-  if (words[MOTES_MOTION_FASTEST] == MOTES_MOTION_NONE || words[MOTES_MOTION_RATE2] == 0u) {
-    if (!motion_started_) {
-      motion_started_ = true;
-      motion_start_time_ = time_;
+
+  // The energy guard: the reference at the first check (and after the state was changed from
+  // outside), with the contact law's stored energy and the margin from a snapshot then.
+  r.kinetic_energy = energy->kinetic;
+  r.potential_energy = energy->potential;
+  r.energy = r.kinetic_energy + r.potential_energy;
+  if (!energy_started_) {
+    Result<Snapshot> s = snapshot();
+    if (!s) return s.status();
+    MechanicalEnergy measured;
+    measured.kinetic = energy->kinetic;
+    measured.potential = energy->potential;
+    energy_reference_ =
+        energy_reference(s.value(), bodies_, energy_model_, settings_.gravity, measured);
+    energy_started_ = true;
+    largest_rise_ = r.energy - energy_reference_.energy();
+  }
+  r.reference = energy_reference_;
+  r.rise = r.energy - energy_reference_.energy();
+  largest_rise_ = std::max(largest_rise_, r.rise);
+  r.largest_rise = largest_rise_;
+  r.largest_kinetic = energy->largest_kinetic;
+  std::tie(r.largest_kinetic_body, r.largest_kinetic_particle) = locate_item(energy->largest_item);
+  r.speed_limit = energy_speed_limit(energy_reference_, energy_model_, r.potential_energy);
+  const EnergyReference& ref = energy_reference_;
+  const GuardPlace at{steps_, time_, settings_.dt, static_cast<int>(settings_.substeps)};
+  if (!std::isfinite(r.energy) || !(r.energy <= ref.limit(r.kinetic_energy))) {
+    std::string who = "no body has kinetic energy";
+    if (r.largest_kinetic_body != MechanicalEnergy::kNone) {
+      const std::uint32_t b = r.largest_kinetic_body;
+      std::string where;
+      if (Result<Snapshot> s = snapshot(); !s) {
+        where = s.message();
+      } else if (r.largest_kinetic_particle != MechanicalEnergy::kNone) {
+        where = fmt::format("particle {} at {:.4g} m/s", r.largest_kinetic_particle,
+                            norm3(s->particle_vel[r.largest_kinetic_particle]));
+      } else {
+        where = fastest_of_body(s.value(), bodies_[b], b);
+      }
+      who = fmt::format("body {} '{}' has the most kinetic energy, {:.4g} J ({})", b,
+                        bodies_[b].name, r.largest_kinetic, where);
     }
+    return Status::error(energy_error(ref, r.kinetic_energy, r.potential_energy, at, who));
+  }
+
+  if (words[MOTES_MOTION_FASTEST] == MOTES_MOTION_NONE || words[MOTES_MOTION_RATE2] == 0u) {
     return r;  // nothing moves
   }
   const auto [b, particle] = locate_particle(words[MOTES_MOTION_FASTEST]);
@@ -66,25 +180,11 @@ Result<MotionReport> Simulation::check_motion() {
   r.diameter = r.speed / rate;
   r.travel = rate * h;
   r.safe_dt = kSafeTravel / rate * settings_.substeps;
-  if (!motion_started_) {
-    motion_started_ = true;
-    motion_start_speed_ = r.speed;
-    motion_start_time_ = time_;
-  }
-  const double gravity = settings_.gravity.norm();
-  const double contact_speed = kSafeTravel * r.diameter / h;
-  const double reference =
-      motion_start_speed_ + gravity * (time_ - motion_start_time_) + contact_speed;
   const BodyInfo& info = bodies_[b];
-  if (r.speed > kBlowUpFactor * reference) {
-    return Status::error(fmt::format(
-        "speed out of bounds at step {} (t = {:.6g} s): particle {} of body {} '{}' moves at "
-        "{:.4g} m/s ({:.4g} of its diameter per substep), more than {:.0f} times the {:.4g} m/s "
-        "that the start ({:.4g} m/s), gravity since then and the contact scale ({:.4g} m/s: {} "
-        "of a diameter per substep) account for; the run has gone unstable (dt {:.4g} s at "
-        "substeps {} too large for the contact stiffness?)",
-        steps_, time_, particle, b, info.name, r.speed, r.travel, kBlowUpFactor, reference,
-        motion_start_speed_, contact_speed, kSafeTravel, settings_.dt, settings_.substeps));
+  if (std::string e = energy_speed_error(ref, energy_model_, r.potential_energy, r.speed,
+                                         r.speed_limit, particle, b, info.name, at);
+      !e.empty()) {
+    return Status::error(e);
   }
   if (r.travel > kSafeTravel) {
     r.warning = fmt::format(

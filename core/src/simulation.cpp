@@ -16,6 +16,7 @@
 #include "motes/cloth.h"
 #include "motes/soft.h"
 #include "shared/body_math.h"
+#include "shared/energy.h"
 #include "shared/halo.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
@@ -643,6 +644,30 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
   if (s && sizes_.partition != 0) s = write_vector(d, Buffer::PartitionRefPos, ppos);
   if (s) s = clear_contact_history();
   if (!s) return s;
+  // The energy guard: the scene's model, and the reference point potential energy is measured
+  // from, the lowest particle along gravity (the first without gravity), so that the device's
+  // float energies stay precise wherever the scene is.
+  energy_model_ = motes::energy_model(scene);
+  rigid_scene_body_.assign(sizes_.bodies, 0u);
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    const BodyInfo& info = bodies_[b];
+    if (!info.free_sphere && !info.linked && !info.soft) {
+      rigid_scene_body_[device_index_[b]] = static_cast<std::uint32_t>(b);
+    }
+  }
+  std::size_t lowest = 0;
+  for (std::size_t i = 1; i < ppos.size(); ++i) {
+    const auto g_dot = [&](const vec4& x) {
+      return settings_.gravity.dot(Eigen::Vector3f(x.x, x.y, x.z).cast<double>());
+    };
+    if (g_dot(ppos[i]) > g_dot(ppos[lowest])) lowest = i;
+  }
+  const vec4 origin = ppos.empty() ? vec4(0.0f) : ppos[lowest];
+  energy_origin_ = Eigen::Vector3f(origin.x, origin.y, origin.z).cast<double>();
+  const std::uint32_t header[MOTES_ENERGY_HEADER] = {
+      shared::float_bits(origin.x), shared::float_bits(origin.y), shared::float_bits(origin.z), 0u};
+  if (Status st = d.write(Buffer::EnergyPartials, header, sizeof header); !st) return st;
+  energy_started_ = false;
   // Rigid particles take their pose from the bodies with the device's own arithmetic.
   if (sizes_.rigid_particles > 0) d.particles_update(params_);
   return d.synchronize();
@@ -843,6 +868,7 @@ Status Simulation::write_state(const Snapshot& state) {
   if (Status s = restore(state, false); !s) return s;
   steps_ = state.step;
   time_ = static_cast<double>(steps_) * settings_.dt;
+  rebase_energy();  // a state from outside: the energy guard measures from it
   return Status::ok();
 }
 
@@ -1007,6 +1033,7 @@ Status Simulation::set_body_velocities(const std::vector<Eigen::Vector3d>& veloc
   if (Status s = restore(state); !s) return s;
   // The rigid particles' velocities from their bodies' new motion.
   if (sizes_.rigid_particles > 0) device_->particles_update(params_);
+  rebase_energy();  // energy from outside the scene: the energy guard measures from here
   return device_->synchronize();
 }
 

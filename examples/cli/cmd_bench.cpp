@@ -197,6 +197,9 @@ double compulsory_bytes(motes::Kernel k, const Measurement& m) {
       return (4.0 * (b + 1) + 128.0 * b + 32.0 * nr) * static_cast<double>(m.impulse_sweeps);
     case motes::Kernel::ParticlesCheck:  // not in a step (the run's guard): read pos, vel
       return 32 * n;
+    case motes::Kernel::EnergyReduce:  // not in a step (the run's guard): read the free particles'
+                                       // pos, vel and the bodies' pos, vel, angvel, angmom
+      return 32 * nf + 64 * b;
     case motes::Kernel::ParticlesDisplacement:  // not in a step (runs over MPI ranks): read pos,
                                                 // the partition's ref
       return 32 * n;
@@ -210,16 +213,17 @@ double compulsory_bytes(motes::Kernel k, const Measurement& m) {
   return 0;
 }
 
-/// The kernel families a step runs: those before particles_check (the run's motion guard) and the
-/// families of runs over MPI ranks (halo_pack, halo_unpack, particles_displacement), none of
-/// which `motes bench` calls.
+/// The kernel families a step runs: those before particles_check (the run's guards:
+/// particles_check, energy_reduce) and the families of runs over MPI ranks (halo_pack,
+/// halo_unpack, particles_displacement), none of which `motes bench` calls.
 constexpr std::size_t kStepKernels = static_cast<std::size_t>(motes::Kernel::ParticlesCheck);
-static_assert(static_cast<std::size_t>(motes::Kernel::HaloPack) == kStepKernels + 1 &&
-                  static_cast<std::size_t>(motes::Kernel::HaloUnpack) == kStepKernels + 2 &&
+static_assert(static_cast<std::size_t>(motes::Kernel::EnergyReduce) == kStepKernels + 1 &&
+                  static_cast<std::size_t>(motes::Kernel::HaloPack) == kStepKernels + 2 &&
+                  static_cast<std::size_t>(motes::Kernel::HaloUnpack) == kStepKernels + 3 &&
                   static_cast<std::size_t>(motes::Kernel::ParticlesDisplacement) ==
-                      kStepKernels + 3 &&
-                  kStepKernels + 4 == motes::kKernelCount,
-              "the families after a step's: particles_check, then those of runs over MPI ranks");
+                      kStepKernels + 4 &&
+                  kStepKernels + 5 == motes::kKernelCount,
+              "the families after a step's: the guards, then those of runs over MPI ranks");
 
 /// Kernel time of family k per step (ms), from the timed run.
 double kernel_ms(const Measurement& m, std::size_t k) {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "cli_util.h"
+#include "motes/energy.h"
 #include "progress.h"
 #include "render_args.h"
 #include "run_mpi.h"
@@ -33,15 +34,39 @@ using Clock = std::chrono::steady_clock;
 constexpr const char* kSetPrefix = "checkpoint-";
 constexpr const char* kSetSuffix = ".mckset";
 
+/// |xyz| in double.
+double norm3(const shared::vec4& v) {
+  const auto x = static_cast<double>(v.x);
+  const auto y = static_cast<double>(v.y);
+  const auto z = static_cast<double>(v.z);
+  return std::sqrt(x * x + y * y + z * z);
+}
+
+/// The energy guard of a run over ranks, on the state rank 0 gathered (motes/energy.h, as
+/// Simulation::check_motion does it on the device): the reference at the first check, the energy
+/// and the speed bound at every check.
+struct EnergyGuard {
+  EnergyModel model;
+  bool started = false;
+  EnergyReference reference;
+  /// Where potential energy is measured from: the lowest particle at the first check.
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  double rise = 0.0;    ///< at the last check
+  double margin = 0.0;  ///< at the last check
+};
+
 /// The motion guard of a run over ranks, on the state rank 0 gathered (docs/scale-out.md): a
-/// non-finite particle is an error naming step, body and particle (scene indices); the fastest
-/// particle's travel per substep beyond Simulation::kSafeTravel of its diameter is a warning.
-Status guard(const Snapshot& s, const DistributedSimulation& sim, double& travel,
-             std::string& warning) {
+/// non-finite particle is an error naming step, body and particle (scene indices), and so are
+/// energy above the energy guard's margin and a particle faster than the energy allows; the
+/// fastest particle's travel per substep beyond Simulation::kSafeTravel of its diameter is a
+/// warning.
+Status guard(const Snapshot& s, const DistributedSimulation& sim, EnergyGuard& energy,
+             double& travel, std::string& warning) {
   const Settings& settings = sim.settings();
   const double h = settings.dt / static_cast<double>(settings.substeps);
   travel = 0.0;
   std::size_t fastest = 0;
+  double fastest_speed = 0.0;
   for (std::size_t i = 0; i < s.particle_pos.size(); ++i) {
     const shared::vec4& p = s.particle_pos[i];
     const shared::vec4& v = s.particle_vel[i];
@@ -55,15 +80,71 @@ Status guard(const Snapshot& s, const DistributedSimulation& sim, double& travel
           s.step, s.time, i, b, sim.bodies()[b].name, p.x, p.y, p.z, v.x, v.y, v.z, settings.dt,
           settings.substeps));
     }
-    const double speed = std::sqrt(static_cast<double>(v.x) * static_cast<double>(v.x) +
-                                   static_cast<double>(v.y) * static_cast<double>(v.y) +
-                                   static_cast<double>(v.z) * static_cast<double>(v.z));
+    const double speed = norm3(v);
     const double t = p.w > 0.0f ? speed * h / (2.0 * static_cast<double>(p.w)) : 0.0;
     if (t > travel) {
       travel = t;
       fastest = i;
     }
+    if (speed > fastest_speed) fastest_speed = speed;
   }
+
+  // The energy guard.
+  const std::vector<BodyInfo>& bodies = sim.bodies();
+  if (!energy.started) {
+    energy.model = energy_model(sim.scene());
+    // The lowest particle along gravity (the first without gravity), as Simulation chooses it.
+    for (std::size_t i = 0; i < s.particle_pos.size(); ++i) {
+      const Eigen::Vector3d x(static_cast<double>(s.particle_pos[i].x),
+                              static_cast<double>(s.particle_pos[i].y),
+                              static_cast<double>(s.particle_pos[i].z));
+      if (i == 0 || settings.gravity.dot(x) > settings.gravity.dot(energy.origin)) {
+        energy.origin = x;
+      }
+    }
+  }
+  const MechanicalEnergy now = mechanical_energy(s, bodies, settings.gravity, energy.origin);
+  if (!energy.started) {
+    energy.reference = energy_reference(s, bodies, energy.model, settings.gravity, now);
+    energy.started = true;
+  }
+  const EnergyReference& ref = energy.reference;
+  energy.rise = now.total() - ref.energy();
+  energy.margin = ref.margin_at(now.kinetic);
+  const GuardPlace at{s.step, s.time, settings.dt, settings.substeps};
+  std::string who = "no body has kinetic energy";
+  if (now.largest_body != MechanicalEnergy::kNone) {
+    const BodyInfo& info = bodies[now.largest_body];
+    std::uint32_t k = now.largest_particle;
+    if (k == MechanicalEnergy::kNone) {  // a rigid body: its fastest particle
+      double best = -1.0;
+      for (std::uint32_t j = info.first_particle; j < info.first_particle + info.particle_count;
+           ++j) {
+        const double u = norm3(s.particle_vel[j]);
+        if (u > best) {
+          best = u;
+          k = j;
+        }
+      }
+    }
+    who = fmt::format(
+        "body {} '{}' has the most kinetic energy, {:.4g} J (particle {} at {:.4g} "
+        "m/s)",
+        now.largest_body, info.name, now.largest_kinetic, k, norm3(s.particle_vel[k]));
+  }
+  if (std::string e = energy_error(ref, now.kinetic, now.potential, at, who); !e.empty()) {
+    return Status::error(e);
+  }
+  // The speed bound, on every particle (the fastest decides).
+  const double limit = energy_speed_limit(ref, energy.model, now.potential);
+  for (std::size_t i = 0; i < s.particle_pos.size() && fastest_speed > limit; ++i) {
+    const double speed = norm3(s.particle_vel[i]);
+    if (speed != fastest_speed) continue;
+    const std::uint32_t b = s.particle_body[i];
+    return Status::error(energy_speed_error(ref, energy.model, now.potential, speed, limit,
+                                            static_cast<std::uint32_t>(i), b, bodies[b].name, at));
+  }
+
   warning.clear();
   if (travel > Simulation::kSafeTravel) {
     const shared::vec4& p = s.particle_pos[fastest];
@@ -116,7 +197,8 @@ class DistributedSession {
     if (rank_ == 0) {
       double travel = 0.0;
       std::string warning;
-      ok = guard(snap.value(), sim, travel, warning);
+      ok = guard(snap.value(), sim, energy_guard_, travel, warning);
+      if (ok) energy_.add(energy_guard_.rise, energy_guard_.margin);
       if (!warning.empty()) {
         ++warned_checks_;
         worst_travel_ = std::max(worst_travel_, travel);
@@ -334,13 +416,14 @@ class DistributedSession {
       fmt::print("  {:<16}{} set{} written, the last {}\n", "checkpoints", checkpoints_,
                  checkpoints_ == 1 ? "" : "s", last_checkpoint_);
     }
-    fmt::print("  {:<16}{} motion check{} on the gathered state{}\n", "guards", guards_,
+    fmt::print("  {:<16}{} motion check{} on the gathered state{}; {}\n", "guards", guards_,
                guards_ == 1 ? "" : "s",
                warned_checks_ == 0
                    ? std::string(", no warning")
                    : fmt::format(", {} with a tunnelling warning (the worst: {:.3g} of a "
                                  "diameter per substep)",
-                                 warned_checks_, worst_travel_));
+                                 warned_checks_, worst_travel_),
+               energy_.summary());
     std::fflush(stdout);
   }
 
@@ -358,6 +441,8 @@ class DistributedSession {
   std::uint64_t warned_checks_ = 0;
   double worst_travel_ = 0.0;
   double last_warned_travel_ = 0.0;
+  EnergyGuard energy_guard_;  // rank 0
+  EnergyRise energy_;
   int signal_ = 0;
   double wall_seconds_ = 0.0;
   double step_seconds_ = 0.0;

@@ -7,9 +7,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <limits>
+#include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -79,6 +81,23 @@ void prune_numbered(const fs::path& dir, std::uint64_t newest, const std::string
   for (std::size_t k = 1; k < older.size(); ++k) fs::remove_all(older[k].second, ec);
 }
 
+void EnergyRise::add(double rise, double margin) {
+  const double fraction = margin > 0.0 ? rise / margin : (rise > 0.0 ? HUGE_VAL : 0.0);
+  if (!any_ || fraction > fraction_) {
+    fraction_ = fraction;
+    rise_ = rise;
+    margin_ = margin;
+  }
+  any_ = true;
+}
+
+std::string EnergyRise::summary() const {
+  if (!any_) return "no energy check";
+  if (rise_ <= 0.0) return fmt::format("energy never above its start (margin {:.3g} J)", margin_);
+  return fmt::format("energy at most {:.3g} of its margin above its start ({:.3g} J of {:.3g} J)",
+                     fraction_, rise_, margin_);
+}
+
 namespace {
 
 class Session {
@@ -101,6 +120,7 @@ class Session {
     ++guards_;
     Result<MotionReport> r = sim.check_motion();
     if (!r) stop(r.message());
+    energy_.add(r->rise, r->reference.margin_at(r->kinetic_energy));
     if (r->warning.empty()) return;
     ++warned_checks_;
     worst_travel_ = std::max(worst_travel_, r->travel);
@@ -296,12 +316,13 @@ class Session {
       fmt::print("  {:<16}{} written, the last {}\n", "checkpoints", checkpoints_,
                  last_checkpoint_);
     }
-    fmt::print("  {:<16}{} motion check{}{}\n", "guards", guards_, guards_ == 1 ? "" : "s",
+    fmt::print("  {:<16}{} motion check{}{}; {}\n", "guards", guards_, guards_ == 1 ? "" : "s",
                warned_checks_ == 0
                    ? std::string(", no warning")
                    : fmt::format(", {} with a tunnelling warning (the worst: {:.3g} of a "
                                  "diameter per substep)",
-                                 warned_checks_, worst_travel_));
+                                 warned_checks_, worst_travel_),
+               energy_.summary());
     std::fflush(stdout);
   }
 
@@ -317,6 +338,7 @@ class Session {
   std::uint64_t warned_checks_ = 0;
   double worst_travel_ = 0.0;
   double last_warned_travel_ = 0.0;
+  EnergyRise energy_;
   int signal_ = 0;
   double wall_seconds_ = 0.0;
   double step_seconds_ = 0.0;

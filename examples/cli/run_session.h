@@ -49,6 +49,23 @@ class InterruptSignals {
   void (*previous_term_)(int) = nullptr;
 };
 
+/// The energy guard over a run, for the summary's guard line (docs/cli.md): the largest rise of
+/// the scene's energy above the guard's reference seen at a check, as a fraction of that check's
+/// margin.
+class EnergyRise {
+ public:
+  void add(double rise, double margin);
+  /// "energy at most 0.012 of its margin above its start (1.2e-05 J of 0.00098 J)", "energy never
+  /// above its start (margin 0.00098 J)", or "no energy check".
+  [[nodiscard]] std::string summary() const;
+
+ private:
+  bool any_ = false;
+  double fraction_ = 0.0;
+  double rise_ = 0.0;
+  double margin_ = 0.0;
+};
+
 /// "SIGINT (Ctrl-C)", "SIGTERM".
 const char* signal_name(int signal);
 

@@ -256,6 +256,7 @@ Result<std::unique_ptr<DistributedSimulation>> DistributedSimulation::create(
     info.kind = b.kind;
     info.first_particle = first;
     info.particle_count = static_cast<std::uint32_t>(b.shape ? b.shape->points.size() : 0);
+    info.soft = b.soft.has_value();  // its energy is its particles' (motes/energy.h)
     first += info.particle_count;
     if (b.shape) diameter = std::max(diameter, b.shape->diameter);
     d->bodies_.push_back(info);

@@ -13,6 +13,7 @@
 #include "shared/links.h"
 #include "shared/neighbours.h"
 #include "shared/halo.h"
+#include "shared/energy.h"
 
 layout(local_size_x = 64) in;
 layout(push_constant) uniform Push { StepParams p; };
@@ -39,6 +40,10 @@ void main() {
   vec4 w;
   body_integrate(body, q, v, l, w, vec4(1.0f), vec4(f, 0.0f), vec4(0.0f), p.gravity_dt, p.flags);
   vec3 x = particle_position(body, q, a) + particle_velocity(q, v, w, a);
-  result[i] = vec4(x + particle_torque(a, body, vec4(f, 0.0f)),
-                   float(bucket) + uintBitsToFloat(displacement2_bits(a, b)));
+  vec3 e = item_energy(a, v, v.w, true, w, l, p.gravity_dt, xyz(b));
+  result[i] = vec4(x + particle_torque(a, body, vec4(f, 0.0f)) + e,
+                   float(bucket) + uintBitsToFloat(displacement2_bits(a, b)) +
+                       float(energy_blocks(energy_items(p.body_count, p.particle_count,
+                                                        p.rigid_particle_count))) +
+                       (energy_larger(e.x, 1u, e.y, 2u) ? bits_float(1u) : 0.0f));
 }

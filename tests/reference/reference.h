@@ -132,6 +132,22 @@ void absorbed_impulses(const Bodies& bodies, const Particles& particles, std::ve
 /// them and its |v|^2 bits, the first particle that is not finite.
 std::vector<uint> particles_check(const Particles& particles);
 
+/// energy_reduce's EnergyPartials as the definition gives it (shared/energy.h): `header` (its
+/// first MOTES_ENERGY_HEADER words: the reference point), then for every block of
+/// MOTES_ENERGY_BLOCK items (bodies [0, p.body_count), then particles [p.rigid_particle_count,
+/// p.particle_count)) the sums of its counting items' shared::item_energy, each added in double in
+/// item order and rounded once to float (the most accurate sum of the float terms, not the
+/// device's tree), its largest item kinetic energy and the first item with it (-1 and
+/// MOTES_ENERGY_NONE when no item counts). Also, per block, the sums of the terms' magnitudes:
+/// what a float sum's rounding error is bounded by.
+struct EnergyBlocks {
+  std::vector<uint> words;
+  std::vector<double> kinetic_abs;
+  std::vector<double> potential_abs;
+};
+EnergyBlocks energy_reduce(const Particles& particles, const Bodies& bodies, const StepParams& p,
+                           const std::vector<uint>& header);
+
 /// particles_integrate: shared::particle_integrate on the free particles [particles.rigid, N)
 /// with `force`, the velocities of the linked ones [p.linked_first, N) first times 1 -
 /// p.linked_damping; returns whether one has moved too far from `ref` (empty ref: false).

@@ -57,6 +57,7 @@ class LimitedDevice final : public motes::Device {
   void particles_update(const StepParams& p) override { inner_->particles_update(p); }
   void particles_integrate(const StepParams& p) override { inner_->particles_integrate(p); }
   void particles_check(const StepParams& p) override { inner_->particles_check(p); }
+  void energy_reduce(const StepParams& p) override { inner_->energy_reduce(p); }
   void constraints_solve(const StepParams& p) override { inner_->constraints_solve(p); }
   void clusters_fit(const StepParams& p) override { inner_->clusters_fit(p); }
   void clusters_goal(const StepParams& p) override { inner_->clusters_goal(p); }
@@ -205,6 +206,37 @@ TEST(DeviceLimits, HaloLaunchesBeyondTheirBuffersAreNamed) {
   EXPECT_EQ(motes::halo_launch_error(Kernel::ParticlesDisplacement, p, s), "");
   p.particle_count = 101;
   EXPECT_NE(motes::halo_launch_error(Kernel::ParticlesDisplacement, p, s), "");
+}
+
+// Every backend's launch guard for energy_reduce: parameters with more items (bodies, then the
+// particles that are not a rigid body's) than EnergyPartials has blocks for are named; the
+// allocation's own parameters, fewer items, and every other family pass.
+TEST(DeviceLimits, EnergyReduceBeyondItsBlocksIsNamed) {
+  Sizes s;
+  s.particles = 300;
+  s.rigid_particles = 100;
+  s.bodies = 10;  // 10 + 200 items: one block of 256
+  EXPECT_EQ(motes::buffer_layout(motes::Buffer::EnergyPartials, s).count, 4u + 4u);
+  StepParams p{};
+  p.particle_count = 300;
+  p.rigid_particle_count = 100;
+  p.body_count = 10;
+  using motes::Kernel;
+  EXPECT_EQ(motes::energy_launch_error(Kernel::EnergyReduce, p, s), "");
+  p.rigid_particle_count = 54;  // 256 items: still one block
+  EXPECT_EQ(motes::energy_launch_error(Kernel::EnergyReduce, p, s), "");
+  p.rigid_particle_count = 53;  // 257 items: a second block EnergyPartials does not have
+  EXPECT_NE(motes::energy_launch_error(Kernel::EnergyReduce, p, s).find("energy_reduce launched"),
+            std::string::npos);
+  EXPECT_EQ(motes::energy_launch_error(Kernel::ParticlesCheck, p, s), "");  // not its business
+  p.rigid_particle_count = 100;
+  p.body_count = 11;
+  EXPECT_NE(motes::energy_launch_error(Kernel::EnergyReduce, p, s), "");
+  p.body_count = 10;
+  p.particle_count = 301;
+  EXPECT_NE(motes::energy_launch_error(Kernel::EnergyReduce, p, s), "");
+  p.particle_count = 99;  // fewer particles than rigid ones
+  EXPECT_NE(motes::energy_launch_error(Kernel::EnergyReduce, p, s), "");
 }
 
 // More than the device has: refused before any allocation, naming the scene, both numbers and

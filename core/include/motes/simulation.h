@@ -11,6 +11,7 @@
 
 #include "motes/api.h"
 #include "motes/backend/device.h"
+#include "motes/energy.h"
 #include "motes/scene.h"
 #include "motes/status.h"
 #include "shared/common.h"
@@ -89,7 +90,8 @@ struct HaloLists {
 };
 
 /// What the motion guard found (Simulation::check_motion, docs/reliability.md "Guards while
-/// running"): the particle that travels the most of its diameter per substep.
+/// running"): the particle that travels the most of its diameter per substep, and the scene's
+/// mechanical energy against the energy guard's reference.
 struct MotionReport {
   std::uint64_t step = 0;
   double time = 0.0;
@@ -104,6 +106,27 @@ struct MotionReport {
   /// Non-empty when travel > kSafeTravel: contacts can be missed (tunnelling); names step, body,
   /// particle, speed and the largest safe dt.
   std::string warning;
+
+  // The energy guard (J; potential energy from the reference point chosen at upload).
+  double kinetic_energy = 0.0;
+  double potential_energy = 0.0;
+  double energy = 0.0;  ///< kinetic + potential
+  /// What it is compared against: E0 (the reference's kinetic + potential + stored contact
+  /// energy), the margin above it, and the step the reference was taken at.
+  EnergyReference reference;
+  /// energy - E0: how much the energy rose since the reference (negative: it fell).
+  double rise = 0.0;
+  /// The largest rise seen by the checks since the reference (this one included).
+  double largest_rise = 0.0;
+  /// The item with the most kinetic energy: its kinetic energy, scene body, and for a particle
+  /// item (free sphere, soft body, cloth, rope) its scene particle (MechanicalEnergy::kNone for a
+  /// rigid body; both kNone when nothing counts).
+  double largest_kinetic = 0.0;
+  std::uint32_t largest_kinetic_body = MechanicalEnergy::kNone;
+  std::uint32_t largest_kinetic_particle = MechanicalEnergy::kNone;
+  /// The fastest any particle can be while the energy holds (energy_speed_limit; infinity when
+  /// nothing can move).
+  double speed_limit = 0.0;
 };
 
 struct CheckpointRun;  // motes/checkpoint.h
@@ -137,14 +160,26 @@ class Simulation {
   Result<std::uint64_t> state_hash();
   /// Checks every body and particle for NaN or infinity; the error names step, body and particle.
   Status check_finite();
-  /// The motion guard (a reduction on the device, Device::particles_check; cheap: call it at
-  /// output frames and at least every kGuardInterval steps). An error, naming step, body and
-  /// particle, when a particle's position or velocity is not finite, or when the fastest particle
-  /// is faster than kBlowUpFactor times what its start speed, gravity since the first check and
-  /// the contact scale (kSafeTravel of its diameter per substep) can give: the run has gone
-  /// unstable. Otherwise the report, with a warning when the fastest particle travels more than
-  /// kSafeTravel of its diameter per substep.
+  /// The motion and energy guards (reductions on the device, Device::particles_check and
+  /// Device::energy_reduce; cheap: call it at output frames and at least every kGuardInterval
+  /// steps). The first call, and the first after the state was changed from outside
+  /// (set_body_velocities, write_state, load_state, rebase_energy), takes the energy reference
+  /// E0 (motes/energy.h: the kinetic and potential energy, plus the contact law's stored energy).
+  /// An error, naming step, body and particle, when a particle's position or velocity is not
+  /// finite; when the scene's mechanical energy is more than the reference's margin above E0;
+  /// or when a particle is faster than that energy could make any item (energy_speed_limit): the
+  /// run has gone unstable. Otherwise the report, with a warning when the fastest particle
+  /// travels more than kSafeTravel of its diameter per substep.
   Result<MotionReport> check_motion();
+  /// Makes the next check_motion take its energy reference anew: after the state was changed in
+  /// a way the scene's physics did not do (set_body_velocities, write_state and load_state call
+  /// it themselves).
+  void rebase_energy() { energy_started_ = false; }
+  /// The point the energy guard measures potential energy from (the lowest particle along
+  /// gravity when the simulation was created; MotionReport::potential_energy), and the scene's
+  /// energy model (motes/energy.h).
+  [[nodiscard]] const Eigen::Vector3d& energy_origin() const { return energy_origin_; }
+  [[nodiscard]] const EnergyModel& energy_model() const { return energy_model_; }
   /// The neighbour-list skin (m) of a scene whose largest particle diameter is `diameter`:
   /// settings.neighbour_skin, or a tenth of that diameter when it is negative (unset).
   static double neighbour_skin(const Settings& settings, double diameter) {
@@ -152,7 +187,6 @@ class Simulation {
   }
   /// Half a particle radius per substep: the scene loader's limit for initial speeds.
   static constexpr double kSafeTravel = 0.25;
-  static constexpr double kBlowUpFactor = 1000.0;
   static constexpr std::uint64_t kGuardInterval = 1000;
   /// Reads the neighbour-list figures from the device.
   Result<NeighbourStats> neighbour_stats();
@@ -305,10 +339,25 @@ class Simulation {
   /// ParticlePos and ParticleVel, device order), which a checkpoint's particles must match.
   std::uint64_t setup_hash_ = 0;
   std::uint64_t particle_w_hash_ = 0;
-  /// check_motion's reference: the fastest particle's speed and the time at its first call.
-  bool motion_started_ = false;
-  double motion_start_speed_ = 0.0;
-  double motion_start_time_ = 0.0;
+  /// The energy guard: the scene's energy model (motes/energy.h), the reference point that
+  /// potential energy is measured from (the lowest particle at upload; EnergyPartials' header),
+  /// each device rigid body's scene body, and check_motion's reference and largest rise since.
+  EnergyModel energy_model_;
+  Eigen::Vector3d energy_origin_ = Eigen::Vector3d::Zero();
+  std::vector<std::uint32_t> rigid_scene_body_;
+  bool energy_started_ = false;
+  EnergyReference energy_reference_;
+  double largest_rise_ = 0.0;
+  /// The device's energy (EnergyPartials summed in double): the item index is the device's.
+  struct DeviceEnergy {
+    double kinetic = 0.0;
+    double potential = 0.0;
+    double largest_kinetic = 0.0;
+    std::uint32_t largest_item = 0xFFFFFFFFu;
+  };
+  Result<DeviceEnergy> read_energy();
+  /// The scene body and particle (MechanicalEnergy::kNone for a rigid body) of energy item j.
+  [[nodiscard]] std::pair<std::uint32_t, std::uint32_t> locate_item(std::uint32_t j) const;
   double time_ = 0.0;
   std::uint64_t steps_ = 0;
 };

@@ -98,6 +98,8 @@ class DistributedSimulation {
   [[nodiscard]] std::uint64_t steps() const { return steps_; }
   [[nodiscard]] double time() const { return static_cast<double>(steps_) * scene_.settings.dt; }
   [[nodiscard]] const Settings& settings() const { return scene_.settings; }
+  /// The whole scene (every rank's copy).
+  [[nodiscard]] const Scene& scene() const { return scene_; }
   /// Every scene body's facts in the scene's order (particle ranges as in a gathered Snapshot).
   [[nodiscard]] const std::vector<BodyInfo>& bodies() const { return bodies_; }
   [[nodiscard]] std::uint64_t particle_count() const { return particles_; }

@@ -96,6 +96,11 @@ enum class Buffer : std::uint32_t {
   // Impulse contacts again (after the others: checkpoints name buffers by their number).
   BodyVelPush,     ///< vec4 (B): BodyVel after the impulse sweeps with position correction
   BodyAngMomPush,  ///< vec4 (B): BodyAngMom after the impulse sweeps with position correction
+  // The energy guard (after the others: checkpoints name buffers by their number; not saved).
+  /// uint (4 + 4 x blocks of 256 items, shared/energy.h): the reference point x_ref that
+  /// potential energy is measured from (written by the host), then per block of energy_reduce's
+  /// items its kinetic and potential energy, its largest item kinetic energy and that item.
+  EnergyPartials,
   Count
 };
 
@@ -116,6 +121,7 @@ enum class Kernel : std::uint32_t {
   ImpulsesCompute,
   ImpulsesApply,
   ParticlesCheck,  ///< not part of a step: the motion guard, at output frames and checks
+  EnergyReduce,    ///< not part of a step: the energy guard, with particles_check
   // Not part of a step: runs over MPI ranks, between steps (motes/distributed.h).
   HaloPack,
   HaloUnpack,
@@ -218,6 +224,10 @@ struct KernelTimes {
 /// partition buffers; "" when it stays inside, and for every other family. The GPU backends
 /// refuse such a call before anything runs (their first error, sticky).
 std::string halo_launch_error(Kernel k, const shared::StepParams& p, const Sizes& sizes);
+/// Why an energy_reduce with these parameters would write blocks beyond EnergyPartials allocated
+/// for `sizes` (more items than the allocation's: shared/energy.h); "" when it stays inside, and
+/// for every other family. Every backend refuses such a call (the GPUs with their first error).
+std::string energy_launch_error(Kernel k, const shared::StepParams& p, const Sizes& sizes);
 
 /// One device of one backend, as listed by `motes devices`.
 struct DeviceInfo {
@@ -317,6 +327,14 @@ class Device {
   /// first particle whose position or velocity is not finite (shared/motion_check.h). Reads
   /// ParticlePos and ParticleVel only.
   virtual void particles_check(const shared::StepParams& p) = 0;
+  /// The energy guard's reduction (shared/energy.h): for every block of MOTES_ENERGY_BLOCK items
+  /// (the rigid bodies [0, p.body_count), then the particles [p.rigid_particle_count,
+  /// p.particle_count)), EnergyPartials gets the sum of its items' shared::item_energy (kinetic,
+  /// potential from the reference point in EnergyPartials' header, gravity p.gravity_dt) added as
+  /// a tree in the fixed order of shared/energy.h, its largest item kinetic energy and the lowest
+  /// item with it. Reads BodyPos, BodyVel, BodyAngVel, BodyAngMom, ParticlePos, ParticleVel and
+  /// the header; writes only the blocks.
+  virtual void energy_reduce(const shared::StepParams& p) = 0;
 
   /// Halo exchange over MPI ranks (shared/halo.h, docs/scale-out.md): HaloData = the state of
   /// the p.halo_particles particles at HaloIndex [p.halo_first, + p.halo_particles) (entry k:
