@@ -73,6 +73,66 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     return s;
   };
 
+  // The sweeps: each contact of two dynamic rigid particles with slots in both lists is evaluated
+  // once, by the lower id (pair_impulse's own order, so the same bits as the higher id's own
+  // evaluation), its impulse kept for both slots and its accumulated impulse written to both.
+  // impulse_mirror_ holds each slot's place in the partner's list, made when the lists change.
+  constexpr uint kNoMirror = 0xffffffffu;
+  const std::size_t slots = std::size_t{capacity} * nr;
+  if (counting && impulse_mirror_.size() != slots) {
+    impulse_mirror_.assign(slots, kNoMirror);
+    impulse_pair_.resize(slots);
+    uint* mirror = impulse_mirror_.data();
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel_heavy(n))
+    for (std::int64_t i = 0; i < n; ++i) {
+      const uint c = count[i];
+      if (vel[i].w == 0.0f || c > capacity) continue;
+      for (uint k = 0; k < c; ++k) {
+        const uint j = list[std::size_t{k} * stride + std::size_t(i)];
+        if (j >= p.rigid_particle_count || vel[j].w == 0.0f || count[j] > capacity) continue;
+        for (uint m = 0; m < count[j]; ++m) {
+          if (list[std::size_t{m} * stride + j] == uint(i)) {
+            mirror[std::size_t{k} * nr + std::size_t(i)] = m;
+            break;
+          }
+        }
+      }
+    }
+  }
+  // Set for the sweeps over the active particles, after lower_pairs has run.
+  bool pairs_once = false;
+  const uint* mirror = impulse_mirror_.data();
+  vec4* pair_r = impulse_pair_.data();
+  // The contacts of an active particle i in its mirrored slots with the higher ids, and with the
+  // lower ids that are not active (none evaluates those for them: out of reach, the same result).
+  const auto lower_pairs = [&](std::int64_t i, const std::uint8_t* active) {
+    const uint c = count[i];
+    if (vel[i].w == 0.0f || c > capacity) return;
+    const vec4 xi = pos[i];
+    bool built = false;
+    shared::ImpulseBody own;
+    for (uint k = 0; k < c; ++k) {
+      const std::size_t at = std::size_t{k} * nr + std::size_t(i);
+      const uint m = mirror[at];
+      const uint j = list[std::size_t{k} * stride + std::size_t(i)];
+      if (m == kNoMirror || (j < uint(i) && active[j] != 0)) continue;
+      if (!built) {
+        own = impulse_body(body[i]);
+        built = true;
+      }
+      const std::size_t other_at = std::size_t{m} * nr + j;
+      vec4 a = acc[at];
+      const vec4 r = shared::pair_impulse(
+          own, xi, impulse_body(body[j]), pos[j], uint(i) < j, margin,
+          laws[shared::pair_law_index(uint(i), material[i], j, material[j], materials)],
+          p.gravity_dt, p.flags, a);
+      acc[at] = a;
+      acc[other_at] = a;
+      pair_r[at] = r;
+      pair_r[other_at] = vec4(-r.x, -r.y, -r.z, r.w);  // j's side, as pair_impulse gives it
+    }
+  };
+
   // One particle's contacts: its list (or the grid beyond K), then the planes.
   const auto particle = [&](std::int64_t i) {
     const vec4 xi = pos[i];
@@ -141,6 +201,11 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     if (c <= capacity) {
       for (uint k = 0; k < c; ++k) {
         const uint j = list[std::size_t{k} * stride + std::size_t(i)];
+        if (pairs_once && mirror[std::size_t{k} * nr + std::size_t(i)] != kNoMirror) {
+          shared::impulse_add(sum, moment_sum, pair_r[std::size_t{k} * nr + std::size_t(i)],
+                              shared::pair_contact_point(xi, pos[j]), own.com);
+          continue;
+        }
         const bool slotted =
             j < p.rigid_particle_count && shared::impulse_pair_slotted(c, count[j], capacity);
         add_contact(j, slotted ? acc + std::size_t{k} * nr + std::size_t(i) : nullptr);
@@ -180,11 +245,20 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
     for (std::int64_t i = 0; i < n; ++i) particle(i);
   } else {
-    // The sweeps of this substep: only the particles the counting pass found touching.
+    // The sweeps of this substep: only the particles the counting pass found touching (a
+    // contact within reach touches both), their shared contacts first.
     const auto active = static_cast<std::int64_t>(impulse_active_.size());
     const uint* ids = impulse_active_.data();
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel_heavy(active))
-    for (std::int64_t a = 0; a < active; ++a) particle(ids[a]);
+    pairs_once = impulse_mirror_.size() == slots;
+#pragma omp parallel num_threads(threads_) if (parallel_heavy(active))
+    {
+      if (pairs_once) {
+#pragma omp for schedule(static)
+        for (std::int64_t a = 0; a < active; ++a) lower_pairs(ids[a], impulse_touches_.data());
+      }
+#pragma omp for schedule(static)
+      for (std::int64_t a = 0; a < active; ++a) particle(ids[a]);
+    }
   }
   record(Kernel::ImpulsesCompute, start);
 }

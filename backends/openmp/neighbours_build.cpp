@@ -27,6 +27,7 @@ void OpenMPDevice::neighbours_update(const shared::StepParams& p) {
 
 void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
+  impulse_mirror_.clear();  // new lists: impulses_compute finds each slot's mirror again
   const auto n = static_cast<std::int64_t>(p.particle_count);
   const std::size_t stride = p.particle_count;
   const uint capacity = p.neighbour_capacity;

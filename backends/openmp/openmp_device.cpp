@@ -110,6 +110,7 @@ Status OpenMPDevice::allocate(const Sizes& sizes) {
     keys_tmp_.assign(sizes.particles, 0);
     ids_tmp_.assign(sizes.particles, 0);
     buffers_ = std::move(fresh);
+    impulse_mirror_.clear();
   } catch (const std::bad_alloc&) {
     return Status::error(
         fmt::format("out of host memory allocating {} particles and {} bodies on the openmp device",
@@ -127,6 +128,7 @@ Status OpenMPDevice::write(Buffer b, const void* src, std::size_t bytes) {
                                      buffer_name(b), buffers_[i].size()));
   }
   if (bytes > 0) std::memcpy(buffers_[i].data(), src, bytes);
+  if (b == Buffer::NeighbourList || b == Buffer::NeighbourCount) impulse_mirror_.clear();
   return Status::ok();
 }
 

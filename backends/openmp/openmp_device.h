@@ -110,6 +110,13 @@ class OpenMPDevice final : public Device {
   std::vector<std::uint8_t> impulse_touches_;
   /// impulses_compute: each body's shared::impulse_body_frame, made by the counting pass.
   std::vector<shared::ImpulseBody> impulse_frames_;
+  /// impulses_compute's sweeps evaluate a contact of two dynamic rigid particles once, at the
+  /// lower id, for both: per list slot k of particle i (k N_r + i), the slot of i in its partner's
+  /// list (kNoMirror: none, the particle evaluates it itself), made at the first counting pass
+  /// after the lists changed (emptied by neighbours_build, allocate and a write to the lists);
+  /// and each slot's contact impulse of the sweep (w: counted).
+  std::vector<std::uint32_t> impulse_mirror_;
+  std::vector<shared::vec4> impulse_pair_;
   bool timing_ = false;
   KernelTimes times_;
 };

@@ -729,16 +729,16 @@ void Simulation::step_impulses() {
   // Forces (soft bodies, cloth, ropes) are summed once; then the impulse stage runs its own
   // substeps on the contacts the lists hold (docs/architecture.md, "Impulse contacts"). Each:
   // gravity and forces into the velocities; the counting pass (every contact in reach counted,
-  // the start velocities kept, the warm start applied); a sweep with position correction, the
-  // velocities it leaves kept for the pose; relaxing sweeps without it, whose velocities the
+  // the start velocities kept, the warm start applied); sweeps with position correction, the
+  // velocities they leave kept for the pose; relaxing sweeps without it, whose velocities the
   // bodies keep; the pose; the particles follow.
   Device& d = *device_;
   const int substeps = settings_.impulse_substeps;
   const int sweeps = (settings_.impulse_iterations + substeps - 1) / substeps;
-  // One sweep with the position correction (soft: it moves an overlap by a fraction per substep
-  // whatever the sweeps), the rest without it: the velocities the bodies keep converge further
-  // and carry no push-out speed (docs/architecture.md, "Impulse contacts").
-  const int correcting = 1;
+  // The first half of the sweeps with the position correction, the rest without it: the
+  // velocities the bodies keep converge further and carry no push-out speed (docs/architecture.md,
+  // "Impulse contacts").
+  const int correcting = (sweeps + 1) / 2;
   const int relaxing = sweeps - correcting;
   shared::StepParams sub = params_;
   sub.gravity_dt.w = params_.gravity_dt.w / static_cast<float>(substeps);

@@ -2,7 +2,8 @@
 # Builds motes for the GPU machine and bundles what has to travel there (it has no network and
 # lacks assimp, the Vulkan loader and the glvnd libraries NVIDIA's Vulkan driver needs):
 #   gpu-bundle/bin/   motes, motes_conformance_tests, motes_unit_tests (their CUDA cases: run
-#                     with --gtest_filter='*cuda*:*Cuda*') (CUDA for sm_90, Vulkan, OpenMP),
+#                     with --gtest_filter='*cuda*:*Cuda*'), motes_property_tests (CUDA for
+#                     sm_90, Vulkan, OpenMP),
 #                     motes_mpi_tests and motes_mpi_bench (over MPI ranks), motes_gpu_floors
 #                     (bench/gpu)
 #   gpu-bundle/lib/   their shared libraries, except those the GPU machine has (libc, libstdc++...)
@@ -16,10 +17,11 @@ bundle=$root/gpu-bundle
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DMOTES_WITH_VULKAN=ON \
   -DMOTES_WITH_CUDA=ON >/dev/null
 cmake --build "$build" -j "${JOBS:-$(nproc)}" --target motes_cli motes_conformance_tests \
-  motes_unit_tests motes_mpi_tests motes_mpi_bench
+  motes_unit_tests motes_property_tests motes_mpi_tests motes_mpi_bench
 rm -rf "$bundle/bin" "$bundle/lib"
 mkdir -p "$bundle/bin" "$bundle/lib" "$bundle/debs"
 cp "$build/bin/motes" "$build/tests/motes_conformance_tests" "$build/tests/motes_unit_tests" \
+  "$build/tests/motes_property_tests" \
   "$build/tests/motes_mpi_tests" "$build/bin/motes_mpi_bench" "$bundle/bin/"
 # The floors every GPU number is compared with (copy bandwidth, CUB sort), for sm_90 plus PTX.
 nvcc=${NVCC:-$(command -v nvcc || echo /usr/local/cuda/bin/nvcc)}

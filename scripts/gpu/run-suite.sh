@@ -7,9 +7,14 @@
 # results. Results go to ${OUT:-gpu-out}/ (at most 8 files come back from the GPU machine):
 # conformance.txt, conformance.md, sanitize.txt, bench.txt, bench.json, bench.md
 # (scripts/gpu/bench-tables.py), scenes.md.
-# Usage: scripts/gpu/run-suite.sh [conformance|unit|sanitize|bench|mpi|scenes|scaling|all]...
-#   (default all but scaling, which needs several GPUs; all writes 9 files, one more than come
-#   back from the GPU machine in one call, so run scenes in a call of its own, as its time asks)
+# Usage: scripts/gpu/run-suite.sh
+#          [conformance|unit|properties|sanitize|bench|mpi|scenes|scaling|all]...
+#   (default all but scaling, which needs several GPUs, and properties; all writes 9 files, one
+#   more than come back from the GPU machine in one call, so run scenes in a call of its own, as
+#   its time asks)
+#   properties: the seeded random impulse scenes (tests/properties) on CUDA and Vulkan,
+#     MOTES_PROPERTY_SEEDS per kind and backend (default 500) in batches of MOTES_PROPERTY_BATCH
+#     (default 250), and the kept seeds, into properties.txt; LIMIT_PROPERTIES seconds each backend
 #   unit: the unit tests' CUDA cases (checkpoint resume on CUDA, the CLI on CUDA), into unit.txt
 #   scenes: every examples/scenes/*.json to its end (its settings.duration) on CUDA and on Vulkan
 #     with the validation layer (MOTES_SCENE_BACKENDS, default "cuda vulkan"), one after another,
@@ -68,6 +73,15 @@ if want conformance; then
   for backend in cuda vulkan; do
     MOTES_VULKAN_VALIDATION=1 part 60 conformance motes run examples/scenes/dominoes.json \
       --backend "$backend" --out "${TMPDIR:-/tmp}/motes-dominoes-$backend" || status=1
+  done
+fi
+if [[ " $parts " == *" properties "* ]]; then
+  for backend in cuda vulkan; do
+    MOTES_VULKAN_VALIDATION=0 MOTES_PROPERTY_SEEDS=${MOTES_PROPERTY_SEEDS:-500} \
+      MOTES_PROPERTY_BATCH=${MOTES_PROPERTY_BATCH:-250} TAIL_LINES=30 \
+      part "${LIMIT_PROPERTIES:-240}" properties motes_property_tests --gtest_brief=1 \
+      --gtest_filter="*/${backend}_*:*KeptImpulseSeeds*/${backend}" ||
+      status=1
   done
 fi
 if want unit; then

@@ -106,6 +106,22 @@ class Builder {
     c_.may_roll.push_back(!is_static && rolls(n));
     return c_.bodies.back();
   }
+  /// True when a body of `n` particles a side at `at` turned by `rot` would keep a tenth of a
+  /// diameter from every particle placed so far (a start with overlaps would be pushed apart,
+  /// lifting bodies: energy the scene did not have).
+  bool clear(const Dims& n, const Eigen::Vector3d& at, const Eigen::Quaterniond& rot) const {
+    const std::shared_ptr<const motes::ParticleSet> shape = box(n);
+    for (const motes::BodySpec& o : c_.bodies) {
+      for (const Eigen::Vector3f& q : o.shape->points) {
+        const Eigen::Vector3d y = o.position + o.rotation * q.cast<double>();
+        for (const Eigen::Vector3f& p : shape->points) {
+          const Eigen::Vector3d x = c_.origin + at + rot * p.cast<double>();
+          if ((x - y).squaredNorm() < 1.1 * 1.1 * kD * kD) return false;
+        }
+      }
+    }
+    return true;
+  }
   /// A static wall of 1 x h x l particles, its long side along z (turned: along x), its foot on
   /// the floor, centred at (x, z).
   void wall(double x, double z, int h, int l, bool along_x) {
@@ -243,12 +259,20 @@ void make_drop(Case& c, Rng& rng) {
   }
   const int drops = rng.integer(1, 4);
   for (int i = 0; i < drops; ++i) {
-    const Dims dims = rng.chance(0.5) ? Dims::Constant(rng.integer(2, 4)) : random_dims(rng, true);
-    const Eigen::Vector3d at(rng.uniform(-3.0, 3.0) * kD,
-                             top + 0.05 + 0.06 * i + rng.uniform(0.0, 0.1),
-                             rng.uniform(-3.0, 3.0) * kD);
-    motes::BodySpec& body =
-        b.add(dims, corner ? at + Eigen::Vector3d(-2.0 * kD, 0.0, -2.0 * kD) : at, rng.rotation());
+    // Drawn again (at most 100 times) while it would start overlapping a body placed before.
+    Dims dims;
+    Eigen::Vector3d at;
+    Eigen::Quaterniond rot;
+    for (int tries = 0; tries < 100; ++tries) {
+      dims = rng.chance(0.5) ? Dims::Constant(rng.integer(2, 4)) : random_dims(rng, true);
+      at = Eigen::Vector3d(rng.uniform(-3.0, 3.0) * kD,
+                           top + 0.05 + 0.06 * i + rng.uniform(0.0, 0.1),
+                           rng.uniform(-3.0, 3.0) * kD);
+      if (corner) at += Eigen::Vector3d(-2.0 * kD, 0.0, -2.0 * kD);
+      rot = rng.rotation();
+      if (b.clear(dims, at, rot)) break;
+    }
+    motes::BodySpec& body = b.add(dims, at, rot);
     body.angular_velocity = rng.vec(4.0);
   }
   c.settles = true;
@@ -272,10 +296,17 @@ void make_wedge(Case& c, Rng& rng) {
     b.add(Dims(len, 1, 3), centre, about_z(angle));
     const int drops = rng.integer(1, 3);
     for (int i = 0; i < drops; ++i) {
-      b.add(Dims::Constant(rng.integer(2, 3)),
-            Eigen::Vector3d(centre.x() + rng.uniform(-2.0, 2.0) * kD, 0.12 + 0.05 * i,
-                            rng.uniform(-1.0, 1.0) * kD),
-            rng.rotation());
+      Dims dims;
+      Eigen::Vector3d at;
+      Eigen::Quaterniond rot;
+      for (int tries = 0; tries < 100; ++tries) {  // drawn again while it would overlap
+        dims = Dims::Constant(rng.integer(2, 3));
+        at = Eigen::Vector3d(centre.x() + rng.uniform(-2.0, 2.0) * kD, 0.12 + 0.05 * i,
+                             rng.uniform(-1.0, 1.0) * kD);
+        rot = rng.rotation();
+        if (b.clear(dims, at, rot)) break;
+      }
+      b.add(dims, at, rot);
     }
     c.summary = fmt::format("a plank of {} leaning on a block, {} boxes dropped on it", len, drops);
   } else if (variant == 1) {

@@ -48,8 +48,10 @@ inline constexpr double kRestSpeed = 2.0e-3;
 
 /// The case of `kind` drawn from `seed` (the same on every machine: its own generator, no
 /// std::uniform_*_distribution, whose results the standard leaves to the library). Its origin
-/// depends on the seed only (slot seed % 256 of a 16 x 16 grid, 2 m apart), so a case runs to the
-/// same bits alone or in a batch of other seeds.
+/// depends on the seed only (slot seed % 256 of a 16 x 16 grid, 2 m apart), so a case stands at
+/// the same place alone or in a batch of other seeds. Alone it runs the same physics, not the same
+/// bits (particle numbers and the times of list builds depend on the batch): a failure names its
+/// batch too, which replays it exactly.
 Case make_case(Kind kind, std::uint32_t seed);
 
 /// Cases side by side in one scene: the floor, one material per case (and the floor's), the
