@@ -11,7 +11,7 @@
 //   roll drifts 1% of a diameter, and each such body ends slower than kRestSpeed.
 // A failure prints the seed and how to replay it (alone, or its whole batch: the same bits).
 //
-// Environment: MOTES_PROPERTY_SEEDS (seeds per kind; default: openmp 40, vulkan 1, cuda 8, sized
+// Environment: MOTES_PROPERTY_SEEDS (seeds per kind; default: openmp 4, vulkan 1, cuda 8, sized
 // for CI's two cores; the sanitizer build 2, 1 and 8 for their first 0.5 s),
 // MOTES_PROPERTY_DURATION (s: stop there, rest not checked),
 // MOTES_PROPERTY_FIRST (first seed, default 1), MOTES_PROPERTY_KIND (only this kind),
@@ -282,7 +282,7 @@ void check_cases(const std::string& backend, const std::vector<Case>& cases,
 }
 
 int default_seeds(const std::string& backend) {
-  if (backend == "openmp") return kQuick ? 2 : 40;
+  if (backend == "openmp") return kQuick ? 2 : 4;
   if (backend == "vulkan") return 1;  // lavapipe in CI: 20 to 90 s a seed
   return 8;                           // run-suite.sh asks for thousands
 }
