@@ -3,7 +3,10 @@
 // is poisoned; the five state buffers are read back. Static bodies keep their state and get a
 // zero angular velocity; bodies with L = 0 or a tiny |w dt| take the no-rotation branches.
 // BodyPos is compared by NMSE on xyz and bitwise on w (the inverse mass, kept); the other four
-// by NMSE on all components (a quaternion; w = 0 for the vectors).
+// by NMSE on all components (a quaternion; w = 0 for the vectors). `PushPose1234` runs the impulse
+// stage's pose update (MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_PUSH): BodyVelPush and
+// BodyAngMomPush written too (some zero), the pose moved with them (body_push_pose) while the
+// bodies keep their own velocities.
 //
 // Tolerance: NMSE 1e-10. Per body the same shared body_integrate runs on the same floats, so
 // openmp matches bitwise (measures 0). A GPU may fuse multiply-adds and has its own sin, cos and
