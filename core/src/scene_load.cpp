@@ -49,7 +49,8 @@ void read_settings(const Node& node, Settings& s, std::int64_t& max_particles) {
   node.expect_object({"dt", "substeps", "gravity", "particle_diameter", "clamp_attraction",
                       "duration", "output_interval", "max_particles", "neighbour_skin",
                       "neighbour_capacity", "constraint_iterations", "link_damping",
-                      "contact_model", "impulse_iterations", "impulse_substeps", "contact"});
+                      "contact_model", "impulse_iterations", "impulse_substeps",
+                      "impulse_memory_across_builds", "contact"});
   if (auto v = node.find("dt")) s.dt = v->number(Sign::Positive);
   if (auto v = node.find("substeps")) s.substeps = static_cast<int>(v->integer(1, 1'000'000));
   if (auto v = node.find("gravity")) s.gravity = v->vec3();
@@ -80,6 +81,9 @@ void read_settings(const Node& node, Settings& s, std::int64_t& max_particles) {
   }
   if (auto v = node.find("impulse_substeps")) {
     s.impulse_substeps = static_cast<int>(v->integer(1, 64));
+  }
+  if (auto v = node.find("impulse_memory_across_builds")) {
+    s.impulse_memory_across_builds = v->boolean();
   }
   if (auto v = node.find("max_particles")) {
     max_particles = v->integer(1, scene_detail::kParticleLimit);

@@ -677,9 +677,12 @@ Status Simulation::step(std::uint64_t count) {
   Device& d = *device_;
   const bool rigid = sizes_.bodies > 0;
   const bool free = sizes_.particles > sizes_.rigid_particles;
+  // A list build moves the impulse contacts' memory on (ImpulseStamp) only when the setting asks.
+  shared::StepParams lists = params_;
+  if (!settings_.impulse_memory_across_builds) lists.flags &= ~MOTES_FLAG_IMPULSE;
   for (std::uint64_t k = 0; k < count; ++k) {
     for (int sub = 0; sub < settings_.substeps; ++sub) {
-      d.neighbours_update(params_);
+      d.neighbours_update(lists);
       d.contacts_compute(params_);
       if (rigid && sizes_.impulse != 0) {
         step_impulses();

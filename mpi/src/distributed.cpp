@@ -239,6 +239,9 @@ Result<std::unique_ptr<DistributedSimulation>> DistributedSimulation::create(
   MPI_Comm_size(comm, &d->size_);
   d->open_device_ = std::move(open_device);
   d->scene_ = std::move(whole);
+  // The impulse contacts' memory is each rank's own and does not travel with a partition (which
+  // makes the ranks' simulations anew): it is dropped at every list build, on every rank count.
+  d->scene_.settings.impulse_memory_across_builds = false;
   d->group_bodies();
   const Scene& scene = d->scene_;
   const std::vector<Eigen::Vector3d> centres = body_centres(scene);

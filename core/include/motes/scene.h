@@ -58,11 +58,16 @@ struct Settings {
   /// Rigid-body contacts by forces (default) or by impulses ("contact_model": "impulse").
   ContactModel contact_model = ContactModel::Forces;
   /// Impulse contacts: sweeps over every contact per substep, spread over impulse_substeps (each
-  /// gets ceil(impulse_iterations / impulse_substeps): the first corrects overlaps, the rest relax;
-  /// docs/architecture.md, "Impulse contacts").
+  /// gets ceil(impulse_iterations / impulse_substeps): the first half correct overlaps, the rest
+  /// relax; docs/architecture.md, "Impulse contacts").
   int impulse_iterations = 16;
   /// Impulse contacts: the impulse stage's own substeps per substep (the contacts found once).
   int impulse_substeps = 4;
+  /// Impulse contacts: a particle whose neighbour list a build leaves unchanged keeps its
+  /// contacts' accumulated impulses (warm start) through the build. Runs over MPI ranks turn it
+  /// off (the memory does not travel with a partition yet: docs/scale-out.md), so that they stay
+  /// bitwise equal to one process run with it off.
+  bool impulse_memory_across_builds = true;
   Material contact;  ///< defaults for materials' missing fields
 };
 
