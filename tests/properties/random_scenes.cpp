@@ -195,9 +195,11 @@ void make_pile(Case& c, Rng& rng) {
     b.wall(0.0, -half, 7, 24, true);
     b.wall(0.0, half, 7, 24, true);
   }
+  // 8 to 30 boxes dropped with restitution up to 0.5 are still rearranging at 2.5 to 3 s in some
+  // seeds (4 of the 5 that were not at rest over [2.5, 3] s are over [5, 6] s).
   c.settles = steady;
-  c.duration = 3.0;
-  c.rest_from = 2.5;
+  c.duration = 6.0;
+  c.rest_from = 5.0;
   c.summary = fmt::format("{} boxes dropped{}{}", n, tray ? " into a tray" : " on the floor",
                           steady ? ", none that rolls" : "");
 }
@@ -223,10 +225,14 @@ void make_stack(Case& c, Rng& rng) {
     }
     c.summary = fmt::format("a column of {} boxes of {}^3, offsets up to 0.1 d", k, side);
   } else {
+    // Boxes of a row 0.2 d apart before their offsets: laid side by side at exactly their size,
+    // offsets of +-0.1 d made neighbours start up to 0.2 d inside each other, and the push-out
+    // spread the rows until pyramids fell (stack 15; issue 25's stacks are misaligned, not
+    // interpenetrating).
     const int rows = rng.integer(2, 5);
     for (int r = 0; r < rows; ++r) {
       for (int j = 0; j < rows - r; ++j) {
-        const double x = (j - 0.5 * (rows - 1 - r)) * size + offset();
+        const double x = (j - 0.5 * (rows - 1 - r)) * (size + 0.2 * kD) + offset();
         b.add(dims, Eigen::Vector3d(x, 0.5 * size + r * size + (r + 1) * kGap, offset()));
       }
     }
