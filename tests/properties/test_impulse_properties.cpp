@@ -239,10 +239,12 @@ std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Cas
   return out;
 }
 
-/// Seeds whose rest check still fails in CI's batches on openmp (deterministic there: the same
-/// bits on any machine and thread count), issue 25 open: their energy and travel are checked as
-/// every other seed's, their rest is reported, named, but does not fail the test. Found with 30
-/// seeds per kind in batches of 20 (docs/validation.md, section 14): a 4^3 box perched on three
+/// Seeds whose rest check still fails in CI's run on openmp (the default seeds and batches, whose
+/// bits are the same on any machine and thread count), issue 25 open: their energy and travel are
+/// checked as every other seed's, their rest failure is printed, named, and not counted; one that
+/// comes to rest fails the test until it leaves this list (a seed run otherwise, alone or in
+/// another batch, is checked as any other: KeptImpulseSeeds runs drops 2 and 8 alone). Found with
+/// 30 seeds per kind in batches of 20 (docs/validation.md, section 14): a 4^3 box perched on three
 /// sphere contacts 30 to 60 degrees off vertical that turns 0.013 rad/s (pile 17), fallen
 /// dominoes and floor piles at friction 0.31 to 0.44 that drift 0.01 to 0.02 d in 0.5 s or keep
 /// a speed of 2 to 12 mm/s without moving (chains 21, 29, 30; pile 25), dice that drift 0.015 and
@@ -255,8 +257,7 @@ constexpr Known kKnownRestless[] = {{Kind::Chain, 21}, {Kind::Chain, 29}, {Kind:
                                     {Kind::Pile, 17},  {Kind::Pile, 25},  {Kind::Drop, 2},
                                     {Kind::Drop, 8}};
 
-bool known_restless(const std::string& backend, const Case& c) {
-  if (backend != "openmp") return false;  // other backends' bits differ: every seed checked
+bool known_restless(const Case& c) {
   return std::any_of(std::begin(kKnownRestless), std::end(kKnownRestless),
                      [&c](const Known& k) { return k.kind == c.kind && k.seed == c.seed; });
 }
@@ -286,8 +287,15 @@ void check_cases(const std::string& backend, const std::vector<Case>& cases,
         worst_drift_seed = c.seed;
       }
       worst.travel = std::max(worst.travel, o.travel);
+      const bool waived = waive_known && known_restless(c);
+      if (waived && o.failure.empty()) {
+        ADD_FAILURE() << fmt::format(
+            "{} seed {} on {} is at rest now: take it out of kKnownRestless", kind_name(c.kind),
+            c.seed, backend);
+        continue;
+      }
       if (o.failure.empty()) continue;
-      if (waive_known && o.failure.rfind("not at rest", 0) == 0 && known_restless(backend, c)) {
+      if (waived && o.failure.rfind("not at rest", 0) == 0) {
         ++known;
         std::printf("%s seed %u on %s: %s (known, issue 25: not counted)\n", kind_name(c.kind),
                     c.seed, backend.c_str(), o.failure.c_str());
@@ -334,8 +342,17 @@ TEST_P(RandomImpulseScenes, KeepEnergyStayQuietAndComeToRest) {
       cases.push_back(make_case(kind, static_cast<std::uint32_t>(s)));
     }
   }
+  // The known seeds are waived only in the run they were found in: CI's, openmp with every default
+  // (other seeds, batches, sweeps or durations give other bits).
+  bool ci_run = backend == "openmp" && !kQuick;
+  for (const char* name : {"MOTES_PROPERTY_SEED", "MOTES_PROPERTY_SEEDS", "MOTES_PROPERTY_FIRST",
+                           "MOTES_PROPERTY_BATCH", "MOTES_PROPERTY_DURATION",
+                           "MOTES_PROPERTY_ITERATIONS", "MOTES_PROPERTY_SUBSTEPS"}) {
+    const char* v = std::getenv(name);
+    ci_run = ci_run && (v == nullptr || *v == '\0');
+  }
   check_cases(backend, cases, kind_name(kind),
-              static_cast<std::size_t>(std::max(1, env_int("MOTES_PROPERTY_BATCH", 20))), true);
+              static_cast<std::size_t>(std::max(1, env_int("MOTES_PROPERTY_BATCH", 20))), ci_run);
 }
 
 std::string param_name(const ::testing::TestParamInfo<Param>& p) {
