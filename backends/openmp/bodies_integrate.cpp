@@ -25,19 +25,17 @@ void OpenMPDevice::bodies_integrate(const shared::StepParams& p) {
   if ((p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u) {
     const vec4* vel_push = buf<vec4>(Buffer::BodyVelPush);
     const vec4* angmom_push = buf<vec4>(Buffer::BodyAngMomPush);
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(bodies))
-    for (std::int64_t b = 0; b < bodies; ++b) {
+    for_items(bodies, parallel(bodies), [&](std::int64_t b) {
       shared::body_push_pose(pos[b], quat[b], angvel[b], inv_inertia[b], angmom[b], vel_push[b],
                              angmom_push[b], p.gravity_dt);
-    }
+    });
     record(Kernel::BodiesIntegrate, start);
     return;
   }
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(bodies))
-  for (std::int64_t b = 0; b < bodies; ++b) {
+  for_items(bodies, parallel(bodies), [&](std::int64_t b) {
     shared::body_integrate(pos[b], quat[b], vel[b], angmom[b], angvel[b], inv_inertia[b], force[b],
                            torque[b], p.gravity_dt, p.flags);
-  }
+  });
   record(Kernel::BodiesIntegrate, start);
 }
 

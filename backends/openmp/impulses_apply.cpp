@@ -46,8 +46,7 @@ void OpenMPDevice::impulses_apply(const shared::StepParams& p) {
               p.rigid_particle_count > 0
           ? impulse_touches_.data()
           : nullptr;
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(bodies))
-  for (std::int64_t b = 0; b < bodies; ++b) {
+  for_items(bodies, parallel(bodies), [&](std::int64_t b) {
     vec4 sum(0.0f);
     vec3 m(0.0f);
     if (com[b].w != 0.0f) {
@@ -72,7 +71,7 @@ void OpenMPDevice::impulses_apply(const shared::StepParams& p) {
       vel_push[b] = vel[b];
       angmom_push[b] = angmom[b];
     }
-  }
+  });
   record(Kernel::ImpulsesApply, start);
 }
 

@@ -61,10 +61,9 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
   if (counting || impulse_frames_.size() != std::size_t(bodies)) {
     impulse_frames_.resize(std::size_t(bodies));
     shared::ImpulseBody* frames = impulse_frames_.data();
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(bodies))
-    for (std::int64_t b = 0; b < bodies; ++b) {
+    for_items(bodies, parallel(bodies), [&](std::int64_t b) {
       frames[b] = shared::impulse_body_frame(com[b], quat[b], inv_inertia[b]);
-    }
+    });
   }
   const shared::ImpulseBody* frames = impulse_frames_.data();
   const auto impulse_body = [&](uint b) {
@@ -133,7 +132,9 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     }
   };
 
-  // One particle's contacts: its list (or the grid beyond K), then the planes.
+  // One particle's contacts: its list (or the grid beyond K), then the planes. defer: a counting
+  // pass that keeps its contacts (impulses_count_kept) only finds which particles touch.
+  bool defer = false;
   const auto particle = [&](std::int64_t i) {
     const vec4 xi = pos[i];
     if (vel[i].w == 0.0f) {  // static particle: its impulse is never used
@@ -175,6 +176,7 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
         moment[i] = vec4(0.0f);
         return false;
       }
+      if (defer) return true;
     }
     const uint bi = body[i];
     const shared::ImpulseBody own = impulse_body(bi);
@@ -234,16 +236,31 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
   if (counting) {
     impulse_touches_.resize(std::size_t(n));
     std::uint8_t* touches = impulse_touches_.data();
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel_heavy(n))
-    for (std::int64_t i = 0; i < n; ++i) touches[i] = particle(i) ? 1 : 0;
+    // Which particles touch something; those within their lists' capacity are evaluated below
+    // (2), from kept contact frames where they can be (impulses_sweep.cpp), else here.
+    defer = true;
+    for_items(n, parallel_heavy(n), [&](std::int64_t i) {
+      touches[i] = particle(i) ? (count[i] <= capacity ? 2 : 1) : 0;
+    });
+    defer = false;
     impulse_active_.clear();
     for (std::int64_t i = 0; i < n; ++i) {
       if (touches[i] != 0) impulse_active_.push_back(static_cast<uint>(i));
+    }
+    if (!impulses_count_kept(p)) {
+      const auto active = static_cast<std::int64_t>(impulse_active_.size());
+      const uint* ids = impulse_active_.data();
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel_heavy(active))
+      for (std::int64_t a = 0; a < active; ++a) {
+        if (touches[ids[a]] == 2) particle(ids[a]);
+      }
     }
   } else if (impulse_touches_.size() != std::size_t(n)) {
     // No counting pass at these sizes yet: every particle.
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
     for (std::int64_t i = 0; i < n; ++i) particle(i);
+  } else if (impulses_sweep(p)) {
+    // The sweeps of this substep from its contacts' kept frames (impulses_sweep.cpp).
   } else {
     // The sweeps of this substep: only the particles the counting pass found touching (a
     // contact within reach touches both), their shared contacts first.

@@ -111,6 +111,7 @@ Status OpenMPDevice::allocate(const Sizes& sizes) {
     ids_tmp_.assign(sizes.particles, 0);
     buffers_ = std::move(fresh);
     impulse_mirror_.clear();
+    impulse_contacts_ready_ = false;
   } catch (const std::bad_alloc&) {
     return Status::error(
         fmt::format("out of host memory allocating {} particles and {} bodies on the openmp device",
@@ -128,6 +129,7 @@ Status OpenMPDevice::write(Buffer b, const void* src, std::size_t bytes) {
                                      buffer_name(b), buffers_[i].size()));
   }
   if (bytes > 0) std::memcpy(buffers_[i].data(), src, bytes);
+  impulse_contacts_ready_ = false;  // what the kept contact frames were made from may have changed
   if (b == Buffer::NeighbourList || b == Buffer::NeighbourCount) impulse_mirror_.clear();
   return Status::ok();
 }

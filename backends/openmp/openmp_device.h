@@ -87,6 +87,18 @@ class OpenMPDevice final : public Device {
   [[nodiscard]] bool parallel_heavy(std::int64_t items) const {
     return threads_ > 1 && items * 16 >= min_parallel_;
   }
+  /// Runs f(i) for every i in [0, n): on the team when `on`, else on this thread without entering
+  /// an OpenMP region (a region that runs on one thread still costs about 0.6 us: libgomp makes
+  /// it a team; a small impulse scene enters some 80 a step).
+  template <typename F>
+  void for_items(std::int64_t n, bool on, const F& f) const {
+    if (!on) {
+      for (std::int64_t i = 0; i < n; ++i) f(i);
+      return;
+    }
+#pragma omp parallel for num_threads(threads_) schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) f(i);
+  }
   template <typename T>
   T* buf(Buffer b) {
     return reinterpret_cast<T*>(buffers_[static_cast<std::size_t>(b)].data());
@@ -117,6 +129,32 @@ class OpenMPDevice final : public Device {
   /// and each slot's contact impulse of the sweep (w: counted).
   std::vector<std::uint32_t> impulse_mirror_;
   std::vector<shared::vec4> impulse_pair_;
+  /// impulses_sweep.cpp: a contact within reach at the last counting pass, with what the
+  /// substep's sweeps do not change; bodies a and b (b == the body count: a plane); the slots of
+  /// its accumulated impulse in ContactImpulse (kNone: none, it starts from 0 every sweep).
+  struct ImpulseContact {
+    shared::ContactFrame frame;
+    shared::ContactLaw law;
+    std::uint32_t a, b, slot, mirror;
+    bool warm;  // the counting pass starts from the slot's accumulated impulse (the sweeps always)
+  };
+  /// The counting pass and the sweeps from kept contact frames (impulses_sweep.cpp): false when
+  /// they cannot be kept (a touching particle beyond its list's capacity), and impulses_compute
+  /// evaluates every contact itself.
+  bool impulses_count_kept(const shared::StepParams& p);
+  bool impulses_sweep(const shared::StepParams& p);
+  bool impulse_contacts_build(const shared::StepParams& p, bool counting);
+  void impulse_bodies_update(const shared::StepParams& p);
+  void impulse_contacts_solve(const shared::StepParams& p);
+  /// The substep's contacts (built by its first sweep, dropped by a counting pass or a write),
+  /// each sweep's results, and per active particle its contacts in order (index * 2 + 1: the
+  /// higher id's side of a pair), from impulse_entry_first_[a]; each body as the sweep sees it
+  /// (impulse_body_state), then a plane; a slot's contact while the list is built.
+  std::vector<ImpulseContact> impulse_contacts_;
+  std::vector<shared::vec4> impulse_results_;
+  std::vector<std::uint32_t> impulse_entries_, impulse_entry_first_, impulse_slot_contact_;
+  std::vector<shared::ImpulseBody> impulse_bodies_;
+  bool impulse_contacts_ready_ = false, impulse_responses_ready_ = false;
   bool timing_ = false;
   KernelTimes times_;
 };

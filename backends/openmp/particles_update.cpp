@@ -16,6 +16,7 @@ using shared::vec4;
 
 void OpenMPDevice::particles_update(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
+  impulse_contacts_ready_ = false;  // positions move: impulses_sweep lists its contacts again
   const auto n = static_cast<std::int64_t>(p.rigid_particle_count);
   const vec4* ref = buf<vec4>(Buffer::NeighbourRefPos);
   const uint* body = buf<uint>(Buffer::ParticleBody);
@@ -30,12 +31,8 @@ void OpenMPDevice::particles_update(const shared::StepParams& p) {
   vec4* impulse = absorb ? buf<vec4>(Buffer::ParticleForce) : nullptr;
   vec4* moment = absorb ? buf<vec4>(Buffer::ParticleMoment) : nullptr;
 
-  uint moved = 0;
-
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n)) \
-    reduction(|                                                                  \
-              : moved)
-  for (std::int64_t i = 0; i < n; ++i) {
+  // One particle follows its body; true when it moved far enough to ask for new lists.
+  const auto follow = [&](std::int64_t i) {
     const uint b = body[i];
     if (absorb) {
       const shared::vec3 j =
@@ -45,7 +42,14 @@ void OpenMPDevice::particles_update(const shared::StepParams& p) {
     }
     pos[i] = vec4(shared::particle_position(body_pos[b], quat[b], local[i]), pos[i].w);
     vel[i] = vec4(shared::particle_velocity(quat[b], body_vel[b], angvel[b], local[i]), vel[i].w);
-    moved |= shared::neighbour_moved_too_far(pos[i], ref[i], p.neighbour_skin) ? 1u : 0u;
+    return shared::neighbour_moved_too_far(pos[i], ref[i], p.neighbour_skin);
+  };
+  uint moved = 0;
+  if (!parallel(n)) {  // without entering an OpenMP region (for_items)
+    for (std::int64_t i = 0; i < n; ++i) moved |= follow(i) ? 1u : 0u;
+  } else {
+#pragma omp parallel for num_threads(threads_) schedule(static) reduction(| : moved)
+    for (std::int64_t i = 0; i < n; ++i) moved |= follow(i) ? 1u : 0u;
   }
   if (moved != 0) buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_REBUILD] = 1;
   record(Kernel::ParticlesUpdate, start);

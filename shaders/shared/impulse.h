@@ -194,33 +194,52 @@ MOTES_FN vec3 plane_contact_point(vec4 xa, vec4 normal_offset) {
   return xyz(xa) - xyz(normal_offset) * xa.w;
 }
 
-/// The impulse on body a of a contact between bodies a and b at point c, normal n (unit, from b
-/// towards a), separation sep, r_a + r_b = rsum (on b: its negation), as a change of the contact's
-/// accumulated impulse acc (xyz: the total impulse on a in this substep; w: its normal part, >= 0).
-/// Returns (the change, counted): every contact within reach counts for mass splitting (1), so a
-/// body is never seen lighter than its contacts can make it (fewer would let the sweeps overshoot,
-/// and grow, as soon as a contact that was apart at the count starts to push).
-/// - Counting pass (MOTES_FLAG_IMPULSE_COUNT): warm start. A contact that touches or needs an
-///   impulse at the start of the substep starts from the total of the last substep (acc), its
-///   tangential part capped at mu times its normal part; one that does not starts from zero.
-/// - Sweeps: the normal total grows by what brings the normal velocity to impulse_target (soft
-///   where impulse_target says so) and is clamped at zero (a contact pushes, never pulls, but may
-///   take back what it pushed too much); then, from the velocity that leaves (the contact solved
-///   as one block), the tangential total grows by what stops the sliding at c and is capped at mu
-///   times the normal total (law.friction < 0: no cap; 0: none). Only totals are clamped, so the
-///   sweeps converge to the simultaneous solution (projected Gauss-Seidel's rule, applied
-///   Jacobi-style).
-/// With acc = 0 on entry every time (a contact without a slot), this is the plain impulse.
-MOTES_FN vec4 contact_impulse(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, vec3 c, vec3 n,
-                              float sep, float rsum, ContactLaw law, vec4 gravity_dt, uint flags,
-                              MOTES_INOUT(vec4) acc) {
+/// What the sweeps of one substep do not change in a contact between bodies a and b at point c
+/// (contact_impulse): poses and the velocities at the substep's start are fixed until the pose.
+struct ContactFrame {
+  vec4 ra;        // xyz: arm on a (c - a's centre), w: separation (< 0: overlap)
+  vec4 rb;        // xyz: arm on b, w: r_a + r_b
+  vec4 n;         // xyz: unit normal from b towards a, w: normal velocity at the substep's start
+  vec4 response;  // xyz: the contact's response to a unit normal impulse, w: its normal part
+};
+
+/// A contact's frame before its response is known (contact_frame_response: the bodies' contact
+/// counts, which scale it, are known only after the counting pass).
+MOTES_FN ContactFrame contact_frame(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, vec3 c,
+                                    vec3 n, float sep, float rsum) {
+  ContactFrame f;
   vec3 ra = c - xyz(a.com);
   vec3 rb = c - xyz(b.com);
   vec3 u0 =
       impulse_point_velocity(a.vel0, a.angvel0, ra) - impulse_point_velocity(b.vel0, b.angvel0, rb);
-  float vn0 = dot(u0, n);
+  f.ra = vec4(ra, sep);
+  f.rb = vec4(rb, rsum);
+  f.n = vec4(n, dot(u0, n));
+  f.response = vec4(0.0f);
+  return f;
+}
+
+/// The change of the relative velocity at the contact that a unit normal impulse makes (both
+/// bodies' impulse_response), and its normal part kn.
+MOTES_FN void contact_frame_response(MOTES_INOUT(ContactFrame) f, MOTES_IN(ImpulseBody) a,
+                                     MOTES_IN(ImpulseBody) b) {
+  vec3 n = xyz(f.n);
+  vec3 response = impulse_response(a, xyz(f.ra), n) + impulse_response(b, xyz(f.rb), n);
+  f.response = vec4(response, dot(response, n));
+}
+
+/// contact_impulse from the contact's frame f (its response filled unless counting), with the
+/// bodies' velocities now in a and b.
+MOTES_FN vec4 contact_solve(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b,
+                            MOTES_IN(ContactFrame) f, ContactLaw law, vec4 gravity_dt, uint flags,
+                            MOTES_INOUT(vec4) acc) {
+  vec3 ra = xyz(f.ra);
+  vec3 rb = xyz(f.rb);
+  vec3 n = xyz(f.n);
+  float sep = f.ra.w;
+  float vn0 = f.n.w;
   float soft = 0.0f;
-  float target = impulse_target(sep, rsum, vn0, law.restitution, gravity_dt, flags, soft);
+  float target = impulse_target(sep, f.rb.w, vn0, law.restitution, gravity_dt, flags, soft);
   float counts = 1.0f;
   vec3 old_total = xyz(acc);
   float jn = acc.w;
@@ -233,8 +252,8 @@ MOTES_FN vec4 contact_impulse(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, 
     vec3 u =
         impulse_point_velocity(a.vel, a.angvel, ra) - impulse_point_velocity(b.vel, b.angvel, rb);
     float vn = dot(u, n);
-    vec3 response = impulse_response(a, ra, n) + impulse_response(b, rb, n);
-    float kn = dot(response, n);
+    vec3 response = xyz(f.response);
+    float kn = f.response.w;
     if (!(kn > 0.0f)) {
       return vec4(0.0f, 0.0f, 0.0f, counts);
     }
@@ -267,6 +286,35 @@ MOTES_FN vec4 contact_impulse(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, 
   // The counting pass applies the whole warm start: nothing of this substep is applied yet.
   vec3 applied = (flags & MOTES_FLAG_IMPULSE_COUNT) != 0u ? vec3(0.0f) : old_total;
   return vec4(total - applied, counts);
+}
+
+/// The impulse on body a of a contact between bodies a and b at point c, normal n (unit, from b
+/// towards a), separation sep, r_a + r_b = rsum (on b: its negation), as a change of the contact's
+/// accumulated impulse acc (xyz: the total impulse on a in this substep; w: its normal part, >= 0).
+/// Returns (the change, counted): every contact within reach counts for mass splitting (1), so a
+/// body is never seen lighter than its contacts can make it (fewer would let the sweeps overshoot,
+/// and grow, as soon as a contact that was apart at the count starts to push).
+/// - Counting pass (MOTES_FLAG_IMPULSE_COUNT): warm start. A contact that touches or needs an
+///   impulse at the start of the substep starts from the total of the last substep (acc), its
+///   tangential part capped at mu times its normal part; one that does not starts from zero.
+/// - Sweeps: the normal total grows by what brings the normal velocity to impulse_target (soft
+///   where impulse_target says so) and is clamped at zero (a contact pushes, never pulls, but may
+///   take back what it pushed too much); then, from the velocity that leaves (the contact solved
+///   as one block), the tangential total grows by what stops the sliding at c and is capped at mu
+///   times the normal total (law.friction < 0: no cap; 0: none). Only totals are clamped, so the
+///   sweeps converge to the simultaneous solution (projected Gauss-Seidel's rule, applied
+///   Jacobi-style).
+/// With acc = 0 on entry every time (a contact without a slot), this is the plain impulse. It is
+/// contact_frame, contact_frame_response and contact_solve: a backend that keeps the frames of a
+/// substep's contacts (openmp) solves each sweep from them, with the same bits.
+MOTES_FN vec4 contact_impulse(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, vec3 c, vec3 n,
+                              float sep, float rsum, ContactLaw law, vec4 gravity_dt, uint flags,
+                              MOTES_INOUT(vec4) acc) {
+  ContactFrame f = contact_frame(a, b, c, n, sep, rsum);
+  if ((flags & MOTES_FLAG_IMPULSE_COUNT) == 0u) {
+    contact_frame_response(f, a, b);
+  }
+  return contact_solve(a, b, f, law, gravity_dt, flags, acc);
 }
 
 /// The impulse on body a of particle a (centre xa, radius ra) touching particle b, as a change of
@@ -379,5 +427,11 @@ MOTES_FN void body_apply_impulse(vec4 com, vec4 quat, vec4 inv_inertia, MOTES_IN
 }
 
 MOTES_SHARED_END
+
+#ifdef __cplusplus
+// The openmp backend keeps these in arrays (impulses_sweep.cpp).
+static_assert(sizeof(motes::shared::ImpulseBody) == 112, "ImpulseBody layout");
+static_assert(sizeof(motes::shared::ContactFrame) == 64, "ContactFrame layout");
+#endif
 
 #endif  // MOTES_SHARED_IMPULSE_H
