@@ -46,10 +46,20 @@ void OpenMPDevice::impulses_apply(const shared::StepParams& p) {
               p.rigid_particle_count > 0
           ? impulse_touches_.data()
           : nullptr;
+  // Each body's run of them in the ascending list of touching particles (impulses_compute).
+  const uint* runs = touches != nullptr && impulse_body_active_.size() == std::size_t(bodies) + 1
+                         ? impulse_body_active_.data()
+                         : nullptr;
+  const uint* active = impulse_active_.data();
   for_items(bodies, parallel(bodies), [&](std::int64_t b) {
     vec4 sum(0.0f);
     vec3 m(0.0f);
-    if (com[b].w != 0.0f) {
+    if (com[b].w != 0.0f && runs != nullptr) {
+      for (uint k = runs[b]; k < runs[b + 1]; ++k) {  // the same particles in the same order
+        sum = sum + impulse[active[k]];
+        m += shared::xyz(moment[active[k]]);
+      }
+    } else if (com[b].w != 0.0f) {
       for (uint i = first[b]; i < first[b + 1]; ++i) {
         // A particle the counting pass found touching nothing has zeros, whose sum changes
         // nothing: skip reading them.

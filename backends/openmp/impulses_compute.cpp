@@ -7,6 +7,7 @@
 // on both sides). The counting pass reads the slots only while the lists are those that wrote them
 // (ImpulseStamp), and stamps them. The sweeps visit only the particles that the counting pass
 // found with a contact within reach (the others' results are zeros that stay so).
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 
@@ -246,6 +247,14 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     impulse_active_.clear();
     for (std::int64_t i = 0; i < n; ++i) {
       if (touches[i] != 0) impulse_active_.push_back(static_cast<uint>(i));
+    }
+    // Each body's touching particles: a run of the ascending active list (impulses_apply).
+    const uint* first = buf<uint>(Buffer::BodyFirst);
+    impulse_body_active_.resize(std::size_t(bodies) + 1);
+    for (std::int64_t b = 0; b <= bodies; ++b) {
+      impulse_body_active_[std::size_t(b)] = static_cast<uint>(
+          std::lower_bound(impulse_active_.begin(), impulse_active_.end(), first[b]) -
+          impulse_active_.begin());
     }
     if (!impulses_count_kept(p)) {
       const auto active = static_cast<std::int64_t>(impulse_active_.size());

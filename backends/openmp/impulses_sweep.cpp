@@ -93,10 +93,11 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
       ImpulseContact ct;
       ct.a = own_first ? body[i] : body[j];
       ct.b = own_first ? body[j] : body[i];
-      ct.frame = shared::contact_frame(bodies[ct.a], bodies[ct.b], shared::pair_contact_point(xa, xb),
-                                       d / dist, dist - rsum, rsum);
-      if (!counting) shared::contact_frame_response(ct.frame, bodies[ct.a], bodies[ct.b]);
       ct.law = laws[shared::pair_law_index(i, material[i], j, material[j], materials)];
+      ct.frame =
+          shared::contact_frame(bodies[ct.a], bodies[ct.b], shared::pair_contact_point(xa, xb),
+                                d / dist, dist - rsum, rsum, ct.law.restitution, p.gravity_dt);
+      if (!counting) shared::contact_frame_response(ct.frame, bodies[ct.a], bodies[ct.b]);
       ct.slot = slotted ? uint(at) : kNone;
       ct.mirror = m != kNone ? uint(std::size_t{m} * nr + j) : kNone;
       // The counting pass's warm start (impulse_slots_valid, alike for both particles of a pair).
@@ -116,11 +117,11 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
       ImpulseContact ct;
       ct.a = body[i];
       ct.b = wall;
-      ct.frame = shared::contact_frame(bodies[ct.a], bodies[wall],
-                                       shared::plane_contact_point(xi, no), shared::xyz(no), sep,
-                                       xi.w);
-      if (!counting) shared::contact_frame_response(ct.frame, bodies[ct.a], bodies[wall]);
       ct.law = laws[own_law + planes[k].material];
+      ct.frame =
+          shared::contact_frame(bodies[ct.a], bodies[wall], shared::plane_contact_point(xi, no),
+                                shared::xyz(no), sep, xi.w, ct.law.restitution, p.gravity_dt);
+      if (!counting) shared::contact_frame_response(ct.frame, bodies[ct.a], bodies[wall]);
       ct.slot = uint(slot);
       ct.mirror = kNone;
       ct.warm = true;
@@ -170,8 +171,7 @@ void OpenMPDevice::impulse_contacts_solve(const shared::StepParams& p) {
     // The first sweep after the counting pass: the bodies' contact counts are known now.
     if (respond) shared::contact_frame_response(ct.frame, state[ct.a], state[ct.b]);
     vec4 a = ct.slot != kNone && (ct.warm || !counting) ? acc[ct.slot] : vec4(0.0f);
-    result[c] = shared::contact_solve(state[ct.a], state[ct.b], ct.frame, ct.law, p.gravity_dt,
-                                      p.flags, a);
+    result[c] = shared::contact_solve(state[ct.a], state[ct.b], ct.frame, ct.law, p.flags, a);
     if (ct.slot != kNone) acc[ct.slot] = a;
     if (ct.mirror != kNone) acc[ct.mirror] = a;
   };

@@ -120,6 +120,8 @@ class OpenMPDevice final : public Device {
   /// pass and its sweeps, so the sweeps visit only these: the others' impulses stay 0.
   std::vector<std::uint32_t> impulse_active_;
   std::vector<std::uint8_t> impulse_touches_;
+  /// Per body (and one past the last), where its particles start in impulse_active_.
+  std::vector<std::uint32_t> impulse_body_active_;
   /// impulses_compute: each body's shared::impulse_body_frame, made by the counting pass.
   std::vector<shared::ImpulseBody> impulse_frames_;
   /// impulses_compute's sweeps evaluate a contact of two dynamic rigid particles once, at the

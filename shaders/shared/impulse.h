@@ -200,21 +200,31 @@ struct ContactFrame {
   vec4 ra;        // xyz: arm on a (c - a's centre), w: separation (< 0: overlap)
   vec4 rb;        // xyz: arm on b, w: r_a + r_b
   vec4 n;         // xyz: unit normal from b towards a, w: normal velocity at the substep's start
+  vec4 target;    // impulse_target and its soft flag: x, y in the correcting sweeps (and the
+                  // counting pass), z, w in the relaxing ones (MOTES_FLAG_IMPULSE_RELAX)
   vec4 response;  // xyz: the contact's response to a unit normal impulse, w: its normal part
 };
 
 /// A contact's frame before its response is known (contact_frame_response: the bodies' contact
 /// counts, which scale it, are known only after the counting pass).
 MOTES_FN ContactFrame contact_frame(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, vec3 c,
-                                    vec3 n, float sep, float rsum) {
+                                    vec3 n, float sep, float rsum, float restitution,
+                                    vec4 gravity_dt) {
   ContactFrame f;
   vec3 ra = c - xyz(a.com);
   vec3 rb = c - xyz(b.com);
   vec3 u0 =
       impulse_point_velocity(a.vel0, a.angvel0, ra) - impulse_point_velocity(b.vel0, b.angvel0, rb);
+  float vn0 = dot(u0, n);
   f.ra = vec4(ra, sep);
   f.rb = vec4(rb, rsum);
-  f.n = vec4(n, dot(u0, n));
+  f.n = vec4(n, vn0);
+  float soft = 0.0f;
+  float relax_soft = 0.0f;
+  float target = impulse_target(sep, rsum, vn0, restitution, gravity_dt, 0u, soft);
+  float relax_target =
+      impulse_target(sep, rsum, vn0, restitution, gravity_dt, MOTES_FLAG_IMPULSE_RELAX, relax_soft);
+  f.target = vec4(target, soft, relax_target, relax_soft);
   f.response = vec4(0.0f);
   return f;
 }
@@ -231,15 +241,16 @@ MOTES_FN void contact_frame_response(MOTES_INOUT(ContactFrame) f, MOTES_IN(Impul
 /// contact_impulse from the contact's frame f (its response filled unless counting), with the
 /// bodies' velocities now in a and b.
 MOTES_FN vec4 contact_solve(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b,
-                            MOTES_IN(ContactFrame) f, ContactLaw law, vec4 gravity_dt, uint flags,
+                            MOTES_IN(ContactFrame) f, ContactLaw law, uint flags,
                             MOTES_INOUT(vec4) acc) {
   vec3 ra = xyz(f.ra);
   vec3 rb = xyz(f.rb);
   vec3 n = xyz(f.n);
   float sep = f.ra.w;
   float vn0 = f.n.w;
-  float soft = 0.0f;
-  float target = impulse_target(sep, f.rb.w, vn0, law.restitution, gravity_dt, flags, soft);
+  bool relaxing = (flags & MOTES_FLAG_IMPULSE_RELAX) != 0u;
+  float target = relaxing ? f.target.z : f.target.x;
+  float soft = relaxing ? f.target.w : f.target.y;
   float counts = 1.0f;
   vec3 old_total = xyz(acc);
   float jn = acc.w;
@@ -310,11 +321,11 @@ MOTES_FN vec4 contact_solve(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b,
 MOTES_FN vec4 contact_impulse(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, vec3 c, vec3 n,
                               float sep, float rsum, ContactLaw law, vec4 gravity_dt, uint flags,
                               MOTES_INOUT(vec4) acc) {
-  ContactFrame f = contact_frame(a, b, c, n, sep, rsum);
+  ContactFrame f = contact_frame(a, b, c, n, sep, rsum, law.restitution, gravity_dt);
   if ((flags & MOTES_FLAG_IMPULSE_COUNT) == 0u) {
     contact_frame_response(f, a, b);
   }
-  return contact_solve(a, b, f, law, gravity_dt, flags, acc);
+  return contact_solve(a, b, f, law, flags, acc);
 }
 
 /// The impulse on body a of particle a (centre xa, radius ra) touching particle b, as a change of
@@ -416,8 +427,8 @@ MOTES_FN void body_apply_impulse(vec4 com, vec4 quat, vec4 inv_inertia, MOTES_IN
                                  MOTES_INOUT(vec4) angmom, MOTES_OUT(vec4) angvel, vec3 impulse,
                                  vec3 moment) {
   float inv_m = com.w;
-  angvel = vec4(body_angular_velocity(quat, inv_inertia, xyz(angmom)), 0.0f);
   if (inv_m == 0.0f) {
+    angvel = vec4(body_angular_velocity(quat, inv_inertia, xyz(angmom)), 0.0f);
     return;
   }
   vec3 l = xyz(angmom) + moment;
@@ -431,7 +442,7 @@ MOTES_SHARED_END
 #ifdef __cplusplus
 // The openmp backend keeps these in arrays (impulses_sweep.cpp).
 static_assert(sizeof(motes::shared::ImpulseBody) == 112, "ImpulseBody layout");
-static_assert(sizeof(motes::shared::ContactFrame) == 64, "ContactFrame layout");
+static_assert(sizeof(motes::shared::ContactFrame) == 80, "ContactFrame layout");
 #endif
 
 #endif  // MOTES_SHARED_IMPULSE_H
