@@ -22,7 +22,7 @@ install(FILES
         core/include/motes/status.h core/include/motes/workloads.h
         render/include/motes/render.h render/include/motes/render_output.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/motes)
-install(FILES core/include/motes/backend/device.h
+install(FILES core/include/motes/backend/device.h core/include/motes/backend/kernels.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/motes/backend)
 file(GLOB MOTES_SHARED_HEADERS CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/shaders/shared/*.h)
 install(FILES ${MOTES_SHARED_HEADERS} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/motes/shared)

@@ -1,7 +1,7 @@
 #version 450
 // grid_build, pass 1 of 5: the bucket of every particle, and its arrival rank in the bucket. The
-// rank comes from an integer atomic, so it is in no particular order; grid_build_place restores
-// the canonical (bucket, particle id) order. GridCellStart holds the counts until the scan.
+// rank comes from an integer atomic, so it is in no particular order; grid_build.comp (the last pass)
+// restores the canonical (bucket, particle id) order. GridCellStart holds the counts until the scan.
 #extension GL_GOOGLE_include_directive : require
 #include "kernel_common.glsl"
 #include "shared/grid_hash.h"

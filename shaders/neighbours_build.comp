@@ -1,5 +1,6 @@
 #version 450
-// neighbours_build (after neighbours_begin or neighbours_decide): every dynamic particle (one thread per particle id) lists the
+// neighbours_build (after neighbours_build_begin.comp or neighbours_update.comp): every dynamic
+// particle (one thread per particle id) lists the
 // particles of other bodies closer than r_i + r_j + skin (shared/neighbours.h) in the canonical
 // order of the 27-cell walk, keeps the first K (entry k at k * N + i) and writes its full count;
 // as backends/openmp/neighbours_build.cpp. The figures of the build (particles over capacity,

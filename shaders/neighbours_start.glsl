@@ -1,6 +1,6 @@
 // The start of a neighbour-list build in NeighbourState: no rebuild pending, one more build, and
 // the figures of this build from zero (neighbours_build adds to them with atomics). Run by one
-// invocation: neighbours_begin.comp before a build on its own, neighbours_decide.comp before a
+// invocation: neighbours_build_begin.comp before a build on its own, neighbours_update.comp before a
 // conditional one. Needs kernel_common.glsl and shared/neighbours.h.
 #ifndef MOTES_NEIGHBOURS_START_GLSL
 #define MOTES_NEIGHBOURS_START_GLSL

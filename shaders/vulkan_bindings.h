@@ -54,7 +54,8 @@
 #define B_GRID_UNSORTED 46  // uint (N): particle ids grouped by bucket, in arrival order
 #define B_SCAN_SCRATCH 47   // uint: block sums of every level of the bucket-count scan
 // uint: VkDispatchIndirectCommand (4 words each) of every pass of a conditional rebuild, then the
-// same for when it runs (written once at allocate); neighbours_decide copies or zeroes the first.
+// same for when it runs (written once at allocate); neighbours_update.comp copies or zeroes the
+// first.
 #define B_INDIRECT_ARGS 48
 #define B_COUNT 49
 

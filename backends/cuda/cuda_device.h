@@ -39,42 +39,7 @@ class CudaDevice final : public Device {
   Status write(Buffer b, const void* src, std::size_t bytes) override;
   Status read(Buffer b, void* dst, std::size_t bytes) override;
 
-  void neighbours_update(const shared::StepParams& p) override {
-    enqueue(Kernel::NeighboursUpdate, p);
-  }
-  void grid_build(const shared::StepParams& p) override { enqueue(Kernel::GridBuild, p); }
-  void neighbours_build(const shared::StepParams& p) override {
-    enqueue(Kernel::NeighboursBuild, p);
-  }
-  void contacts_compute(const shared::StepParams& p) override {
-    enqueue(Kernel::ContactsCompute, p);
-  }
-  void bodies_reduce(const shared::StepParams& p) override { enqueue(Kernel::BodiesReduce, p); }
-  void bodies_integrate(const shared::StepParams& p) override {
-    enqueue(Kernel::BodiesIntegrate, p);
-  }
-  void particles_update(const shared::StepParams& p) override {
-    enqueue(Kernel::ParticlesUpdate, p);
-  }
-  void particles_integrate(const shared::StepParams& p) override {
-    enqueue(Kernel::ParticlesIntegrate, p);
-  }
-  void constraints_solve(const shared::StepParams& p) override {
-    enqueue(Kernel::ConstraintsSolve, p);
-  }
-  void clusters_fit(const shared::StepParams& p) override { enqueue(Kernel::ClustersFit, p); }
-  void clusters_goal(const shared::StepParams& p) override { enqueue(Kernel::ClustersGoal, p); }
-  void impulses_compute(const shared::StepParams& p) override {
-    enqueue(Kernel::ImpulsesCompute, p);
-  }
-  void impulses_apply(const shared::StepParams& p) override { enqueue(Kernel::ImpulsesApply, p); }
-  void particles_check(const shared::StepParams& p) override { enqueue(Kernel::ParticlesCheck, p); }
-  void energy_reduce(const shared::StepParams& p) override { enqueue(Kernel::EnergyReduce, p); }
-  void halo_pack(const shared::StepParams& p) override { enqueue(Kernel::HaloPack, p); }
-  void halo_unpack(const shared::StepParams& p) override { enqueue(Kernel::HaloUnpack, p); }
-  void particles_displacement(const shared::StepParams& p) override {
-    enqueue(Kernel::ParticlesDisplacement, p);
-  }
+  void enqueue(Kernel k, const shared::StepParams& p) override;
 
   Status synchronize() override;
   /// Page-locked host memory (cudaMallocHost): read() and write() move it by DMA.
@@ -114,7 +79,6 @@ class CudaDevice final : public Device {
   void release_buffers();
   void release_graphs();
 
-  void enqueue(Kernel k, const shared::StepParams& p);
   /// Runs every queued call: captured graphs when timing is off, timed launches when on.
   Status flush();
   Status run_timed(const std::vector<KernelCall>& calls);
@@ -128,25 +92,12 @@ class CudaDevice final : public Device {
   std::size_t launch(const std::vector<KernelCall>& calls, std::size_t i, bool fuse = true);
 
   // One file per kernel family launches it on stream_ (grid_build.cu, contacts_compute.cu...).
-  void launch_neighbours_update(const shared::StepParams& p);
+#define MOTES_LAUNCH_DECLARATION(E, name, reads, writes) \
+  void launch_##name(const shared::StepParams& p);
+  MOTES_KERNELS(MOTES_LAUNCH_DECLARATION)
+#undef MOTES_LAUNCH_DECLARATION
+  /// neighbours_update.cu: the kernel that sets the rebuild's IF-node condition.
   void launch_neighbours_decide(cudaGraphConditionalHandle handle);
-  void launch_grid_build(const shared::StepParams& p);
-  void launch_neighbours_build(const shared::StepParams& p);
-  void launch_particles_integrate(const shared::StepParams& p);
-  void launch_contacts_compute(const shared::StepParams& p);
-  void launch_bodies_reduce(const shared::StepParams& p);
-  void launch_bodies_integrate(const shared::StepParams& p);
-  void launch_particles_update(const shared::StepParams& p);
-  void launch_constraints_solve(const shared::StepParams& p);
-  void launch_clusters_fit(const shared::StepParams& p);
-  void launch_clusters_goal(const shared::StepParams& p);
-  void launch_impulses_compute(const shared::StepParams& p);
-  void launch_impulses_apply(const shared::StepParams& p);
-  void launch_particles_check(const shared::StepParams& p);
-  void launch_energy_reduce(const shared::StepParams& p);
-  void launch_halo_pack(const shared::StepParams& p);
-  void launch_halo_unpack(const shared::StepParams& p);
-  void launch_particles_displacement(const shared::StepParams& p);
   /// bodies_reduce, bodies_integrate and particles_update in one pass (bodies_step.cu), for scenes
   /// whose bodies are small; the same arithmetic as the three kernels.
   void launch_bodies_step(const shared::StepParams& p);

@@ -84,132 +84,24 @@ void CudaDevice::enqueue(Kernel k, const shared::StepParams& p) {
 
 std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t i, bool fuse) {
   const shared::StepParams& p = calls[i].params;
+  if (calls[i].kernel == Kernel::BodiesReduce && fuse && bodies_fusable_ &&
+      p.body_count == sizes_.bodies && p.rigid_particle_count == sizes_.rigid_particles &&
+      i + 2 < calls.size() && same_call(calls[i + 1], {Kernel::BodiesIntegrate, p}) &&
+      same_call(calls[i + 2], {Kernel::ParticlesUpdate, p})) {
+    launch_bodies_step(p);
+    return 3;
+  }
   switch (calls[i].kernel) {
-    case Kernel::NeighboursUpdate:
-      launch_neighbours_update(p);
-      return 1;
-    case Kernel::GridBuild:
-      launch_grid_build(p);
-      return 1;
-    case Kernel::NeighboursBuild:
-      launch_neighbours_build(p);
-      return 1;
-    case Kernel::ContactsCompute:
-      launch_contacts_compute(p);
-      return 1;
-    case Kernel::BodiesReduce:
-      if (fuse && bodies_fusable_ && p.body_count == sizes_.bodies &&
-          p.rigid_particle_count == sizes_.rigid_particles && i + 2 < calls.size() &&
-          same_call(calls[i + 1], {Kernel::BodiesIntegrate, p}) &&
-          same_call(calls[i + 2], {Kernel::ParticlesUpdate, p})) {
-        launch_bodies_step(p);
-        return 3;
-      }
-      launch_bodies_reduce(p);
-      return 1;
-    case Kernel::BodiesIntegrate:
-      launch_bodies_integrate(p);
-      return 1;
-    case Kernel::ParticlesUpdate:
-      launch_particles_update(p);
-      return 1;
-    case Kernel::ParticlesIntegrate:
-      launch_particles_integrate(p);
-      return 1;
-    case Kernel::ClustersFit:
-      launch_clusters_fit(p);
-      return 1;
-    case Kernel::ClustersGoal:
-      launch_clusters_goal(p);
-      return 1;
-    case Kernel::ConstraintsSolve:
-      launch_constraints_solve(p);
-      return 1;
-    case Kernel::ImpulsesCompute:
-      launch_impulses_compute(p);
-      return 1;
-    case Kernel::ImpulsesApply:
-      launch_impulses_apply(p);
-      return 1;
-    case Kernel::ParticlesCheck:
-      launch_particles_check(p);
-      return 1;
-    case Kernel::EnergyReduce:
-      launch_energy_reduce(p);
-      return 1;
-    case Kernel::HaloPack:
-      launch_halo_pack(p);
-      return 1;
-    case Kernel::HaloUnpack:
-      launch_halo_unpack(p);
-      return 1;
-    case Kernel::ParticlesDisplacement:
-      launch_particles_displacement(p);
-      return 1;
+#define MOTES_LAUNCH_CASE(E, name, reads, writes) \
+  case Kernel::E:                                 \
+    launch_##name(p);                             \
+    break;
+    MOTES_KERNELS(MOTES_LAUNCH_CASE)
+#undef MOTES_LAUNCH_CASE
     case Kernel::Count:
       break;
   }
   return 1;
-}
-
-void CudaDevice::launch_neighbours_update(const shared::StepParams& p) {
-  // Only ever called while stream_ is being captured (flush: graphs; run_timed decides on the
-  // host). A kernel sets the condition of an IF node from NeighbourState; the node's body, captured
-  // on a second stream, is grid_build then neighbours_build.
-  cudaStreamCaptureStatus status = cudaStreamCaptureStatusNone;
-  cudaGraph_t graph = nullptr;
-  const cudaGraphNode_t* deps = nullptr;
-  const cudaGraphEdgeData* edges = nullptr;
-  std::size_t dep_count = 0;
-  if (!check(cudaStreamGetCaptureInfo(stream_, &status, nullptr, &graph),
-             "cudaStreamGetCaptureInfo")) {
-    return;
-  }
-  if (status != cudaStreamCaptureStatusActive) {
-    check(cudaErrorStreamCaptureUnsupported, "neighbours_update outside a graph capture");
-    return;
-  }
-  cudaGraphConditionalHandle handle{};
-  if (!check(cudaGraphConditionalHandleCreate(&handle, graph, 0, 0),
-             "cudaGraphConditionalHandleCreate")) {
-    return;
-  }
-  launch_neighbours_decide(handle);
-  if (!check(cudaStreamGetCaptureInfo(stream_, &status, nullptr, &graph, &deps, &edges, &dep_count),
-             "cudaStreamGetCaptureInfo")) {
-    return;
-  }
-  cudaGraphNodeParams params{};
-  params.type = cudaGraphNodeTypeConditional;
-  params.conditional.handle = handle;
-  params.conditional.type = cudaGraphCondTypeIf;
-  params.conditional.size = 1;
-  cudaGraphNode_t node = nullptr;
-  if (!check(cudaGraphAddNode(&node, graph, deps, edges, dep_count, &params),
-             "cudaGraphAddNode (conditional)")) {
-    return;
-  }
-  if (!check(cudaStreamUpdateCaptureDependencies(stream_, &node, nullptr, 1,
-                                                 cudaStreamSetCaptureDependencies),
-             "cudaStreamUpdateCaptureDependencies")) {
-    return;
-  }
-  cudaGraph_t body = params.conditional.phGraph_out[0];
-  if (!check(cudaStreamBeginCaptureToGraph(body_stream_, body, nullptr, nullptr, 0,
-                                           cudaStreamCaptureModeThreadLocal),
-             "cudaStreamBeginCaptureToGraph")) {
-    return;
-  }
-  std::swap(stream_, body_stream_);  // the launches below go to the body's stream
-  launch_grid_build(p);
-  launch_neighbours_build(p);
-  std::swap(stream_, body_stream_);
-  const cudaError_t launched = cudaGetLastError();
-  cudaGraph_t captured = nullptr;
-  const cudaError_t ended = cudaStreamEndCapture(body_stream_, &captured);
-  if (check(launched, "a kernel launch in the conditional rebuild")) {
-    check(ended, "cudaStreamEndCapture (conditional rebuild)");
-  }
 }
 
 void CudaDevice::release_graphs() {

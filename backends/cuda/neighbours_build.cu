@@ -3,8 +3,7 @@
 // entries kept (entry k at k * N + i) and its full count written; as
 // backends/openmp/neighbours_build.cpp. Two launches: one thread starts the build in
 // NeighbourState, then a thread per particle; the build's figures are reduced per block and added
-// with integer atomics. neighbours_decide sets the condition of the graph's IF node that holds a
-// conditional rebuild (cuda_launch.cpp).
+// with integer atomics.
 #include "cuda_device.h"
 #include "grid_walk.cuh"
 #include "shared/impulse.h"
@@ -96,11 +95,6 @@ __global__ void neighbours_build_kernel(shared::StepParams p, BuildInputs in, Bu
   }
 }
 
-__global__ void neighbours_decide_kernel(cudaGraphConditionalHandle handle,
-                                         const uint* __restrict__ state) {
-  cudaGraphSetConditional(handle, state[MOTES_NEIGHBOUR_REBUILD] != 0 ? 1u : 0u);
-}
-
 }  // namespace
 
 void CudaDevice::launch_neighbours_build(const shared::StepParams& p) {
@@ -117,10 +111,6 @@ void CudaDevice::launch_neighbours_build(const shared::StepParams& p) {
                              ? buf<uint>(Buffer::ImpulseStamp)
                              : nullptr};
   neighbours_build_kernel<<<blocks_for(p.particle_count), kBlock, 0, stream_>>>(p, in, out);
-}
-
-void CudaDevice::launch_neighbours_decide(cudaGraphConditionalHandle handle) {
-  neighbours_decide_kernel<<<1, 1, 0, stream_>>>(handle, buf<uint>(Buffer::NeighbourState));
 }
 
 }  // namespace motes::cuda

@@ -1,6 +1,6 @@
 // neighbours_build: every dynamic particle's list of the particles of other bodies closer than
 // r_i + r_j + skin, in the canonical order of the 27-cell walk over the grid that grid_build has
-// just made; and neighbours_update, which runs grid_build and this when a rebuild is due.
+// just made.
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -15,15 +15,6 @@ namespace motes::openmp {
 
 using shared::uint;
 using shared::vec4;
-
-void OpenMPDevice::neighbours_update(const shared::StepParams& p) {
-  const auto start = std::chrono::steady_clock::now();
-  const bool rebuild = buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_REBUILD] != 0;
-  record(Kernel::NeighboursUpdate, start);
-  if (!rebuild) return;
-  grid_build(p);
-  neighbours_build(p);
-}
 
 void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();

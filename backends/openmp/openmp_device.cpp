@@ -145,6 +145,19 @@ Status OpenMPDevice::read(Buffer b, void* dst, std::size_t bytes) {
   return Status::ok();
 }
 
+void OpenMPDevice::enqueue(Kernel k, const shared::StepParams& p) {
+  switch (k) {
+#define MOTES_FAMILY_CASE(E, name, reads, writes) \
+  case Kernel::E:                                 \
+    name(p);                                      \
+    break;
+    MOTES_KERNELS(MOTES_FAMILY_CASE)
+#undef MOTES_FAMILY_CASE
+    case Kernel::Count:
+      break;
+  }
+}
+
 Status OpenMPDevice::check_guards() {
   for (std::size_t i = 0; i < buffers_.size(); ++i) {
     if (!buffers_[i].guard_intact()) {

@@ -51,24 +51,7 @@ class OpenMPDevice final : public Device {
   Status write(Buffer b, const void* src, std::size_t bytes) override;
   Status read(Buffer b, void* dst, std::size_t bytes) override;
 
-  void neighbours_update(const shared::StepParams& p) override;
-  void grid_build(const shared::StepParams& p) override;
-  void neighbours_build(const shared::StepParams& p) override;
-  void contacts_compute(const shared::StepParams& p) override;
-  void bodies_reduce(const shared::StepParams& p) override;
-  void bodies_integrate(const shared::StepParams& p) override;
-  void particles_update(const shared::StepParams& p) override;
-  void particles_integrate(const shared::StepParams& p) override;
-  void particles_check(const shared::StepParams& p) override;
-  void energy_reduce(const shared::StepParams& p) override;
-  void constraints_solve(const shared::StepParams& p) override;
-  void clusters_fit(const shared::StepParams& p) override;
-  void clusters_goal(const shared::StepParams& p) override;
-  void impulses_compute(const shared::StepParams& p) override;
-  void impulses_apply(const shared::StepParams& p) override;
-  void halo_pack(const shared::StepParams& p) override;
-  void halo_unpack(const shared::StepParams& p) override;
-  void particles_displacement(const shared::StepParams& p) override;
+  void enqueue(Kernel k, const shared::StepParams& p) override;
 
   Status synchronize() override { return Status::ok(); }
   Status check_guards() override;
@@ -79,6 +62,12 @@ class OpenMPDevice final : public Device {
   [[nodiscard]] int threads() const { return threads_; }
 
  private:
+  // One per kernel family, each in the file of its name (neighbours_update.cpp, grid_build.cpp...),
+  // declared from the list in motes/backend/kernels.h; enqueue() runs them at once.
+#define MOTES_FAMILY_DECLARATION(E, name, reads, writes) void name(const shared::StepParams& p);
+  MOTES_KERNELS(MOTES_FAMILY_DECLARATION)
+#undef MOTES_FAMILY_DECLARATION
+
   [[nodiscard]] bool parallel(std::int64_t items) const {
     return threads_ > 1 && items >= min_parallel_;
   }

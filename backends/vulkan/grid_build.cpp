@@ -1,9 +1,9 @@
 // grid_build on Vulkan: a deterministic counting sort in six passes (shaders/grid_build_*.comp).
 // The bucket counts are zeroed; counting with integer atomics gives each bucket's size and an
 // arbitrary arrival rank; a multi-level scan turns the counts into GridCellStart; particles are
-// scattered by arrival rank; grid_build_place then puts each particle at its canonical slot (rank
-// by id within the bucket), so the result equals the stable sort by (bucket, particle id) of the
-// OpenMP backend exactly.
+// scattered by arrival rank; grid_build.comp (the last pass) then puts each particle at its
+// canonical slot (rank by id within the bucket), so the result equals the stable sort by (bucket,
+// particle id) of the OpenMP backend exactly.
 #include "vulkan_device.h"
 
 namespace motes::vulkan {
@@ -34,7 +34,7 @@ std::vector<VulkanDevice::Pass> VulkanDevice::grid_build_passes(const shared::St
                       {l.in_scratch, l.offset, l.count, l.sums_offset}});
   }
   passes.push_back({Pipeline::GridBuildScatter, groups_for(n), {}});
-  passes.push_back({Pipeline::GridBuildPlace, groups_for(n), {}});
+  passes.push_back({Pipeline::GridBuild, groups_for(n), {}});
   return passes;
 }
 

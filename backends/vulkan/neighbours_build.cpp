@@ -1,8 +1,4 @@
-// neighbours_build on Vulkan (shaders/neighbours_begin.comp, neighbours_build.comp), and
-// neighbours_update: neighbours_decide copies the indirect arguments of every rebuild pass from
-// their template (written at allocate) when NeighbourState asks for a rebuild, or zeroes them;
-// the grid_build and neighbours_build passes are then dispatched indirectly, so a recorded step
-// replays without the host deciding anything.
+// neighbours_build on Vulkan (shaders/neighbours_build_begin.comp, neighbours_build.comp).
 #include "vulkan_device.h"
 
 namespace motes::vulkan {
@@ -15,37 +11,11 @@ std::vector<VulkanDevice::Pass> VulkanDevice::neighbours_build_passes(
 }
 
 void VulkanDevice::record_neighbours_build(VkCommandBuffer cb, const shared::StepParams& p) const {
-  // On its own the build starts with neighbours_begin; in neighbours_update, neighbours_decide
-  // starts it.
-  std::vector<Pass> passes = {{Pipeline::NeighboursBegin, 1, {}}};
+  // On its own the build starts with neighbours_build_begin; in neighbours_update,
+  // neighbours_update.comp starts it.
+  std::vector<Pass> passes = {{Pipeline::NeighboursBuildBegin, 1, {}}};
   for (const Pass& pass : neighbours_build_passes(p)) passes.push_back(pass);
   record_passes(cb, passes, p);
-}
-
-void VulkanDevice::record_neighbours_update(VkCommandBuffer cb, const shared::StepParams& p,
-                                            std::vector<Kernel>* spans,
-                                            std::uint32_t& query) const {
-  // Timed: a pair of timestamps around the decision and around each family it may run.
-  const auto stamp = [&](bool begin, Kernel k) {
-    if (spans == nullptr) return;
-    vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, queries_, query++);
-    if (begin) spans->push_back(k);
-  };
-  const std::uint32_t words = rebuild_passes_ * 4;
-  const std::uint32_t args[4] = {words, words, 0, 0};
-  stamp(true, Kernel::NeighboursUpdate);
-  dispatch_groups(cb, Pipeline::NeighboursDecide, p, 1, args);
-  barrier(cb, Sync::Indirect);
-  stamp(false, Kernel::NeighboursUpdate);
-  const std::vector<Pass> grid = grid_build_passes(p);
-  stamp(true, Kernel::GridBuild);
-  record_passes(cb, grid, p, 0);
-  barrier(cb);
-  stamp(false, Kernel::GridBuild);
-  stamp(true, Kernel::NeighboursBuild);
-  record_passes(cb, neighbours_build_passes(p), p, static_cast<int>(grid.size()));
-  barrier(cb);
-  stamp(false, Kernel::NeighboursBuild);
 }
 
 }  // namespace motes::vulkan

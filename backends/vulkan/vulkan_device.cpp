@@ -47,13 +47,15 @@ static_assert(B_GRID_ARRIVAL == static_cast<int>(Buffer::Count));
 
 namespace {
 
+// Each pipeline's shader (its file stem in shaders/), in Pipeline's order.
 constexpr const char* kPipelineShaders[kPipelineCount] = {
-    "neighbours_decide",   "grid_build_clear",    "grid_build_count",       "grid_build_scan_block",
-    "grid_build_scan_add", "grid_build_scatter",  "grid_build_place",       "neighbours_begin",
-    "neighbours_build",    "contacts_compute",    "bodies_reduce",          "bodies_integrate",
-    "particles_update",    "particles_integrate", "clusters_fit",           "clusters_goal",
-    "constraints_solve",   "impulses_compute",    "impulses_apply",         "particles_check",
-    "halo_pack",           "halo_unpack",         "particles_displacement", "energy_reduce"};
+#define MOTES_FAMILY_SHADER(E, name, reads, writes) #name,
+    MOTES_KERNELS(MOTES_FAMILY_SHADER)
+#undef MOTES_FAMILY_SHADER
+#define MOTES_PASS_SHADER(E, name) #name,
+        MOTES_VULKAN_PASSES(MOTES_PASS_SHADER)
+#undef MOTES_PASS_SHADER
+};
 
 const char* binding_name(std::uint32_t binding) {
   if (binding < kBufferCount) return buffer_name(static_cast<Buffer>(binding));
@@ -675,48 +677,6 @@ Status VulkanDevice::validation_status() {
   for (const std::string& m : log.messages) text += "\n  " + m;
   log.messages.clear();
   return Status::error(text);
-}
-
-void VulkanDevice::neighbours_update(const shared::StepParams& p) {
-  enqueue(Kernel::NeighboursUpdate, p);
-}
-void VulkanDevice::grid_build(const shared::StepParams& p) { enqueue(Kernel::GridBuild, p); }
-void VulkanDevice::neighbours_build(const shared::StepParams& p) {
-  enqueue(Kernel::NeighboursBuild, p);
-}
-void VulkanDevice::contacts_compute(const shared::StepParams& p) {
-  enqueue(Kernel::ContactsCompute, p);
-}
-void VulkanDevice::bodies_reduce(const shared::StepParams& p) { enqueue(Kernel::BodiesReduce, p); }
-void VulkanDevice::bodies_integrate(const shared::StepParams& p) {
-  enqueue(Kernel::BodiesIntegrate, p);
-}
-void VulkanDevice::particles_update(const shared::StepParams& p) {
-  enqueue(Kernel::ParticlesUpdate, p);
-}
-void VulkanDevice::particles_integrate(const shared::StepParams& p) {
-  enqueue(Kernel::ParticlesIntegrate, p);
-}
-
-void VulkanDevice::particles_check(const shared::StepParams& p) {
-  enqueue(Kernel::ParticlesCheck, p);
-}
-void VulkanDevice::halo_pack(const shared::StepParams& p) { enqueue(Kernel::HaloPack, p); }
-void VulkanDevice::energy_reduce(const shared::StepParams& p) { enqueue(Kernel::EnergyReduce, p); }
-void VulkanDevice::halo_unpack(const shared::StepParams& p) { enqueue(Kernel::HaloUnpack, p); }
-void VulkanDevice::particles_displacement(const shared::StepParams& p) {
-  enqueue(Kernel::ParticlesDisplacement, p);
-}
-void VulkanDevice::constraints_solve(const shared::StepParams& p) {
-  enqueue(Kernel::ConstraintsSolve, p);
-}
-void VulkanDevice::clusters_fit(const shared::StepParams& p) { enqueue(Kernel::ClustersFit, p); }
-void VulkanDevice::clusters_goal(const shared::StepParams& p) { enqueue(Kernel::ClustersGoal, p); }
-void VulkanDevice::impulses_compute(const shared::StepParams& p) {
-  enqueue(Kernel::ImpulsesCompute, p);
-}
-void VulkanDevice::impulses_apply(const shared::StepParams& p) {
-  enqueue(Kernel::ImpulsesApply, p);
 }
 
 Listing list_devices() {

@@ -21,33 +21,26 @@
 
 namespace motes::vulkan {
 
-/// The compute pipelines, one per shader in shaders/*.comp.
+/// The passes of families that need more than one pipeline, each a shader of its own
+/// (shaders/FAMILY_PASS.comp), before the family's own shader (shaders/FAMILY.comp).
+#define MOTES_VULKAN_PASSES(X)                 \
+  X(GridBuildClear, grid_build_clear)          \
+  X(GridBuildCount, grid_build_count)          \
+  X(GridBuildScanBlock, grid_build_scan_block) \
+  X(GridBuildScanAdd, grid_build_scan_add)     \
+  X(GridBuildScatter, grid_build_scatter)      \
+  X(NeighboursBuildBegin, neighbours_build_begin)
+
+/// The compute pipelines: one per kernel family (motes/backend/kernels.h), whose shader is
+/// shaders/NAME.comp, then the extra passes.
 enum class Pipeline : std::uint32_t {
-  NeighboursDecide,
-  GridBuildClear,
-  GridBuildCount,
-  GridBuildScanBlock,
-  GridBuildScanAdd,
-  GridBuildScatter,
-  GridBuildPlace,
-  NeighboursBegin,
-  NeighboursBuild,
-  ContactsCompute,
-  BodiesReduce,
-  BodiesIntegrate,
-  ParticlesUpdate,
-  ParticlesIntegrate,
-  ClustersFit,
-  ClustersGoal,
-  ConstraintsSolve,
-  ImpulsesCompute,
-  ImpulsesApply,
-  ParticlesCheck,
-  HaloPack,
-  HaloUnpack,
-  ParticlesDisplacement,
-  EnergyReduce,
-  Count
+#define MOTES_FAMILY_PIPELINE(E, name, reads, writes) E,
+  MOTES_KERNELS(MOTES_FAMILY_PIPELINE)
+#undef MOTES_FAMILY_PIPELINE
+#define MOTES_PASS_PIPELINE(E, name) E,
+      MOTES_VULKAN_PASSES(MOTES_PASS_PIPELINE)
+#undef MOTES_PASS_PIPELINE
+          Count
 };
 constexpr std::size_t kPipelineCount = static_cast<std::size_t>(Pipeline::Count);
 constexpr std::size_t kBindingCount = B_COUNT;
@@ -78,24 +71,7 @@ class VulkanDevice final : public Device {
   Status write(Buffer b, const void* src, std::size_t bytes) override;
   Status read(Buffer b, void* dst, std::size_t bytes) override;
 
-  void neighbours_update(const shared::StepParams& p) override;
-  void grid_build(const shared::StepParams& p) override;
-  void neighbours_build(const shared::StepParams& p) override;
-  void contacts_compute(const shared::StepParams& p) override;
-  void bodies_reduce(const shared::StepParams& p) override;
-  void bodies_integrate(const shared::StepParams& p) override;
-  void particles_update(const shared::StepParams& p) override;
-  void particles_integrate(const shared::StepParams& p) override;
-  void particles_check(const shared::StepParams& p) override;
-  void energy_reduce(const shared::StepParams& p) override;
-  void halo_pack(const shared::StepParams& p) override;
-  void halo_unpack(const shared::StepParams& p) override;
-  void particles_displacement(const shared::StepParams& p) override;
-  void constraints_solve(const shared::StepParams& p) override;
-  void clusters_fit(const shared::StepParams& p) override;
-  void clusters_goal(const shared::StepParams& p) override;
-  void impulses_compute(const shared::StepParams& p) override;
-  void impulses_apply(const shared::StepParams& p) override;
+  void enqueue(Kernel k, const shared::StepParams& p) override;
 
   Status synchronize() override;
   Status check_guards() override;
@@ -137,7 +113,6 @@ class VulkanDevice final : public Device {
   Status ensure_staging(VkDeviceSize bytes);
 
   // Queue and replay (vulkan_record.cpp).
-  void enqueue(Kernel k, const shared::StepParams& p);
   /// Submits every queued call, replaying a cached recording when the calls repeat one.
   Status flush();
   /// A new primary command buffer, begun with `usage`.
@@ -157,8 +132,9 @@ class VulkanDevice final : public Device {
 
   // Recording helpers shared by the kernel files.
   /// What a barrier makes visible: compute writes to the next dispatch (between passes), also to
-  /// the indirect arguments read by the next dispatches (after neighbours_decide), or everything
-  /// to everything, transfers and the host included (where a command buffer starts and ends).
+  /// the indirect arguments read by the next dispatches (after neighbours_update.comp), or
+  /// everything to everything, transfers and the host included (where a command buffer starts and
+  /// ends).
   enum class Sync { Compute, Indirect, All };
   void barrier(VkCommandBuffer cb, Sync sync = Sync::Compute) const;
   /// Binds a pipeline, its descriptor set and the push constants.
@@ -183,23 +159,13 @@ class VulkanDevice final : public Device {
   // records timestamps around its parts when `spans` is given (timing).
   void record_neighbours_update(VkCommandBuffer cb, const shared::StepParams& p,
                                 std::vector<Kernel>* spans, std::uint32_t& query) const;
-  void record_grid_build(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_neighbours_build(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_particles_integrate(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_particles_check(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_energy_reduce(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_halo_pack(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_halo_unpack(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_particles_displacement(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_constraints_solve(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_clusters_fit(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_clusters_goal(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_impulses_compute(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_impulses_apply(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_contacts_compute(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_bodies_reduce(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_bodies_integrate(VkCommandBuffer cb, const shared::StepParams& p) const;
-  void record_particles_update(VkCommandBuffer cb, const shared::StepParams& p) const;
+  // (the others, generated from the list: record_grid_build, record_contacts_compute...)
+#define MOTES_RECORD_DECLARATION(E, name, reads, writes) \
+  void record_##name(VkCommandBuffer cb, const shared::StepParams& p) const;
+  MOTES_KERNELS(MOTES_RECORD_DECLARATION)
+#undef MOTES_RECORD_DECLARATION
+  /// Records one call of family k (not neighbours_update) by its record_NAME.
+  void record(VkCommandBuffer cb, Kernel k, const shared::StepParams& p) const;
 
   std::shared_ptr<Instance> instance_;
   PhysicalDevice physical_;

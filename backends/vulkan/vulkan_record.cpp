@@ -42,6 +42,20 @@ void VulkanDevice::enqueue(Kernel k, const shared::StepParams& p) {
   pending_.push_back({k, p});
 }
 
+void VulkanDevice::record(VkCommandBuffer cb, Kernel k, const shared::StepParams& p) const {
+  switch (k) {
+    // neighbours_update records its own barriers and timestamps (record_neighbours_update).
+#define MOTES_RECORD_CASE(E, name, reads, writes) \
+  case Kernel::E:                                 \
+    record_##name(cb, p);                         \
+    break;
+    MOTES_KERNELS(MOTES_RECORD_CASE)
+#undef MOTES_RECORD_CASE
+    case Kernel::Count:
+      break;
+  }
+}
+
 void VulkanDevice::barrier(VkCommandBuffer cb, Sync sync) const {
   VkMemoryBarrier b{};
   b.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
@@ -163,62 +177,7 @@ Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool ti
       vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, queries_, q++);
       if (spans != nullptr) spans->push_back(ops[i].kernel);
     }
-    switch (ops[i].kernel) {
-      case Kernel::GridBuild:
-        record_grid_build(cb, p);
-        break;
-      case Kernel::NeighboursBuild:
-        record_neighbours_build(cb, p);
-        break;
-      case Kernel::ContactsCompute:
-        record_contacts_compute(cb, p);
-        break;
-      case Kernel::BodiesReduce:
-        record_bodies_reduce(cb, p);
-        break;
-      case Kernel::BodiesIntegrate:
-        record_bodies_integrate(cb, p);
-        break;
-      case Kernel::ParticlesUpdate:
-        record_particles_update(cb, p);
-        break;
-      case Kernel::ParticlesIntegrate:
-        record_particles_integrate(cb, p);
-        break;
-      case Kernel::ClustersFit:
-        record_clusters_fit(cb, p);
-        break;
-      case Kernel::ClustersGoal:
-        record_clusters_goal(cb, p);
-        break;
-      case Kernel::ConstraintsSolve:
-        record_constraints_solve(cb, p);
-        break;
-      case Kernel::ImpulsesCompute:
-        record_impulses_compute(cb, p);
-        break;
-      case Kernel::ImpulsesApply:
-        record_impulses_apply(cb, p);
-        break;
-      case Kernel::ParticlesCheck:
-        record_particles_check(cb, p);
-        break;
-      case Kernel::EnergyReduce:
-        record_energy_reduce(cb, p);
-        break;
-      case Kernel::HaloPack:
-        record_halo_pack(cb, p);
-        break;
-      case Kernel::HaloUnpack:
-        record_halo_unpack(cb, p);
-        break;
-      case Kernel::ParticlesDisplacement:
-        record_particles_displacement(cb, p);
-        break;
-      case Kernel::NeighboursUpdate:
-      case Kernel::Count:
-        break;
-    }
+    record(cb, ops[i].kernel, p);
     barrier(cb);
     if (timing) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, queries_, q++);
   }

@@ -4,8 +4,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <new>
 #include <vector>
@@ -115,48 +117,58 @@ const char* buffer_name(Buffer b) {
   return "?";
 }
 
+namespace {
+
+using enum Buffer;
+
+constexpr BufferMask mask_of(std::initializer_list<Buffer> buffers) {
+  BufferMask m = 0;
+  for (Buffer b : buffers) m |= buffer_bit(b);
+  return m;
+}
+
+struct KernelEntry {
+  const char* name;
+  BufferMask reads, writes;
+};
+
+// One entry per family, from the list in motes/backend/kernels.h.
+#define MOTES_KERNEL_ENTRY(E, name, reads, writes) \
+  KernelEntry{#name, mask_of({MOTES_UNPAREN reads}), mask_of({MOTES_UNPAREN writes})},
+#define MOTES_UNPAREN(...) __VA_ARGS__
+constexpr std::array<KernelEntry, kKernelCount> kKernels{{MOTES_KERNELS(MOTES_KERNEL_ENTRY)}};
+#undef MOTES_UNPAREN
+#undef MOTES_KERNEL_ENTRY
+
+}  // namespace
+
 const char* kernel_name(Kernel k) {
-  switch (k) {
-    case Kernel::NeighboursUpdate:
-      return "neighbours_update";
-    case Kernel::GridBuild:
-      return "grid_build";
-    case Kernel::NeighboursBuild:
-      return "neighbours_build";
-    case Kernel::ContactsCompute:
-      return "contacts_compute";
-    case Kernel::BodiesReduce:
-      return "bodies_reduce";
-    case Kernel::BodiesIntegrate:
-      return "bodies_integrate";
-    case Kernel::ParticlesUpdate:
-      return "particles_update";
-    case Kernel::ParticlesIntegrate:
-      return "particles_integrate";
-    case Kernel::ClustersFit:
-      return "clusters_fit";
-    case Kernel::ClustersGoal:
-      return "clusters_goal";
-    case Kernel::ConstraintsSolve:
-      return "constraints_solve";
-    case Kernel::ImpulsesCompute:
-      return "impulses_compute";
-    case Kernel::ImpulsesApply:
-      return "impulses_apply";
-    case Kernel::ParticlesCheck:
-      return "particles_check";
-    case Kernel::EnergyReduce:
-      return "energy_reduce";
-    case Kernel::HaloPack:
-      return "halo_pack";
-    case Kernel::HaloUnpack:
-      return "halo_unpack";
-    case Kernel::ParticlesDisplacement:
-      return "particles_displacement";
-    case Kernel::Count:
-      break;
+  const auto i = static_cast<std::size_t>(k);
+  return i < kKernelCount ? kKernels[i].name : "?";
+}
+
+Kernel kernel_from_name(std::string_view name) {
+  for (std::size_t i = 0; i < kKernelCount; ++i) {
+    if (name == kKernels[i].name) return static_cast<Kernel>(i);
   }
-  return "?";
+  return Kernel::Count;
+}
+
+BufferMask kernel_reads(Kernel k) {
+  const auto i = static_cast<std::size_t>(k);
+  return i < kKernelCount ? kKernels[i].reads : 0;
+}
+
+BufferMask kernel_writes(Kernel k) {
+  const auto i = static_cast<std::size_t>(k);
+  return i < kKernelCount ? kKernels[i].writes : 0;
+}
+
+Buffer buffer_from_name(std::string_view name) {
+  for (std::size_t i = 0; i < kBufferCount; ++i) {
+    if (name == buffer_name(static_cast<Buffer>(i))) return static_cast<Buffer>(i);
+  }
+  return Buffer::Count;
 }
 
 BufferLayout buffer_layout(Buffer b, const Sizes& s) {

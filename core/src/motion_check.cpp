@@ -97,8 +97,8 @@ Result<Simulation::DeviceEnergy> Simulation::read_energy() {
 
 Result<MotionReport> Simulation::check_motion() {
   Device& d = *device_;
-  d.particles_check(params_);
-  d.energy_reduce(params_);
+  d.enqueue(Kernel::ParticlesCheck, params_);
+  d.enqueue(Kernel::EnergyReduce, params_);
   std::uint32_t words[MOTES_MOTION_WORDS] = {};
   if (Status s = d.read(Buffer::MotionCheck, words, sizeof words); !s) return s;
   Result<DeviceEnergy> energy = read_energy();

@@ -669,7 +669,7 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
   if (Status st = d.write(Buffer::EnergyPartials, header, sizeof header); !st) return st;
   energy_started_ = false;
   // Rigid particles take their pose from the bodies with the device's own arithmetic.
-  if (sizes_.rigid_particles > 0) d.particles_update(params_);
+  if (sizes_.rigid_particles > 0) d.enqueue(Kernel::ParticlesUpdate, params_);
   return d.synchronize();
 }
 
@@ -682,19 +682,19 @@ Status Simulation::step(std::uint64_t count) {
   if (!settings_.impulse_memory_across_builds) lists.flags &= ~MOTES_FLAG_IMPULSE;
   for (std::uint64_t k = 0; k < count; ++k) {
     for (int sub = 0; sub < settings_.substeps; ++sub) {
-      d.neighbours_update(lists);
-      d.contacts_compute(params_);
+      d.enqueue(Kernel::NeighboursUpdate, lists);
+      d.enqueue(Kernel::ContactsCompute, params_);
       if (rigid && sizes_.impulse != 0) {
         step_impulses();
       } else if (rigid) {
-        d.bodies_reduce(params_);
-        d.bodies_integrate(params_);
-        d.particles_update(params_);
+        d.enqueue(Kernel::BodiesReduce, params_);
+        d.enqueue(Kernel::BodiesIntegrate, params_);
+        d.enqueue(Kernel::ParticlesUpdate, params_);
       }
-      if (free) d.particles_integrate(params_);
+      if (free) d.enqueue(Kernel::ParticlesIntegrate, params_);
       if (params_.cluster_count > 0) {
-        d.clusters_fit(params_);
-        d.clusters_goal(params_);
+        d.enqueue(Kernel::ClustersFit, params_);
+        d.enqueue(Kernel::ClustersGoal, params_);
       }
       for (int it = 0; it < settings_.constraint_iterations && colour_first_.size() > 1; ++it) {
         for (std::size_t c = 0; c + 1 < colour_first_.size(); ++c) {
@@ -703,7 +703,7 @@ Status Simulation::step(std::uint64_t count) {
           if (it + 1 == settings_.constraint_iterations) colour.flags |= MOTES_FLAG_SKIN_CHECK;
           colour.constraint_first = colour_first_[c];
           colour.constraint_count = colour_first_[c + 1] - colour_first_[c];
-          d.constraints_solve(colour);
+          d.enqueue(Kernel::ConstraintsSolve, colour);
         }
       }
       if (sizes_.absorb != 0) absorb_attachments();
@@ -723,9 +723,9 @@ void Simulation::absorb_attachments() {
   absorb.flags = (absorb.flags | MOTES_FLAG_ABSORB) & ~MOTES_FLAG_IMPULSE_COUNT;
   shared::StepParams apply = params_;
   apply.flags = (apply.flags | MOTES_FLAG_ABSORB) & ~MOTES_FLAG_IMPULSE_COUNT;
-  d.particles_update(absorb);
-  d.impulses_apply(apply);
-  d.particles_update(params_);
+  d.enqueue(Kernel::ParticlesUpdate, absorb);
+  d.enqueue(Kernel::ImpulsesApply, apply);
+  d.enqueue(Kernel::ParticlesUpdate, params_);
 }
 
 void Simulation::step_impulses() {
@@ -755,21 +755,21 @@ void Simulation::step_impulses() {
   relax.flags |= MOTES_FLAG_IMPULSE_RELAX;
   shared::StepParams pose = last;
   pose.flags |= MOTES_FLAG_BODY_POSE;
-  d.bodies_reduce(params_);
+  d.enqueue(Kernel::BodiesReduce, params_);
   for (int s = 0; s < substeps; ++s) {
-    d.bodies_integrate(velocity);
-    d.impulses_compute(count);
-    d.impulses_apply(count);
+    d.enqueue(Kernel::BodiesIntegrate, velocity);
+    d.enqueue(Kernel::ImpulsesCompute, count);
+    d.enqueue(Kernel::ImpulsesApply, count);
     for (int it = 0; it < correcting; ++it) {
-      d.impulses_compute(sub);
-      d.impulses_apply(it + 1 == correcting ? last : sub);
+      d.enqueue(Kernel::ImpulsesCompute, sub);
+      d.enqueue(Kernel::ImpulsesApply, it + 1 == correcting ? last : sub);
     }
     for (int it = 0; it < relaxing; ++it) {
-      d.impulses_compute(relax);
-      d.impulses_apply(relax);
+      d.enqueue(Kernel::ImpulsesCompute, relax);
+      d.enqueue(Kernel::ImpulsesApply, relax);
     }
-    d.bodies_integrate(pose);
-    d.particles_update(sub);
+    d.enqueue(Kernel::BodiesIntegrate, pose);
+    d.enqueue(Kernel::ParticlesUpdate, sub);
   }
 }
 
@@ -1035,7 +1035,7 @@ Status Simulation::set_body_velocities(const std::vector<Eigen::Vector3d>& veloc
   }
   if (Status s = restore(state); !s) return s;
   // The rigid particles' velocities from their bodies' new motion.
-  if (sizes_.rigid_particles > 0) device_->particles_update(params_);
+  if (sizes_.rigid_particles > 0) device_->enqueue(Kernel::ParticlesUpdate, params_);
   rebase_energy();  // energy from outside the scene: the energy guard measures from here
   return device_->synchronize();
 }
@@ -1056,7 +1056,7 @@ void Simulation::queue_halo_pack() {
   p.halo_particles = halo_entries_[0];
   p.halo_bodies = halo_entries_[1];
   p.halo_first = 0;
-  device_->halo_pack(p);
+  device_->enqueue(Kernel::HaloPack, p);
 }
 
 void Simulation::queue_halo_unpack() {
@@ -1064,7 +1064,7 @@ void Simulation::queue_halo_unpack() {
   p.halo_particles = halo_entries_[2];
   p.halo_bodies = halo_entries_[3];
   p.halo_first = halo_entries_[0] + halo_entries_[1];
-  device_->halo_unpack(p);
+  device_->enqueue(Kernel::HaloUnpack, p);
 }
 
 Status Simulation::halo_pack() {
@@ -1125,7 +1125,7 @@ Result<double> Simulation::partition_displacement() {
   if (sizes_.partition == 0) {
     return Status::error("partition_displacement: a simulation without a partition reference");
   }
-  device_->particles_displacement(params_);
+  device_->enqueue(Kernel::ParticlesDisplacement, params_);
   std::uint32_t bits = 0;
   if (Status s = device_->read(Buffer::PartitionCheck, &bits, sizeof bits); !s) return s;
   if (bits >= MOTES_PARTITION_NOT_FINITE) return std::numeric_limits<double>::infinity();

@@ -228,6 +228,55 @@ void expect_clean(motes::Device& d) {
 
 void DeviceTest::finish_kernel() { expect_clean(*device_); }
 
+namespace {
+
+bool poison_unread() {
+  const char* v = std::getenv("MOTES_CONFORMANCE_POISON_UNREAD");
+  return v != nullptr && std::string(v) == "1";
+}
+
+}  // namespace
+
+void DeviceTest::run(motes::Kernel k, const motes::shared::StepParams& p) {
+  const motes::BufferMask reads = motes::kernel_reads(k);
+  const motes::BufferMask writes = motes::kernel_writes(k);
+  const bool poison = poison_unread();
+  std::vector<std::vector<unsigned char>> before(motes::kBufferCount);
+  std::vector<bool> poisoned(motes::kBufferCount, false);
+  for (std::size_t i = 0; i < motes::kBufferCount; ++i) {
+    const auto b = static_cast<motes::Buffer>(i);
+    const std::size_t bytes = motes::buffer_layout(b, sizes_).bytes();
+    if ((writes & motes::buffer_bit(b)) != 0 || bytes == 0) continue;
+    before[i].resize(bytes);
+    ASSERT_NO_FATAL_FAILURE(read_bytes(b, before[i].data(), bytes));
+    if (poison && (reads & motes::buffer_bit(b)) == 0) {
+      const std::vector<unsigned char> junk(bytes, 0xFF);
+      ASSERT_NO_FATAL_FAILURE(write_bytes(b, junk.data(), bytes));
+      poisoned[i] = true;
+    }
+  }
+  device_->enqueue(k, p);
+  ASSERT_NO_FATAL_FAILURE(finish_kernel());
+  std::vector<unsigned char> after;
+  for (std::size_t i = 0; i < motes::kBufferCount; ++i) {
+    if (before[i].empty()) continue;
+    const auto b = static_cast<motes::Buffer>(i);
+    after.resize(before[i].size());
+    ASSERT_NO_FATAL_FAILURE(read_bytes(b, after.data(), after.size()));
+    const bool same = poisoned[i] ? std::all_of(after.begin(), after.end(),
+                                                [](unsigned char c) { return c == 0xFF; })
+                                  : after == before[i];
+    if (!same) {
+      ADD_FAILURE() << motes::kernel_name(k) << " changed " << motes::buffer_name(b)
+                    << ", which is not among its writes in motes/backend/kernels.h";
+      if (case_.open) add_mismatches("a buffer outside the family's writes", 1);
+    }
+    if (poisoned[i]) {
+      ASSERT_NO_FATAL_FAILURE(write_bytes(b, before[i].data(), before[i].size()));
+    }
+  }
+}
+
 void DeviceTest::begin_case(const std::string& name, std::size_t size) {
   case_ = OpenCase{};
   case_.open = true;

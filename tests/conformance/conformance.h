@@ -116,6 +116,13 @@ class DeviceTest : public testing::TestWithParam<DeviceParam> {
   void poison_all_but(std::initializer_list<motes::Buffer> inputs);
   /// Synchronizes and checks the guard words (ASSERTs); call after the kernel, before reading.
   void finish_kernel();
+  /// Runs one call of family k and checks it against its entry in motes/backend/kernels.h:
+  /// every buffer outside the family's writes must hold the same bytes afterwards. With
+  /// MOTES_CONFORMANCE_POISON_UNREAD=1 every buffer the family neither reads nor writes is also
+  /// filled with 0xFF bytes for the call (and put back after it), so that a kernel reading a
+  /// buffer its entry does not list gets garbage and fails the comparison with the oracle.
+  /// Synchronizes (ASSERTs) like finish_kernel().
+  void run(motes::Kernel k, const motes::shared::StepParams& p);
 
   /// Starts a case (one row of the table): name "kernel/layout", size N (or B).
   void begin_case(const std::string& name, std::size_t size);

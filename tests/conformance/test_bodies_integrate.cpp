@@ -69,7 +69,7 @@ class BodiesIntegrate : public DeviceTest {
       ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyVelPush, vel_push));
       ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyAngMomPush, angmom_push));
     }
-    device().bodies_integrate(w.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::BodiesIntegrate, w.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     motes_ref::Bodies got;
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyPos, got.pos));

@@ -38,7 +38,7 @@ class BodiesReduce : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyPos, w.bodies.pos));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyFirst, w.bodies.first));
-    device().bodies_reduce(w.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::BodiesReduce, w.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<vec4> got_force;
     std::vector<vec4> got_torque;

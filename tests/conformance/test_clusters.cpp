@@ -182,7 +182,7 @@ class Clusters : public DeviceTest {
         poison_all_but({Buffer::ParticlePos, Buffer::ParticleVel, Buffer::Clusters,
                         Buffer::ClusterMembers, Buffer::ClusterFrames}));
     ASSERT_NO_FATAL_FAILURE(write_inputs(c, c.frames));
-    device().clusters_fit(c.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ClustersFit, c.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<ClusterFrame> got;
     std::vector<vec4> pos;
@@ -232,7 +232,7 @@ class Clusters : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ClusterGather, gather));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourRefPos, ref));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourState, state_in));
-    device().clusters_goal(c.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ClustersGoal, c.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<vec4> pos;
     std::vector<vec4> vel;

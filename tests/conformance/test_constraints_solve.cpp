@@ -186,7 +186,7 @@ class ConstraintsSolve : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourState, state_in));
     for (int it = 0; it < kIterations; ++it) {
       for (std::size_t k = 0; k < c.colouring.colours(); ++k) {
-        device().constraints_solve(colour_params(it, k));
+        ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ConstraintsSolve, colour_params(it, k)));
       }
     }
     ASSERT_NO_FATAL_FAILURE(finish_kernel());

@@ -68,8 +68,7 @@ class ContactsCompute : public DeviceTest {
     write(Buffer::ContactLaws, w.laws);
     write(Buffer::Planes, w.planes);
     if (HasFatalFailure()) return got;
-    device().contacts_compute(params);
-    finish_kernel();
+    run(motes::Kernel::ContactsCompute, params);
     if (HasFatalFailure()) return got;
     read(Buffer::ParticleForce, got);
     return got;

@@ -77,7 +77,7 @@ class EnergyReduce : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyAngVel, w.bodies.angvel));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyAngMom, w.bodies.angmom));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::EnergyPartials, header));  // the blocks stay poisoned
-    device().energy_reduce(w.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::EnergyReduce, w.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<uint> got;
     ASSERT_NO_FATAL_FAILURE(read(Buffer::EnergyPartials, got));

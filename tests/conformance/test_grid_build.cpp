@@ -31,7 +31,7 @@ class GridBuild : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleVel, w.particles.vel));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleBody, w.particles.body));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleMaterial, w.particles.material));
-    device().grid_build(w.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::GridBuild, w.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
 
     motes_ref::Grid got;

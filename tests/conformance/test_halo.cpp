@@ -193,7 +193,7 @@ class HaloPack : public HaloTest {
          Buffer::BodyVel, Buffer::BodyAngMom, Buffer::BodyAngVel, Buffer::HaloIndex}));
     ASSERT_NO_FATAL_FAILURE(write_state(h));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::HaloIndex, h.index));
-    device().halo_pack(h.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::HaloPack, h.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<vec4> got;
     ASSERT_NO_FATAL_FAILURE(read(Buffer::HaloData, got));
@@ -268,7 +268,7 @@ class HaloUnpack : public HaloTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::HaloData, data));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourRefPos, ref));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourState, state_in));
-    device().halo_unpack(h.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::HaloUnpack, h.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<uint> state;
     ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourState, state));
@@ -335,14 +335,15 @@ class HaloRoundTrip : public HaloTest {
     ASSERT_NO_FATAL_FAILURE(poison_all_but({}));
     ASSERT_NO_FATAL_FAILURE(write_state(h));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::HaloIndex, h.index));
-    device().halo_pack(h.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::HaloPack, h.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<vec4> got;
     ASSERT_NO_FATAL_FAILURE(read(Buffer::HaloData, got));
     ASSERT_NO_FATAL_FAILURE(write_state(overwritten));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourRefPos, ref));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourState, state_in));
-    device().halo_unpack(h.params);  // from the HaloData the device packed
+    ASSERT_NO_FATAL_FAILURE(
+        run(motes::Kernel::HaloUnpack, h.params));  // from the HaloData the device packed
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<uint> state;
     ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourState, state));
@@ -375,9 +376,7 @@ class HaloLaunchGuard : public DeviceTest {
     motes::Device& d = *opened.value();
     ASSERT_TRUE(d.allocate(h.sizes));
     ASSERT_TRUE(d.write(Buffer::HaloIndex, h.index.data(), h.index.size() * sizeof(uint)));
-    if (kernel == motes::Kernel::HaloPack) d.halo_pack(p);
-    if (kernel == motes::Kernel::HaloUnpack) d.halo_unpack(p);
-    if (kernel == motes::Kernel::ParticlesDisplacement) d.particles_displacement(p);
+    d.enqueue(kernel, p);
     const motes::Status s = d.synchronize();
     begin_case(std::string(motes::kernel_name(kernel)) + "/" + layout, h.entries());
     check_that("the call is refused", !s);

@@ -131,15 +131,16 @@ class Impulses : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourState, state));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ContactImpulse, acc0));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ImpulseStamp, stamp0));
-    device().impulses_compute(count);
-    device().impulses_apply(count);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesCompute, count));
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesApply, count));
     for (int it = 0; it < kIterations; ++it) {
-      device().impulses_compute(w.params);
-      device().impulses_apply(it + 1 == kIterations ? last : w.params);
+      ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesCompute, w.params));
+      ASSERT_NO_FATAL_FAILURE(
+          run(motes::Kernel::ImpulsesApply, it + 1 == kIterations ? last : w.params));
     }
     for (int it = 0; it < kRelaxing; ++it) {
-      device().impulses_compute(relax);
-      device().impulses_apply(relax);
+      ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesCompute, relax));
+      ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesApply, relax));
     }
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<vec4> vel, angmom, angvel, vel0, angvel0, vel_push, angmom_push, acc, force, moment;

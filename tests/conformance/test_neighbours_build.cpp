@@ -105,7 +105,7 @@ class NeighboursBuild : public ListTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::SortedBody, g.sorted_body));
     ASSERT_NO_FATAL_FAILURE(
         write(Buffer::NeighbourState, std::vector<uint>{1u, kBuildsBefore, 77u, 88u}));
-    device().neighbours_build(w.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::NeighboursBuild, w.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
 
     std::vector<uint> list, count, state;
@@ -176,7 +176,7 @@ class NeighboursBuildStamps : public ListTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ImpulseStamp, stamp));
     ASSERT_NO_FATAL_FAILURE(
         write(Buffer::NeighbourState, std::vector<uint>{1u, kBuildsBefore, 77u, 88u}));
-    device().neighbours_build(w.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::NeighboursBuild, w.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
 
     std::vector<uint> list, count, state, got_stamp;
@@ -285,8 +285,8 @@ class NeighboursUpdate : public ListTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleMaterial, w.particles.material));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourState, state_in));
     // Twice: the first call rebuilds (when asked), the second must then do nothing more.
-    device().neighbours_update(w.params);
-    device().neighbours_update(w.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::NeighboursUpdate, w.params));
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::NeighboursUpdate, w.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
 
     motes_ref::Grid got;

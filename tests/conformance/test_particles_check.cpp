@@ -42,7 +42,7 @@ class ParticlesCheck : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(poison_all_but({Buffer::ParticlePos, Buffer::ParticleVel}));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleVel, w.particles.vel));
-    device().particles_check(w.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ParticlesCheck, w.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<uint> got;
     ASSERT_NO_FATAL_FAILURE(read(Buffer::MotionCheck, got));

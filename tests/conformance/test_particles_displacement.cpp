@@ -38,7 +38,7 @@ class ParticlesDisplacement : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(poison_all_but({Buffer::ParticlePos, Buffer::PartitionRefPos}));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::PartitionRefPos, ref));
-    device().particles_displacement(w.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ParticlesDisplacement, w.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<uint> got;
     ASSERT_NO_FATAL_FAILURE(read(Buffer::PartitionCheck, got));

@@ -55,7 +55,7 @@ class ParticlesIntegrate : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleForce, force));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourRefPos, ref));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourState, state_in));
-    device().particles_integrate(w.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ParticlesIntegrate, w.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<vec4> pos;
     std::vector<vec4> vel;

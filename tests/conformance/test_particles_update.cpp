@@ -72,7 +72,7 @@ class ParticlesUpdate : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyAngVel, w.bodies.angvel));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourRefPos, ref));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourState, state_in));
-    device().particles_update(w.params);
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ParticlesUpdate, w.params));
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
     std::vector<vec4> pos;
     std::vector<vec4> vel;

@@ -48,24 +48,7 @@ class LimitedDevice final : public motes::Device {
     return inner_->write(b, src, n);
   }
   Status read(Buffer b, void* dst, std::size_t n) override { return inner_->read(b, dst, n); }
-  void neighbours_update(const StepParams& p) override { inner_->neighbours_update(p); }
-  void grid_build(const StepParams& p) override { inner_->grid_build(p); }
-  void neighbours_build(const StepParams& p) override { inner_->neighbours_build(p); }
-  void contacts_compute(const StepParams& p) override { inner_->contacts_compute(p); }
-  void bodies_reduce(const StepParams& p) override { inner_->bodies_reduce(p); }
-  void bodies_integrate(const StepParams& p) override { inner_->bodies_integrate(p); }
-  void particles_update(const StepParams& p) override { inner_->particles_update(p); }
-  void particles_integrate(const StepParams& p) override { inner_->particles_integrate(p); }
-  void particles_check(const StepParams& p) override { inner_->particles_check(p); }
-  void energy_reduce(const StepParams& p) override { inner_->energy_reduce(p); }
-  void constraints_solve(const StepParams& p) override { inner_->constraints_solve(p); }
-  void clusters_fit(const StepParams& p) override { inner_->clusters_fit(p); }
-  void clusters_goal(const StepParams& p) override { inner_->clusters_goal(p); }
-  void impulses_compute(const StepParams& p) override { inner_->impulses_compute(p); }
-  void impulses_apply(const StepParams& p) override { inner_->impulses_apply(p); }
-  void halo_pack(const StepParams& p) override { inner_->halo_pack(p); }
-  void halo_unpack(const StepParams& p) override { inner_->halo_unpack(p); }
-  void particles_displacement(const StepParams& p) override { inner_->particles_displacement(p); }
+  void enqueue(motes::Kernel k, const StepParams& p) override { inner_->enqueue(k, p); }
   Status synchronize() override { return inner_->synchronize(); }
   Status check_guards() override { return inner_->check_guards(); }
   void set_timing(bool on) override { inner_->set_timing(on); }

@@ -240,9 +240,9 @@ void check_on_device(const Particles& p, std::uint32_t flags, const motes::Devic
   params.neighbour_capacity = sizes.neighbour_capacity;
   params.neighbour_skin = 0.0f;  // lists of exactly the touching pairs
 
-  dev.grid_build(params);
-  dev.neighbours_build(params);
-  dev.contacts_compute(params);
+  dev.enqueue(motes::Kernel::GridBuild, params);
+  dev.enqueue(motes::Kernel::NeighboursBuild, params);
+  dev.enqueue(motes::Kernel::ContactsCompute, params);
   ASSERT_TRUE(dev.synchronize());
   const auto bucket = read_all<std::uint32_t>(dev, motes::Buffer::GridBucket, sizes);
   const auto order = read_all<std::uint32_t>(dev, motes::Buffer::GridOrder, sizes);

@@ -160,8 +160,8 @@ class Simulation {
   Result<std::uint64_t> state_hash();
   /// Checks every body and particle for NaN or infinity; the error names step, body and particle.
   Status check_finite();
-  /// The motion and energy guards (reductions on the device, Device::particles_check and
-  /// Device::energy_reduce; cheap: call it at output frames and at least every kGuardInterval
+  /// The motion and energy guards (reductions on the device, the kernel families particles_check
+  /// and energy_reduce; cheap: call it at output frames and at least every kGuardInterval
   /// steps). The first call, and the first after the state was changed from outside
   /// (set_body_velocities, write_state, load_state, rebase_energy), takes the energy reference
   /// E0 (motes/energy.h: the kinetic and potential energy, plus the contact law's stored energy).

@@ -8,9 +8,11 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "motes/api.h"
+#include "motes/backend/kernels.h"
 #include "motes/status.h"
 #include "shared/params.h"
 
@@ -104,36 +106,35 @@ enum class Buffer : std::uint32_t {
   Count
 };
 
-/// Kernel families, in the order a step runs them. NeighboursUpdate is the step's decision: when
-/// NeighbourState says so, it runs GridBuild and NeighboursBuild (each timed as itself).
+/// Kernel families, in the order a step runs them (motes/backend/kernels.h names each once, with
+/// its contract and the buffers it reads and writes).
 enum class Kernel : std::uint32_t {
-  NeighboursUpdate,
-  GridBuild,
-  NeighboursBuild,
-  ContactsCompute,
-  BodiesReduce,
-  BodiesIntegrate,
-  ParticlesUpdate,
-  ParticlesIntegrate,
-  ClustersFit,
-  ClustersGoal,
-  ConstraintsSolve,
-  ImpulsesCompute,
-  ImpulsesApply,
-  ParticlesCheck,  ///< not part of a step: the motion guard, at output frames and checks
-  EnergyReduce,    ///< not part of a step: the energy guard, with particles_check
-  // Not part of a step: runs over MPI ranks, between steps (motes/distributed.h).
-  HaloPack,
-  HaloUnpack,
-  ParticlesDisplacement,
-  Count
+#define MOTES_KERNEL_ENUMERATOR(E, name, reads, writes) E,
+  MOTES_KERNELS(MOTES_KERNEL_ENUMERATOR)
+#undef MOTES_KERNEL_ENUMERATOR
+      Count
 };
 
 constexpr std::size_t kBufferCount = static_cast<std::size_t>(Buffer::Count);
 constexpr std::size_t kKernelCount = static_cast<std::size_t>(Kernel::Count);
 
 const char* buffer_name(Buffer b);
+/// The buffer called `name` (buffer_name), or Buffer::Count.
+Buffer buffer_from_name(std::string_view name);
+/// The family's name, e.g. "constraints_solve".
 const char* kernel_name(Kernel k);
+/// The family called `name` (kernel_name), or Kernel::Count.
+Kernel kernel_from_name(std::string_view name);
+
+/// A set of buffers: bit b is Buffer b.
+using BufferMask = std::uint64_t;
+static_assert(kBufferCount <= 64, "BufferMask holds one bit per buffer");
+[[nodiscard]] constexpr BufferMask buffer_bit(Buffer b) {
+  return BufferMask{1} << static_cast<std::uint32_t>(b);
+}
+/// The buffers family k reads, and those it writes (motes/backend/kernels.h).
+BufferMask kernel_reads(Kernel k);
+BufferMask kernel_writes(Kernel k);
 
 /// Element counts of a simulation.
 struct Sizes {
@@ -265,96 +266,12 @@ class Device {
   /// Copies the start of a buffer to host memory (waits for queued kernels).
   virtual Status read(Buffer b, void* dst, std::size_t bytes) = 0;
 
-  /// When NeighbourState[MOTES_NEIGHBOUR_REBUILD] is nonzero: grid_build, then neighbours_build;
-  /// otherwise nothing. Decided on the device, so that a queued step needs no host round trip.
-  virtual void neighbours_update(const shared::StepParams& p) = 0;
-  /// Buckets, stable sort by (bucket, particle id), bucket starts, sorted copies of particles.
-  virtual void grid_build(const shared::StepParams& p) = 0;
-  /// From the grid: every dynamic particle's list of the particles of other bodies closer than
-  /// r_i + r_j + skin (shared/neighbours.h), in the canonical order of the 27-cell walk
-  /// (docs/architecture.md), its first K entries kept and its full count written (static
-  /// particles: 0); NeighbourRefPos = ParticlePos; NeighbourState: rebuild 0, builds + 1, the
-  /// particles over capacity and the largest count.
-  virtual void neighbours_build(const shared::StepParams& p) = 0;
-  /// ParticleForce: each dynamic particle sums the contact forces of its list in order (a
-  /// particle with more than K neighbours walks the grid of the last build from the cell of its
-  /// NeighbourRefPos instead: the same pairs in the same order), then the planes in order.
-  /// Static particles get 0. Exact while no particle has moved 0.45 skin since the build.
-  virtual void contacts_compute(const shared::StepParams& p) = 0;
-  /// BodyForce and BodyTorque: sums over each body's particles in particle order.
-  virtual void bodies_reduce(const shared::StepParams& p) = 0;
-  /// Semi-implicit Euler on every dynamic body (shared/body_math.h: body_integrate).
-  virtual void bodies_integrate(const shared::StepParams& p) = 0;
-  /// ParticlePos and ParticleVel xyz of the rigid particles [0, Nr) from their body's pose; asks
-  /// for a rebuild (NeighbourState) when one has moved too far from its NeighbourRefPos. With
-  /// MOTES_FLAG_ABSORB, first ParticleForce = shared::particle_absorbed_impulse of the particle's
-  /// velocity as it is and ParticleMoment = (R local) x that impulse.
-  virtual void particles_update(const shared::StepParams& p) = 0;
-  /// Semi-implicit Euler on the free particles [Nr, N) (shared/body_math.h: particle_integrate),
-  /// the velocities of the linked particles [Nl, N) first multiplied by 1 - p.linked_damping; asks
-  /// for a rebuild when one has moved too far from its NeighbourRefPos.
-  virtual void particles_integrate(const shared::StepParams& p) = 0;
-  /// One colour of distance constraints: Constraints [p.constraint_first, + p.constraint_count),
-  /// no two of which share a particle, each projected once (shared/links.h:
-  /// constraint_correction) on ParticlePos and ParticleVel; asks for a rebuild when a particle it
-  /// moved is too far from its NeighbourRefPos.
-  virtual void constraints_solve(const shared::StepParams& p) = 0;
-  /// ClusterFrames: for each of the p.cluster_count clusters, the centre of mass of its members
-  /// and A_pq (cluster_centre_add, cluster_moment_add), summed in member order, then
-  /// shared/shape_matching.h: cluster_frame, from the cluster's last rotation.
-  virtual void clusters_fit(const shared::StepParams& p) = 0;
-  /// Every soft particle [p.soft_first, p.linked_first) moved by the sum of cluster_shift over
-  /// its members in ClusterGather order (its velocity by the same / dt); asks for a rebuild when
-  /// one ends too far from its NeighbourRefPos.
-  virtual void clusters_goal(const shared::StepParams& p) = 0;
-
-  /// Impulse contacts (shared/impulse.h), rigid particles [0, Nr) only: ParticleForce xyz = the
-  /// sum of particle_contact_impulse over its list's rigid particles in list order (each pair
-  /// evaluated lower id first, negated for the higher), then plane_contact_impulse over the
-  /// planes; w = the contacts counted; ParticleMoment = the sum of (c - x_com) x J. The bodies'
-  /// state: BodyPos, BodyQuat, BodyInvInertia, BodyVel, BodyAngVel now, BodyVelStart and
-  /// BodyAngVelStart. Static particles get 0. With MOTES_FLAG_IMPULSE_COUNT the same (only w is
-  /// used).
-  virtual void impulses_compute(const shared::StepParams& p) = 0;
-  /// Every dynamic body sums its particles' ParticleForce and ParticleMoment in particle order,
-  /// then shared/impulse.h: body_apply_impulse (BodyVel, BodyAngMom, BodyAngVel). With
-  /// MOTES_FLAG_IMPULSE_COUNT instead: BodyVelStart = (BodyVel xyz, the summed count),
-  /// BodyAngVelStart = BodyAngVel.
-  virtual void impulses_apply(const shared::StepParams& p) = 0;
-
-  /// The motion guard's reduction over particles [0, particle_count): MotionCheck gets the
-  /// largest (|v| / d)^2 of a finite particle, the first particle with it and its |v|^2, and the
-  /// first particle whose position or velocity is not finite (shared/motion_check.h). Reads
-  /// ParticlePos and ParticleVel only.
-  virtual void particles_check(const shared::StepParams& p) = 0;
-  /// The energy guard's reduction (shared/energy.h): for every block of MOTES_ENERGY_BLOCK items
-  /// (the rigid bodies [0, p.body_count), then the particles [p.rigid_particle_count,
-  /// p.particle_count)), EnergyPartials gets the sum of its items' shared::item_energy (kinetic,
-  /// potential from the reference point in EnergyPartials' header, gravity p.gravity_dt) added as
-  /// a tree in the fixed order of shared/energy.h, its largest item kinetic energy and the lowest
-  /// item with it. Reads BodyPos, BodyVel, BodyAngVel, BodyAngMom, ParticlePos, ParticleVel and
-  /// the header; writes only the blocks.
-  virtual void energy_reduce(const shared::StepParams& p) = 0;
-
-  /// Halo exchange over MPI ranks (shared/halo.h, docs/scale-out.md): HaloData = the state of
-  /// the p.halo_particles particles at HaloIndex [p.halo_first, + p.halo_particles) (entry k:
-  /// ParticlePos at 2k, ParticleVel at 2k + 1), then of the p.halo_bodies rigid bodies at the next
-  /// p.halo_bodies words (entry j at 2 P + 5 j: BodyPos, BodyQuat, BodyVel, BodyAngMom,
-  /// BodyAngVel). HaloData's entries start at its word 0 whatever p.halo_first is. Plain copies:
-  /// the same bits on every backend. An entry whose index is not below p.particle_count (a
-  /// particle) or p.body_count (a body) is skipped: its HaloData entry is left as it was.
-  virtual void halo_pack(const shared::StepParams& p) = 0;
-  /// The reverse of halo_pack with the same layout: HaloData's entries written to the particles
-  /// and bodies HaloIndex names (from p.halo_first; an index out of range, as in halo_pack:
-  /// nothing written); asks for a neighbour-list rebuild (NeighbourState) when a particle it
-  /// wrote is too far from its NeighbourRefPos (shared/neighbours.h: neighbour_moved_too_far), as
-  /// the integrators do, and leaves NeighbourState as it is otherwise.
-  virtual void halo_unpack(const shared::StepParams& p) = 0;
-  /// PartitionCheck[0] = the largest of shared/halo.h: displacement2_bits(ParticlePos[i],
-  /// PartitionRefPos[i]) over particles [0, p.particle_count): the float bits of the largest
-  /// squared distance a particle has moved since the partition (an infinity's bits when one is
-  /// not finite). Reads ParticlePos and PartitionRefPos only.
-  virtual void particles_displacement(const shared::StepParams& p) = 0;
+  /// Queues one call of kernel family k with these parameters (motes/backend/kernels.h: what each
+  /// family computes, reads and writes). Kernels run in the order they are queued; an error
+  /// (parameters beyond the allocated buffers) surfaces at synchronize().
+  virtual void enqueue(Kernel k, const shared::StepParams& p) = 0;
+  /// Whether this device runs family k (every backend runs every family today).
+  [[nodiscard]] virtual bool supports(Kernel k) const { return k != Kernel::Count; }
 
   /// Waits for queued work; reports any error it raised.
   virtual Status synchronize() = 0;

@@ -1,0 +1,145 @@
+// Every kernel family, named once (docs/architecture.md, "Adding a kernel family"). A family is
+// one name: the Kernel enumerator, the name in timings, tables and conformance filters, the file
+// of each backend (backends/openmp/NAME.cpp, backends/cuda/NAME.cu, backends/vulkan/NAME.cpp with
+// shaders/NAME*.comp), its oracle (tests/reference/NAME.cpp) and its conformance file
+// (tests/conformance/test_NAME.cpp). The list below gives, in the order a step runs them, each
+// family's enumerator, its name, and the buffers it reads and writes (motes::Buffer enumerators;
+// a buffer a family changes only in part, keeping the rest, is in both). The conformance suite
+// checks both lists on every backend: it poisons every buffer a call neither reads nor writes
+// and requires every buffer outside its writes unchanged afterwards.
+//
+// The contracts (what each family computes; the same on every backend):
+//
+// neighbours_update: when NeighbourState[MOTES_NEIGHBOUR_REBUILD] is nonzero, grid_build then
+//   neighbours_build (each timed as itself); otherwise nothing. Decided on the device, so that a
+//   queued step needs no host round trip.
+// grid_build: buckets, a stable sort by (bucket, particle id), bucket starts, sorted copies of
+//   the particles.
+// neighbours_build: from the grid, every dynamic particle's list of the particles of other
+//   bodies closer than r_i + r_j + skin (shared/neighbours.h), in the canonical order of the
+//   27-cell walk, its first K entries kept and its full count written (static particles: 0);
+//   NeighbourRefPos = ParticlePos; NeighbourState: rebuild 0, builds + 1, the particles over
+//   capacity and the largest count; with impulse contacts, ImpulseStamp of every rigid particle.
+// contacts_compute: ParticleForce: each dynamic particle sums the contact forces of its list in
+//   order (a particle with more than K neighbours walks the grid of the last build from the cell
+//   of its NeighbourRefPos instead: the same pairs in the same order), then the planes in order.
+//   Static particles get 0. Exact while no particle has moved 0.45 skin since the build.
+// bodies_reduce: BodyForce and BodyTorque: sums over each body's particles in particle order.
+// bodies_integrate: semi-implicit Euler on every dynamic body (shared/body_math.h:
+//   body_integrate; with impulse contacts from BodyVelPush and BodyAngMomPush).
+// particles_update: ParticlePos and ParticleVel xyz of the rigid particles [0, Nr) from their
+//   body's pose; asks for a rebuild (NeighbourState) when one has moved too far from its
+//   NeighbourRefPos. With MOTES_FLAG_ABSORB, first ParticleForce =
+//   shared::particle_absorbed_impulse of the particle's velocity as it is and ParticleMoment =
+//   (R local) x that impulse.
+// particles_integrate: semi-implicit Euler on the free particles [Nr, N)
+//   (shared/body_math.h: particle_integrate), the velocities of the linked particles [Nl, N)
+//   first multiplied by 1 - p.linked_damping; asks for a rebuild when one has moved too far.
+// clusters_fit: ClusterFrames: for each of the p.cluster_count clusters, the centre of mass of
+//   its members and A_pq (cluster_centre_add, cluster_moment_add), summed in member order, then
+//   shared/shape_matching.h: cluster_frame, from the cluster's last rotation.
+// clusters_goal: every soft particle [p.soft_first, p.linked_first) moved by the sum of
+//   cluster_shift over its members in ClusterGather order (its velocity by the same / dt); asks
+//   for a rebuild when one ends too far from its NeighbourRefPos.
+// constraints_solve: one colour of distance constraints: Constraints [p.constraint_first,
+//   + p.constraint_count), no two of which share a particle, each projected once
+//   (shared/links.h: constraint_correction) on ParticlePos and ParticleVel; asks for a rebuild
+//   when a particle it moved is too far from its NeighbourRefPos.
+// impulses_compute: impulse contacts (shared/impulse.h), rigid particles [0, Nr) only:
+//   ParticleForce xyz = the sum of particle_contact_impulse over its list's rigid particles in
+//   list order (each pair evaluated lower id first, negated for the higher), then
+//   plane_contact_impulse over the planes; w = the contacts counted; ParticleMoment = the sum of
+//   (c - x_com) x J; the contacts' accumulated impulses in ContactImpulse (ImpulseStamp says
+//   which are valid). Static particles get 0. With MOTES_FLAG_IMPULSE_COUNT the same (only w is
+//   used).
+// impulses_apply: every dynamic body sums its particles' ParticleForce and ParticleMoment in
+//   particle order, then shared/impulse.h: body_apply_impulse (BodyVel, BodyAngMom, BodyAngVel).
+//   With MOTES_FLAG_IMPULSE_COUNT instead: BodyVelStart = (BodyVel xyz, the summed count),
+//   BodyAngVelStart = BodyAngVel; with MOTES_FLAG_IMPULSE_PUSH the pushed velocities.
+// particles_check (not part of a step: the motion guard): MotionCheck gets the largest
+//   (|v| / d)^2 of a finite particle of [0, particle_count), the first particle with it and its
+//   |v|^2, and the first particle whose position or velocity is not finite
+//   (shared/motion_check.h).
+// energy_reduce (not part of a step: the energy guard, shared/energy.h): for every block of
+//   MOTES_ENERGY_BLOCK items (the rigid bodies [0, p.body_count), then the particles
+//   [p.rigid_particle_count, p.particle_count)), EnergyPartials gets the sum of its items'
+//   shared::item_energy (from the reference point in EnergyPartials' header) added as a tree in
+//   the fixed order of shared/energy.h, its largest item kinetic energy and the lowest item with
+//   it; the header is left as it is.
+// halo_pack (runs over MPI ranks, shared/halo.h, docs/scale-out.md): HaloData = the state of the
+//   p.halo_particles particles at HaloIndex [p.halo_first, + p.halo_particles) (entry k:
+//   ParticlePos at 2k, ParticleVel at 2k + 1), then of the p.halo_bodies rigid bodies at the
+//   next p.halo_bodies words (entry j at 2 P + 5 j: BodyPos, BodyQuat, BodyVel, BodyAngMom,
+//   BodyAngVel). Plain copies: the same bits on every backend. An entry whose index is not below
+//   p.particle_count (a particle) or p.body_count (a body) is skipped.
+// halo_unpack: the reverse of halo_pack with the same layout; asks for a rebuild when a particle
+//   it wrote is too far from its NeighbourRefPos, and leaves NeighbourState as it is otherwise.
+// particles_displacement: PartitionCheck[0] = the largest of shared/halo.h:
+//   displacement2_bits(ParticlePos[i], PartitionRefPos[i]) over [0, p.particle_count).
+#pragma once
+
+// X(Enumerator, name, (buffers read), (buffers written)), in the order a step runs them.
+#define MOTES_KERNELS(X)                                                                         \
+  X(NeighboursUpdate, neighbours_update,                                                         \
+    (ParticlePos, ParticleVel, ParticleBody, NeighbourState, LinkExclusions, ImpulseStamp),      \
+    (GridBucket, GridOrder, GridCellStart, SortedPos, SortedBody, NeighbourList, NeighbourCount, \
+     NeighbourRefPos, NeighbourState, ImpulseStamp))                                             \
+  X(GridBuild, grid_build, (ParticlePos, ParticleBody),                                          \
+    (GridBucket, GridOrder, GridCellStart, SortedPos, SortedBody))                               \
+  X(NeighboursBuild, neighbours_build,                                                           \
+    (ParticlePos, ParticleVel, ParticleBody, GridOrder, GridCellStart, SortedPos, SortedBody,    \
+     NeighbourState, LinkExclusions, ImpulseStamp),                                              \
+    (NeighbourList, NeighbourCount, NeighbourRefPos, NeighbourState, ImpulseStamp))              \
+  X(ContactsCompute, contacts_compute,                                                           \
+    (ParticlePos, ParticleVel, ParticleBody, ParticleMaterial, GridOrder, GridCellStart,         \
+     SortedPos, SortedBody, NeighbourList, NeighbourCount, NeighbourRefPos, ContactLaws, Planes, \
+     LinkExclusions),                                                                            \
+    (ParticleForce))                                                                             \
+  X(BodiesReduce, bodies_reduce, (ParticlePos, ParticleForce, BodyPos, BodyFirst),               \
+    (BodyForce, BodyTorque))                                                                     \
+  X(BodiesIntegrate, bodies_integrate,                                                           \
+    (BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel, BodyInvInertia, BodyForce, BodyTorque,  \
+     BodyVelPush, BodyAngMomPush),                                                               \
+    (BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel))                                        \
+  X(ParticlesUpdate, particles_update,                                                           \
+    (ParticlePos, ParticleVel, ParticleLocal, ParticleBody, BodyPos, BodyQuat, BodyVel,          \
+     BodyAngVel, NeighbourRefPos, NeighbourState),                                               \
+    (ParticlePos, ParticleVel, ParticleForce, ParticleMoment, NeighbourState))                   \
+  X(ParticlesIntegrate, particles_integrate,                                                     \
+    (ParticlePos, ParticleVel, ParticleForce, NeighbourRefPos, NeighbourState),                  \
+    (ParticlePos, ParticleVel, NeighbourState))                                                  \
+  X(ClustersFit, clusters_fit,                                                                   \
+    (ParticlePos, ParticleVel, Clusters, ClusterMembers, ClusterFrames), (ClusterFrames))        \
+  X(ClustersGoal, clusters_goal,                                                                 \
+    (ParticlePos, ParticleVel, NeighbourRefPos, NeighbourState, ClusterMembers, ClusterFrames,   \
+     ClusterGather),                                                                             \
+    (ParticlePos, ParticleVel, NeighbourState))                                                  \
+  X(ConstraintsSolve, constraints_solve,                                                         \
+    (ParticlePos, ParticleVel, NeighbourRefPos, NeighbourState, Constraints),                    \
+    (ParticlePos, ParticleVel, NeighbourState))                                                  \
+  X(ImpulsesCompute, impulses_compute,                                                           \
+    (ParticlePos, ParticleVel, ParticleBody, ParticleMaterial, BodyPos, BodyQuat, BodyVel,       \
+     BodyAngVel, BodyInvInertia, BodyFirst, GridOrder, GridCellStart, SortedPos, SortedBody,     \
+     NeighbourList, NeighbourCount, NeighbourRefPos, NeighbourState, ContactLaws, Planes,        \
+     BodyVelStart, BodyAngVelStart, ContactImpulse, ImpulseStamp),                               \
+    (ParticleForce, ParticleMoment, ContactImpulse, ImpulseStamp))                               \
+  X(ImpulsesApply, impulses_apply,                                                               \
+    (ParticleForce, ParticleMoment, BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel,          \
+     BodyInvInertia, BodyFirst, BodyVelStart, BodyAngVelStart, NeighbourState, ImpulseStamp,     \
+     BodyVelPush, BodyAngMomPush),                                                               \
+    (BodyVel, BodyAngMom, BodyAngVel, BodyVelStart, BodyAngVelStart, ImpulseStamp, BodyVelPush,  \
+     BodyAngMomPush))                                                                            \
+  X(ParticlesCheck, particles_check, (ParticlePos, ParticleVel), (MotionCheck))                  \
+  X(EnergyReduce, energy_reduce,                                                                 \
+    (ParticlePos, ParticleVel, BodyPos, BodyVel, BodyAngMom, BodyAngVel, EnergyPartials),        \
+    (EnergyPartials))                                                                            \
+  X(HaloPack, halo_pack,                                                                         \
+    (ParticlePos, ParticleVel, BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel, HaloIndex,    \
+     HaloData),                                                                                  \
+    (HaloData))                                                                                  \
+  X(HaloUnpack, halo_unpack,                                                                     \
+    (ParticlePos, ParticleVel, BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel,               \
+     NeighbourRefPos, NeighbourState, HaloIndex, HaloData),                                      \
+    (ParticlePos, ParticleVel, BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel,               \
+     NeighbourState))                                                                            \
+  X(ParticlesDisplacement, particles_displacement, (ParticlePos, PartitionRefPos), (PartitionCheck))
