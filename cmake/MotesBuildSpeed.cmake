@@ -21,7 +21,7 @@ endfunction()
 #   functions; a unity batch does that once. Measured in the sanitizer build: 619 s of CPU in
 #   separate files, 336 s in batches. Names at namespace scope (anonymous namespaces included)
 #   must therefore be unique across a target's files: shared helpers live in tests/unit/
-#   test_support.h, tests/mpi/mpi_support.h and examples/cli/cli_util.h.
+#   test_support.h, tests/mpi/mpi_support.h and cli/cli_util.h.
 # - In a sanitizer build they are compiled at -O0 (in every configuration but Debug, which is
 #   -O0 anyway): their own code is a negligible part of any run (the kernels, the oracle and the
 #   writers keep the build type's optimization), while instrumenting their large test bodies and

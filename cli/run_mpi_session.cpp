@@ -1,7 +1,7 @@
-// The stepping loop of `motes run` and `motes resume` over MPI ranks (run_mpi_session.h): every
-// rank steps its part in the same chunks; at frames and guards rank 0 gathers and checks the state
-// and writes it; checkpoint sets every C steps (the last two kept); a signal on any rank stops
-// every rank at the same step with a last set.
+// `motes run` and `motes resume` over MPI ranks (run_mpi_session.h): every rank steps its part in
+// the same chunks (the loop is shared with the run in one process, session_loop.cpp); at frames
+// and guards rank 0 gathers and checks the state and writes it; checkpoint sets every C steps (the
+// last two kept); a signal on any rank stops every rank at the same step with a last set.
 #ifdef MOTES_HAVE_MPI
 
 #include "run_mpi_session.h"
@@ -9,20 +9,20 @@
 #include <fmt/format.h>
 #include <mpi.h>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
-#include <limits>
+#include <memory>
 #include <utility>
 #include <vector>
 
 #include "cli_util.h"
 #include "motes/energy.h"
 #include "progress.h"
-#include "render_args.h"
 #include "run_mpi.h"
 #include "run_session.h"
+#include "session_loop.h"
 
 namespace motes::cli {
 
@@ -164,11 +164,12 @@ Status guard(const Snapshot& s, const DistributedSimulation& sim, EnergyGuard& e
   return Status::ok();
 }
 
-class DistributedSession {
+class DistributedSession final : public SessionLoop {
  public:
   explicit DistributedSession(DistributedPlan plan)
-      : p_(std::move(plan)),
-        frame_times_(p_.record.series.frame_times),
+      : SessionLoop(plan.record.series.frame_times, plan.writer.get(), plan.render.get(),
+                    "checkpoint set"),
+        p_(std::move(plan)),
         rank_(mpi_rank()),
         ranks_(mpi_ranks()) {}
 
@@ -184,6 +185,25 @@ class DistributedSession {
   }
 
  private:
+  [[nodiscard]] std::uint64_t current_step() const override { return p_.sim->steps(); }
+  [[nodiscard]] double current_time() const override { return p_.sim->time(); }
+
+  /// One collective per chunk: a signal caught by any rank stops every rank here, at the same
+  /// step, and the next chunk's size follows the slowest rank (the same on every rank).
+  ChunkStart start_chunk(bool /*stepped*/, double took) override {
+    const double mine[2] = {static_cast<double>(InterruptSignals::caught()), took};
+    double all[2] = {0.0, 0.0};
+    MPI_Allreduce(mine, all, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    return {static_cast<int>(all[0]), all[1], all[1] > 0.0};  // > 0: after the first chunk
+  }
+
+  void step_chunk(std::uint64_t n) override {
+    if (Status s = p_.sim->step(n); !s) stop(s.message());  // the same error on every rank
+  }
+
+  void guard_state() override { check(false); }
+  void write_frame() override { check(true); }
+
   /// The state gathered on rank 0 and checked by the motion guard; with `frame`, written as the
   /// next frame (and drawn). A guard or output error stops the run on every rank.
   void check(bool frame) {
@@ -199,15 +219,7 @@ class DistributedSession {
       std::string warning;
       ok = guard(snap.value(), sim, energy_guard_, travel, warning);
       if (ok) energy_.add(energy_guard_.rise, energy_guard_.margin);
-      if (!warning.empty()) {
-        ++warned_checks_;
-        worst_travel_ = std::max(worst_travel_, travel);
-        if (travel > 2.0 * last_warned_travel_) {
-          if (progress_ != nullptr) progress_->finish();
-          fmt::print(stderr, "motes: warning: {}\n", warning);
-          last_warned_travel_ = travel;
-        }
-      }
+      note_warning(warning, travel);
       if (ok && frame && p_.writer) ok = p_.writer->write_frame(snap.value());
       if (ok && frame && p_.render) ok = p_.render->add_frame(snap.value());
     }
@@ -219,25 +231,9 @@ class DistributedSession {
     output_seconds_ += seconds_since(start);
   }
 
-  /// Ends a run that cannot go on, on every rank: the frames so far are finished (their series
-  /// stays readable), the message names the last good set, the exit code is 2.
-  [[noreturn]] void stop(const std::string& message) {
-    if (progress_ != nullptr) progress_->finish();
-    if (p_.writer) (void)p_.writer->finish();
-    if (p_.render) (void)p_.render->finish();
-    const std::string frames = fmt::format(
-        "{} frame{} written{}", frame_times_.size(), frame_times_.size() == 1 ? "" : "s",
-        p_.writer ? fmt::format(" ({})", p_.writer->main_path()) : "");
-    fail(fmt::format(
-        "{}\nmotes: run stopped; {}; {}", message, frames,
-        last_checkpoint_.empty()
-            ? std::string("no checkpoint set was written (--checkpoint-every N keeps one)")
-            : fmt::format("the last good checkpoint set is {}", last_checkpoint_)));
-  }
-
   /// Writes the set checkpoint-<step>.mckset (atomically) and removes all but the last two;
   /// only a state the guard has passed.
-  void save_checkpoint() {
+  void save_checkpoint() override {
     const Clock::time_point start = Clock::now();
     DistributedSimulation& sim = *p_.sim;
     if (last_guard_step_ != sim.steps()) check(false);
@@ -274,8 +270,7 @@ class DistributedSession {
     std::unique_ptr<Progress> progress;
     if (rank_ == 0) progress = std::make_unique<Progress>(p_.total, sim.steps());
     progress_ = progress.get();
-    first_step_ = sim.steps();
-    run_steps();
+    run_steps(p_.total, p_.every, p_.checkpoint_every, p_.resumed);
     if (progress_ != nullptr) progress_->finish();
     progress_ = nullptr;
     Status finished = Status::ok();
@@ -287,75 +282,12 @@ class DistributedSession {
     wall_seconds_ = seconds_since(start);
     if (signal_ != 0 && rank_ == 0) {
       fmt::print(stderr,
-                 "motes: interrupted by {} at step {} of {} (t = {:.6g} s); {} frame{} written{}; "
-                 "checkpoint set {}\n"
+                 "motes: interrupted by {} at step {} of {} (t = {:.6g} s); {}; checkpoint set {}\n"
                  "motes: continue with: mpirun -np {} motes resume {}\n",
-                 signal_name(signal_), sim.steps(), p_.total, sim.time(), frame_times_.size(),
-                 frame_times_.size() == 1 ? "" : "s",
-                 p_.writer ? fmt::format(" ({})", p_.writer->main_path()) : "", last_checkpoint_,
-                 ranks_, last_checkpoint_);
+                 signal_name(signal_), sim.steps(), p_.total, sim.time(), frames_written(),
+                 last_checkpoint_, ranks_, last_checkpoint_);
       std::fflush(stderr);
     }
-  }
-
-  /// Frame 0 (not for a resumed run), the steps with a frame every `every` steps and a set every
-  /// `checkpoint_every`, and the final state.
-  void run_steps() {
-    DistributedSimulation& sim = *p_.sim;
-    const std::uint64_t first = sim.steps();
-    const std::uint64_t every = p_.every;
-    const std::uint64_t ck = p_.checkpoint_every;
-    if (!p_.resumed) {
-      check(true);
-    } else {
-      check(false);  // the set's state, before the first step
-      if (!frame_times_.empty() && frame_times_.back() == sim.time()) {
-        last_frame_step_ = first;  // the set's step already has its frame
-      }
-    }
-    std::uint64_t next_frame = (first / every + 1) * every;
-    std::uint64_t next_checkpoint =
-        ck > 0 ? (first / ck + 1) * ck : std::numeric_limits<std::uint64_t>::max();
-    std::uint64_t chunk = 1;
-    double took = 0.0;
-    while (sim.steps() < p_.total) {
-      // One collective per chunk: a signal caught by any rank stops every rank here, at the same
-      // step, and the next chunk's size follows the slowest rank (the same on every rank).
-      const double mine[2] = {static_cast<double>(InterruptSignals::caught()), took};
-      double all[2] = {0.0, 0.0};
-      MPI_Allreduce(mine, all, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-      if (all[0] != 0.0) {
-        signal_ = static_cast<int>(all[0]);
-        break;
-      }
-      if (all[1] > 0.0) {  // after the first chunk
-        if (all[1] < kChunkSeconds / 2 && chunk < kMaxChunk) chunk *= 2;
-        if (all[1] > kChunkSeconds * 2 && chunk > 1) chunk /= 2;
-      }
-      const std::uint64_t done = sim.steps();
-      // > done: a guard runs at the start and whenever a chunk reaches it.
-      const std::uint64_t next_guard = last_guard_step_ + Simulation::kGuardInterval;
-      const std::uint64_t n = std::min(
-          {chunk, p_.total - done, next_frame - done, next_checkpoint - done, next_guard - done});
-      const Clock::time_point t0 = Clock::now();
-      if (Status s = sim.step(n); !s) stop(s.message());  // the same error on every rank
-      took = seconds_since(t0);
-      step_seconds_ += took;
-      if (sim.steps() == next_frame) {
-        check(true);
-        next_frame += every;
-      } else if (sim.steps() >= next_guard) {
-        check(false);
-      }
-      if (sim.steps() == next_checkpoint) {
-        // The one at the end comes after the final frame (loop()).
-        if (sim.steps() < p_.total) save_checkpoint();
-        next_checkpoint += ck;
-      }
-      if (progress_ != nullptr) progress_->update(sim.steps(), sim.time());
-    }
-    // The final state is always a frame, also when the step count is not a multiple of --every.
-    if (sim.steps() >= p_.total && last_frame_step_ != sim.steps()) check(true);
   }
 
   void summary() const {
@@ -405,48 +337,19 @@ class DistributedSession {
                format_seconds(output_seconds_));
     fmt::print("  {:<16}{} steps/s, {} particle-steps/s (stepping, halos included)\n", "speed",
                format_si(rate), format_si(rate * static_cast<double>(sim.particle_count())));
-    if (p_.writer) {
-      fmt::print("  {:<16}{} written to {}\n", "frames", p_.writer->frames(),
-                 p_.writer->main_path());
-    } else {
-      fmt::print("  {:<16}none written (--format none)\n", "frames");
-    }
-    if (p_.render) fmt::print("  {:<16}{}\n", "pictures", render_summary(*p_.render));
+    print_frames();
     if (checkpoints_ > 0) {
       fmt::print("  {:<16}{} set{} written, the last {}\n", "checkpoints", checkpoints_,
                  checkpoints_ == 1 ? "" : "s", last_checkpoint_);
     }
-    fmt::print("  {:<16}{} motion check{} on the gathered state{}; {}\n", "guards", guards_,
-               guards_ == 1 ? "" : "s",
-               warned_checks_ == 0
-                   ? std::string(", no warning")
-                   : fmt::format(", {} with a tunnelling warning (the worst: {:.3g} of a "
-                                 "diameter per substep)",
-                                 warned_checks_, worst_travel_),
-               energy_.summary());
+    print_guards(" on the gathered state");
     std::fflush(stdout);
   }
 
   DistributedPlan p_;
-  std::vector<double> frame_times_;
   int rank_ = 0;
   int ranks_ = 1;
-  std::uint64_t first_step_ = 0;
-  std::uint64_t last_frame_step_ = std::numeric_limits<std::uint64_t>::max();
-  std::uint64_t checkpoints_ = 0;
-  std::string last_checkpoint_;
-  Progress* progress_ = nullptr;  // rank 0, while the loop runs
-  std::uint64_t last_guard_step_ = 0;
-  std::uint64_t guards_ = 0;
-  std::uint64_t warned_checks_ = 0;
-  double worst_travel_ = 0.0;
-  double last_warned_travel_ = 0.0;
   EnergyGuard energy_guard_;  // rank 0
-  EnergyRise energy_;
-  int signal_ = 0;
-  double wall_seconds_ = 0.0;
-  double step_seconds_ = 0.0;
-  double output_seconds_ = 0.0;
 };
 
 }  // namespace

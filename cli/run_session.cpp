@@ -1,6 +1,6 @@
-// The stepping loop of `motes run` and `motes resume`: frames every K steps, checkpoints every C
-// steps (the last two kept), progress, SIGINT/SIGTERM (a last checkpoint, then a non-zero exit),
-// and the summary.
+// `motes run` and `motes resume` in one process: frames every K steps, checkpoints every C steps
+// (the last two kept), progress, SIGINT/SIGTERM (a last checkpoint, then a non-zero exit), and the
+// summary. The loop itself is shared with the run over MPI ranks (session_loop.cpp).
 #include "run_session.h"
 
 #include <fmt/format.h>
@@ -10,7 +10,6 @@
 #include <cmath>
 #include <csignal>
 #include <filesystem>
-#include <limits>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -18,7 +17,7 @@
 
 #include "cli_util.h"
 #include "progress.h"
-#include "render_args.h"
+#include "session_loop.h"
 
 namespace motes::cli {
 
@@ -100,10 +99,12 @@ std::string EnergyRise::summary() const {
 
 namespace {
 
-class Session {
+class Session final : public SessionLoop {
  public:
   explicit Session(SessionPlan plan)
-      : p_(std::move(plan)), frame_times_(p_.record.series.frame_times) {}
+      : SessionLoop(plan.record.series.frame_times, plan.writer.get(), plan.render.get(),
+                    "checkpoint"),
+        p_(std::move(plan)) {}
 
   void run() {
     loop();
@@ -112,45 +113,36 @@ class Session {
   }
 
  private:
+  [[nodiscard]] std::uint64_t current_step() const override { return p_.sim->steps(); }
+  [[nodiscard]] double current_time() const override { return p_.sim->time(); }
+
+  ChunkStart start_chunk(bool stepped, double took) override {
+    return {InterruptSignals::caught(), took, stepped};
+  }
+
+  void step_chunk(std::uint64_t n) override {
+    Simulation& sim = *p_.sim;
+    if (Status s = sim.step(n); !s) fail(s.message());
+    if (Status s = sim.device().synchronize(); !s) fail(s.message());
+  }
+
   /// The motion guard (Simulation::check_motion): prints a tunnelling warning the first time
   /// and whenever it is twice as bad as the last one printed; stops the run on an error.
-  void guard() {
+  void guard_state() override {
     Simulation& sim = *p_.sim;
     last_guard_step_ = sim.steps();
     ++guards_;
     Result<MotionReport> r = sim.check_motion();
     if (!r) stop(r.message());
     energy_.add(r->rise, r->reference.margin_at(r->kinetic_energy));
-    if (r->warning.empty()) return;
-    ++warned_checks_;
-    worst_travel_ = std::max(worst_travel_, r->travel);
-    if (r->travel > 2.0 * last_warned_travel_) {
-      if (progress_ != nullptr) progress_->finish();
-      fmt::print(stderr, "motes: warning: {}\n", r->warning);
-      last_warned_travel_ = r->travel;
-    }
-  }
-
-  /// Ends a run the guard stopped: the frames so far are finished (their series stays readable),
-  /// the message says which checkpoint is the last good one, and the exit is non-zero.
-  [[noreturn]] void stop(const std::string& message) {
-    if (progress_ != nullptr) progress_->finish();
-    if (p_.writer) (void)p_.writer->finish();
-    if (p_.render) (void)p_.render->finish();
-    const std::string frames = fmt::format(
-        "{} frame{} written{}", frame_times_.size(), frame_times_.size() == 1 ? "" : "s",
-        p_.writer ? fmt::format(" ({})", p_.writer->main_path()) : "");
-    fail(fmt::format("{}\nmotes: run stopped; {}; {}", message, frames,
-                     last_checkpoint_.empty()
-                         ? std::string("no checkpoint was written (--checkpoint-every N keeps one)")
-                         : fmt::format("the last good checkpoint is {}", last_checkpoint_)));
+    note_warning(r->warning, r->travel);
   }
 
   /// Checks the state and writes it as the next frame.
-  void output_frame() {
+  void write_frame() override {
     const Clock::time_point start = Clock::now();
     Simulation& sim = *p_.sim;
-    guard();
+    guard_state();
     if (p_.writer || p_.render) {
       Result<Snapshot> snapshot = sim.snapshot();
       if (!snapshot) fail(snapshot.message());
@@ -168,10 +160,10 @@ class Session {
 
   /// Writes checkpoint-<step>.mck (atomically) and removes all but the last two; only a state
   /// the guard has passed.
-  void save_checkpoint() {
+  void save_checkpoint() override {
     const Clock::time_point start = Clock::now();
     Simulation& sim = *p_.sim;
-    if (last_guard_step_ != sim.steps()) guard();
+    if (last_guard_step_ != sim.steps()) guard_state();
     const fs::path dir = p_.record.checkpoint_dir;
     if (Status s = create_output_directory(dir.string(), "checkpoint"); !s) fail(s.message());
     CheckpointRun record = p_.record;
@@ -192,9 +184,8 @@ class Session {
     const Clock::time_point start = Clock::now();
     Progress progress(p_.total, p_.sim->steps());
     progress_ = &progress;
-    first_step_ = p_.sim->steps();
     try {
-      run_steps(progress);
+      run_steps(p_.total, p_.every, p_.checkpoint_every, p_.resumed);
     } catch (const CLI::RuntimeError&) {
       progress.finish();  // so that the error starts on a line of its own
       throw;
@@ -213,67 +204,11 @@ class Session {
     if (signal_ != 0) {
       Simulation& sim = *p_.sim;
       fmt::print(stderr,
-                 "motes: interrupted by {} at step {} of {} (t = {:.6g} s); {} frame{} written{}; "
-                 "checkpoint {}\n"
+                 "motes: interrupted by {} at step {} of {} (t = {:.6g} s); {}; checkpoint {}\n"
                  "motes: continue with: motes resume {}\n",
-                 signal_name(signal_), sim.steps(), p_.total, sim.time(), frame_times_.size(),
-                 frame_times_.size() == 1 ? "" : "s",
-                 p_.writer ? fmt::format(" ({})", p_.writer->main_path()) : "", last_checkpoint_,
-                 last_checkpoint_);
+                 signal_name(signal_), sim.steps(), p_.total, sim.time(), frames_written(),
+                 last_checkpoint_, last_checkpoint_);
     }
-  }
-
-  /// Frame 0 (not for a resumed run), the steps with a frame every `every` steps and a checkpoint
-  /// every `checkpoint_every`, and the final state.
-  void run_steps(Progress& progress) {
-    Simulation& sim = *p_.sim;
-    const std::uint64_t first = sim.steps();
-    const std::uint64_t every = p_.every;
-    const std::uint64_t ck = p_.checkpoint_every;
-    if (!p_.resumed) {
-      output_frame();
-    } else {
-      guard();  // the checkpoint's state, before the first step
-      if (!frame_times_.empty() && frame_times_.back() == sim.time()) {
-        last_frame_step_ = first;  // the checkpoint's step already has its frame
-      }
-    }
-    std::uint64_t next_frame = (first / every + 1) * every;
-    std::uint64_t next_checkpoint =
-        ck > 0 ? (first / ck + 1) * ck : std::numeric_limits<std::uint64_t>::max();
-    std::uint64_t chunk = 1;
-    while (sim.steps() < p_.total) {
-      if (InterruptSignals::caught() != 0) {
-        signal_ = InterruptSignals::caught();
-        break;
-      }
-      const std::uint64_t done = sim.steps();
-      // > done: a guard runs at the start and whenever a chunk reaches it.
-      const std::uint64_t next_guard = last_guard_step_ + Simulation::kGuardInterval;
-      const std::uint64_t n = std::min(
-          {chunk, p_.total - done, next_frame - done, next_checkpoint - done, next_guard - done});
-      const Clock::time_point t0 = Clock::now();
-      if (Status s = sim.step(n); !s) fail(s.message());
-      if (Status s = sim.device().synchronize(); !s) fail(s.message());
-      const double took = seconds_since(t0);
-      step_seconds_ += took;
-      if (took < kChunkSeconds / 2 && chunk < kMaxChunk) chunk *= 2;
-      if (took > kChunkSeconds * 2 && chunk > 1) chunk /= 2;
-      if (sim.steps() == next_frame) {
-        output_frame();
-        next_frame += every;
-      } else if (sim.steps() >= next_guard) {
-        guard();
-      }
-      if (sim.steps() == next_checkpoint) {
-        // The one at the end comes after the final frame (loop()).
-        if (sim.steps() < p_.total) save_checkpoint();
-        next_checkpoint += ck;
-      }
-      progress.update(sim.steps(), sim.time());
-    }
-    // The final state is always a frame, also when the step count is not a multiple of --every.
-    if (sim.steps() >= p_.total && last_frame_step_ != sim.steps()) output_frame();
   }
 
   void summary() const {
@@ -305,44 +240,16 @@ class Session {
                format_seconds(output_seconds_));
     fmt::print("  {:<16}{} steps/s, {} particle-steps/s (stepping only)\n", "speed",
                format_si(rate), format_si(particle_rate));
-    if (p_.writer) {
-      fmt::print("  {:<16}{} written to {}\n", "frames", p_.writer->frames(),
-                 p_.writer->main_path());
-    } else {
-      fmt::print("  {:<16}none written (--format none)\n", "frames");
-    }
-    if (p_.render) fmt::print("  {:<16}{}\n", "pictures", render_summary(*p_.render));
+    print_frames();
     if (checkpoints_ > 0) {
       fmt::print("  {:<16}{} written, the last {}\n", "checkpoints", checkpoints_,
                  last_checkpoint_);
     }
-    fmt::print("  {:<16}{} motion check{}{}; {}\n", "guards", guards_, guards_ == 1 ? "" : "s",
-               warned_checks_ == 0
-                   ? std::string(", no warning")
-                   : fmt::format(", {} with a tunnelling warning (the worst: {:.3g} of a "
-                                 "diameter per substep)",
-                                 warned_checks_, worst_travel_),
-               energy_.summary());
+    print_guards("");
     std::fflush(stdout);
   }
 
   SessionPlan p_;
-  std::vector<double> frame_times_;
-  std::uint64_t first_step_ = 0;
-  std::uint64_t last_frame_step_ = std::numeric_limits<std::uint64_t>::max();
-  std::uint64_t checkpoints_ = 0;
-  std::string last_checkpoint_;
-  Progress* progress_ = nullptr;  // while the loop runs
-  std::uint64_t last_guard_step_ = 0;
-  std::uint64_t guards_ = 0;
-  std::uint64_t warned_checks_ = 0;
-  double worst_travel_ = 0.0;
-  double last_warned_travel_ = 0.0;
-  EnergyRise energy_;
-  int signal_ = 0;
-  double wall_seconds_ = 0.0;
-  double step_seconds_ = 0.0;
-  double output_seconds_ = 0.0;
 };
 
 }  // namespace
