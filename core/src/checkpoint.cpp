@@ -1,16 +1,20 @@
 // Checkpoints (docs/reliability.md, "Checkpoint and resume"): everything that defines the future of
 // a run, as raw bits, in one file written atomically.
 //
-// Version 2, in the machine's byte order (little-endian on every supported machine):
+// Version 3, in the machine's byte order (little-endian on every supported machine):
 //   header (96 bytes): magic "MOTESCK1", version, header bytes, file bytes, step, time, setup hash,
 //     scene hash, particles, scene bodies, rigid bodies, rigid particles, hash table size T,
 //     neighbour capacity K, clusters, section count, run record bytes;
 //   run record: the backend, then CheckpointRun (strings as u32 length + bytes; the extension, as
 //     u64 length + bytes, only when it is not empty);
-//   sections: {u32 buffer, u32 element bytes, u64 bytes, the buffer's first `bytes` bytes}, one per
-//     buffer of state_buffers(), in that order, in the device's order (the same on every backend):
-//     17, and an 18th (PartitionRefPos) for one rank of a run over MPI ranks;
+//   sections: {the buffer's name (buffer_name, 32 bytes padded with zeros), u32 element bytes,
+//     u32 0, u64 bytes, the buffer's first `bytes` bytes}, one per buffer of state_buffers(), in
+//     that order, in the device's order (the same on every backend): 17, and an 18th
+//     (PartitionRefPos) for one rank of a run over MPI ranks;
 //   checksum: FNV-1a 64 of every byte before it.
+// Version 2 (still read): the same, but each section starts {u32 buffer, u32 element bytes, u64
+// bytes} with the buffer's number in the Buffer enum as it was then (kVersion2Buffers), so that
+// the enum can be regrouped.
 // Version 1 (still read by load_state): a 48-byte header {magic, version, particles, bodies,
 // reserved, step, time, payload bytes}, the scene-ordered body and particle arrays of a Snapshot,
 // and the FNV-1a 64 of that payload.
@@ -42,7 +46,21 @@ namespace {
 
 constexpr std::array<char, 8> kMagic = {'M', 'O', 'T', 'E', 'S', 'C', 'K', '1'};
 constexpr std::size_t kHeaderBytes = 96;
-constexpr std::size_t kSectionHeaderBytes = 16;
+constexpr std::size_t kSectionHeaderBytes = 48;
+constexpr std::size_t kVersion2SectionHeaderBytes = 16;
+constexpr std::size_t kSectionNameBytes = 32;
+
+/// Version 2's section numbers: the Buffer enum as it was when version 2 was written.
+constexpr std::array<const char*, 45> kVersion2Buffers = {
+    "ParticlePos",     "ParticleVel",    "ParticleLocal",   "ParticleBody",    "ParticleMaterial",
+    "ParticleForce",   "BodyPos",        "BodyQuat",        "BodyVel",         "BodyAngMom",
+    "BodyAngVel",      "BodyInvInertia", "BodyForce",       "BodyTorque",      "BodyFirst",
+    "GridBucket",      "GridOrder",      "GridCellStart",   "SortedPos",       "SortedBody",
+    "NeighbourList",   "NeighbourCount", "NeighbourRefPos", "NeighbourState",  "ContactLaws",
+    "Planes",          "Constraints",    "Clusters",        "ClusterMembers",  "ClusterFrames",
+    "ClusterGather",   "ParticleMoment", "BodyVelStart",    "BodyAngVelStart", "ContactImpulse",
+    "ImpulseStamp",    "MotionCheck",    "LinkExclusions",  "HaloIndex",       "HaloData",
+    "PartitionRefPos", "PartitionCheck", "BodyVelPush",     "BodyAngMomPush",  "EnergyPartials"};
 constexpr std::size_t kV1HeaderBytes = 48;
 
 /// The device buffers a checkpoint holds: every buffer that a step reads before it writes it
@@ -173,9 +191,18 @@ bool decode_record(const unsigned char* p, std::size_t n, CheckpointInfo& info) 
   return !r.bad && r.left() == 0;
 }
 
-/// One section of a parsed version 2 file.
+/// `text` with every byte outside printable ASCII shown as '?', for messages.
+std::string printable(std::string_view text) {
+  std::string out(text);
+  for (char& c : out) {
+    if (c < 0x20 || c > 0x7e) c = '?';
+  }
+  return out;
+}
+
+/// One section of a parsed version 2 or 3 file.
 struct Section {
-  std::uint32_t buffer = 0;
+  Buffer buffer = Buffer::Count;
   std::uint32_t element_bytes = 0;
   std::size_t offset = 0;  ///< of its bytes in the file
   std::size_t bytes = 0;
@@ -242,9 +269,9 @@ Result<Parsed> parse(const std::string& path, const std::vector<unsigned char>& 
     out.info.checksum = stored;
     return out;
   }
-  if (version != kCheckpointVersion) {
+  if (version != 2 && version != kCheckpointVersion) {
     return Status::error(
-        fmt::format("{}: checkpoint format version {}; this motes reads versions 1 and {}", path,
+        fmt::format("{}: checkpoint format version {}; this motes reads versions 1 to {}", path,
                     version, kCheckpointVersion));
   }
   if (size < kHeaderBytes + 8) {
@@ -283,14 +310,32 @@ Result<Parsed> parse(const std::string& path, const std::vector<unsigned char>& 
   }
   std::size_t at = kHeaderBytes + h.record_bytes;
   if (h.section_count > kStateBuffers.size() * 4) return corrupt("section count");
+  const std::size_t section_header =
+      version == 2 ? kVersion2SectionHeaderBytes : kSectionHeaderBytes;
   for (std::uint32_t k = 0; k < h.section_count; ++k) {
-    if (body_end - at < kSectionHeaderBytes) return corrupt("section table");
+    if (body_end - at < section_header) return corrupt("section table");
     Section s;
     std::uint64_t n = 0;
-    std::memcpy(&s.buffer, bytes.data() + at, 4);
-    std::memcpy(&s.element_bytes, bytes.data() + at + 4, 4);
-    std::memcpy(&n, bytes.data() + at + 8, 8);
-    at += kSectionHeaderBytes;
+    const unsigned char* entry = bytes.data() + at;
+    if (version == 2) {
+      std::uint32_t number = 0;
+      std::memcpy(&number, entry, 4);
+      if (number >= kVersion2Buffers.size()) return corrupt("a section's buffer number");
+      s.buffer = buffer_from_name(kVersion2Buffers[number]);
+      std::memcpy(&s.element_bytes, entry + 4, 4);
+      std::memcpy(&n, entry + 8, 8);
+    } else {
+      const char* name = reinterpret_cast<const char*>(entry);
+      const std::string_view named(name, strnlen(name, kSectionNameBytes));
+      s.buffer = buffer_from_name(named);
+      if (s.buffer == Buffer::Count) {
+        return Status::error(fmt::format(
+            "{}: corrupt checkpoint (a section of unknown buffer '{}')", path, printable(named)));
+      }
+      std::memcpy(&s.element_bytes, entry + kSectionNameBytes, 4);
+      std::memcpy(&n, entry + kSectionNameBytes + 8, 8);
+    }
+    at += section_header;
     if (n > body_end - at) return corrupt("section size");
     s.offset = at;
     s.bytes = static_cast<std::size_t>(n);
@@ -469,10 +514,13 @@ Status Simulation::save_state(const std::string& path, const CheckpointRun& run)
     std::vector<unsigned char> data;
     for (const Buffer b : buffers) {
       const BufferLayout layout = buffer_layout(b, sizes_);
-      const std::uint32_t section[2] = {static_cast<std::uint32_t>(b),
-                                        static_cast<std::uint32_t>(layout.element_bytes)};
+      std::array<char, kSectionNameBytes> name{};
+      const std::string_view named = buffer_name(b);
+      std::copy(named.begin(), named.end(), name.begin());
+      const std::uint32_t sizes[2] = {static_cast<std::uint32_t>(layout.element_bytes), 0};
       const std::uint64_t bytes = layout.bytes();
-      if (Status st = file.write(section, sizeof section); !st) return st;
+      if (Status st = file.write(name.data(), name.size()); !st) return st;
+      if (Status st = file.write(sizes, sizeof sizes); !st) return st;
       if (Status st = file.write(&bytes, sizeof bytes); !st) return st;
       if (bytes == 0) continue;
       data.resize(layout.bytes());
@@ -528,9 +576,8 @@ Status Simulation::load_state(const std::string& path) {
   // A rank's checkpoint of a run over MPI ranks ends with the partition reference; a single
   // process's has none.
   const std::vector<Buffer> expected = state_buffers(sizes_);
-  const bool with_reference =
-      sections.size() == kStateBuffers.size() + 1 &&
-      sections.back().buffer == static_cast<std::uint32_t>(Buffer::PartitionRefPos);
+  const bool with_reference = sections.size() == kStateBuffers.size() + 1 &&
+                              sections.back().buffer == Buffer::PartitionRefPos;
   if (sizes_.partition != 0 && !with_reference) {
     return Status::error(fmt::format(
         "{}: a single process's checkpoint: this simulation is one rank of a run over MPI ranks, "
@@ -554,8 +601,8 @@ Status Simulation::load_state(const std::string& path) {
   }
   for (std::size_t k = 0; k < sections.size(); ++k) {
     const BufferLayout layout = buffer_layout(expected[k], sizes_);
-    if (sections[k].buffer != static_cast<std::uint32_t>(expected[k]) ||
-        sections[k].element_bytes != layout.element_bytes || sections[k].bytes != layout.bytes()) {
+    if (sections[k].buffer != expected[k] || sections[k].element_bytes != layout.element_bytes ||
+        sections[k].bytes != layout.bytes()) {
       return corrupt(fmt::format("section {} is not {} of {} bytes", k, buffer_name(expected[k]),
                                  layout.bytes()));
     }

@@ -15,9 +15,11 @@
 MOTES_API_BEGIN
 namespace motes {
 
-/// The checkpoint format this motes writes. load_state also reads version 1 (bodies and particles
-/// only, as `motes bench` cached them; the lists are then rebuilt, so not a bitwise resume).
-constexpr std::uint32_t kCheckpointVersion = 2;
+/// The checkpoint format this motes writes (3: sections named by buffer_name). load_state also
+/// reads version 2 (sections numbered by the Buffer enum of its day; the same bits) and version 1
+/// (bodies and particles only, as `motes bench` cached them; the lists are then rebuilt, so not a
+/// bitwise resume).
+constexpr std::uint32_t kCheckpointVersion = 3;
 
 /// The run a checkpoint belongs to, as the caller describes it (the motes command fills it; a
 /// library user may leave it empty). Stored in the checkpoint, read back by read_checkpoint_info.
