@@ -31,24 +31,24 @@
 #define B_CONTACT_LAWS 24
 #define B_PLANES 25
 #define B_CONSTRAINTS 26
-#define B_CLUSTERS 27
-#define B_CLUSTER_MEMBERS 28
-#define B_CLUSTER_FRAMES 29
-#define B_CLUSTER_GATHER 30
-#define B_PARTICLE_MOMENT 31
-#define B_BODY_VEL_START 32
-#define B_BODY_ANGVEL_START 33
-#define B_CONTACT_IMPULSE 34
-#define B_IMPULSE_STAMP 35
-#define B_MOTION_CHECK 36
-#define B_LINK_EXCLUSIONS 37
-#define B_HALO_INDEX 38
-#define B_HALO_DATA 39
-#define B_PARTITION_REF_POS 40
-#define B_PARTITION_CHECK 41
-#define B_BODY_VEL_PUSH 42
-#define B_BODY_ANGMOM_PUSH 43
-#define B_ENERGY_PARTIALS 44
+#define B_LINK_EXCLUSIONS 27
+#define B_CLUSTERS 28
+#define B_CLUSTER_MEMBERS 29
+#define B_CLUSTER_FRAMES 30
+#define B_CLUSTER_GATHER 31
+#define B_PARTICLE_MOMENT 32
+#define B_BODY_VEL_START 33
+#define B_BODY_ANGVEL_START 34
+#define B_BODY_VEL_PUSH 35
+#define B_BODY_ANGMOM_PUSH 36
+#define B_CONTACT_IMPULSE 37
+#define B_IMPULSE_STAMP 38
+#define B_MOTION_CHECK 39
+#define B_ENERGY_PARTIALS 40
+#define B_HALO_INDEX 41
+#define B_HALO_DATA 42
+#define B_PARTITION_REF_POS 43
+#define B_PARTITION_CHECK 44
 // Scratch buffers of the backend (not part of motes::Buffer).
 #define B_GRID_ARRIVAL 45  // uint (N): arrival rank of a particle in its bucket (atomic, any order)
 #define B_GRID_UNSORTED 46  // uint (N): particle ids grouped by bucket, in arrival order

@@ -19,8 +19,8 @@
 MOTES_API_BEGIN
 namespace motes {
 
-/// Every buffer a device holds, grouped by feature. Element types and counts: see
-/// buffer_layout().
+/// Every buffer a device holds, grouped by feature (checkpoints name buffers by buffer_name, so the
+/// order is free). Element types and counts: see buffer_layout().
 enum class Buffer : std::uint32_t {
   // Particles (N). The rigid bodies' particles come first, in body order: body b owns particles
   // [BodyFirst[b], BodyFirst[b+1]) and BodyFirst[B] = Nr. Particles [Nr, N) are free spheres
@@ -57,6 +57,10 @@ enum class Buffer : std::uint32_t {
   Planes,       ///< PlaneData (P)
   // Cloth and ropes: their particles are [Nl, N) (StepParams.linked_first).
   Constraints,  ///< Constraint (C): distance constraints, grouped by colour (shared/links.h)
+  /// uint (N - Nl + 1 + E; empty without a cloth from a triangle mesh): for each linked particle,
+  /// where its list of the particles within two links starts, then the lists, ascending
+  /// (shared/links.h, contact_listed).
+  LinkExclusions,
   // Soft bodies (shape matching): their particles are [Ns, Nl) (StepParams.soft_first).
   Clusters,        ///< Cluster (S): clusters of soft-body particles (shared/shape_matching.h)
   ClusterMembers,  ///< ClusterMember (Sm): every cluster's members, cluster by cluster
@@ -68,6 +72,8 @@ enum class Buffer : std::uint32_t {
   ParticleMoment,   ///< vec4 (Nr): impulses_compute's (or the absorb's) moment about the centre
   BodyVelStart,     ///< vec4 (B): BodyVel at the start of the impulse stage, w = contacts
   BodyAngVelStart,  ///< vec4 (B): BodyAngVel at the start of the impulse stage
+  BodyVelPush,      ///< vec4 (B): BodyVel after the impulse sweeps with position correction
+  BodyAngMomPush,   ///< vec4 (B): BodyAngMom after the impulse sweeps with position correction
   /// vec4 ((K + P) x Nr): accumulated impulse of every contact of rigid particle i (xyz: on the
   /// lower particle id's body, w: its normal part), its list slot k at k * Nr + i, plane k at
   /// (K + k) * Nr + i. Kept across substeps while the lists stay (warm start).
@@ -75,15 +81,13 @@ enum class Buffer : std::uint32_t {
   /// uint (Nr): NeighbourState[MOTES_NEIGHBOUR_BUILDS] when particle i's list slots of
   /// ContactImpulse were last written; another value: the lists were rebuilt, the slots are void.
   ImpulseStamp,
-  // Run-time checks.
+  // Run-time checks (not saved in checkpoints).
   MotionCheck,  ///< uint (4): particles_check's MOTES_MOTION_* words (shared/motion_check.h)
-  // Cloth from triangle meshes (empty without one; after the others: checkpoints name buffers
-  // by their number).
-  /// uint (N - Nl + 1 + E): for each linked particle, where its list of the particles within
-  /// two links starts, then the lists, ascending (shared/links.h, contact_listed).
-  LinkExclusions,
-  // Runs over MPI ranks (motes/distributed.h, docs/scale-out.md; empty in one process). After
-  // the others: checkpoints name buffers by their number.
+  /// uint (4 + 4 x blocks of 256 items, shared/energy.h): the reference point x_ref that
+  /// potential energy is measured from (written by the host), then per block of energy_reduce's
+  /// items its kinetic and potential energy, its largest item kinetic energy and that item.
+  EnergyPartials,
+  // Runs over MPI ranks (motes/distributed.h, docs/scale-out.md; empty in one process).
   /// uint (Sizes::halo_index): the entries halo_pack and halo_unpack walk, as StepParams
   /// halo_first, halo_particles and halo_bodies say: particle indices, then rigid body indices.
   HaloIndex,
@@ -95,14 +99,6 @@ enum class Buffer : std::uint32_t {
   PartitionRefPos,
   /// uint (1 when Sizes::partition, else 0): particles_displacement's word (shared/halo.h).
   PartitionCheck,
-  // Impulse contacts again (after the others: checkpoints name buffers by their number).
-  BodyVelPush,     ///< vec4 (B): BodyVel after the impulse sweeps with position correction
-  BodyAngMomPush,  ///< vec4 (B): BodyAngMom after the impulse sweeps with position correction
-  // The energy guard (after the others: checkpoints name buffers by their number; not saved).
-  /// uint (4 + 4 x blocks of 256 items, shared/energy.h): the reference point x_ref that
-  /// potential energy is measured from (written by the host), then per block of energy_reduce's
-  /// items its kinetic and potential energy, its largest item kinetic energy and that item.
-  EnergyPartials,
   Count
 };
 
