@@ -9,16 +9,12 @@
 #include <cstddef>
 #include <cstring>
 #include <limits>
-#include <numbers>
 
-#include "contact_laws.h"
 #include "motes/checkpoint.h"
-#include "motes/cloth.h"
-#include "motes/soft.h"
+#include "scene_layout.h"
 #include "shared/body_math.h"
 #include "shared/energy.h"
 #include "shared/halo.h"
-#include "shared/links.h"
 #include "shared/neighbours.h"
 
 namespace motes {
@@ -27,44 +23,7 @@ using shared::vec4;
 
 namespace {
 
-/// Bytes of Sizes before its fields of runs over MPI ranks: the whole struct until they came
-/// (14 words), hashed as the setup's fingerprint (Simulation::setup_hash).
-constexpr std::size_t kSizesBeforeMpi = offsetof(Sizes, halo_index);
-static_assert(kSizesBeforeMpi == 14 * sizeof(std::uint32_t),
-              "the setup hash covers the Sizes of single-process checkpoints");
-
-vec4 to_vec4(const Eigen::Vector3d& v, double w) {
-  return {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z()),
-          static_cast<float>(w)};
-}
-
-vec4 to_quat(const Eigen::Quaterniond& q) {
-  return {static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z()),
-          static_cast<float>(q.w())};
-}
-
-/// The constraint that holds cloth or rope particle `point` to a body whose particles are
-/// [first, first + count): from the body's particle nearest the point (the first of equals), at
-/// their distance.
-shared::Constraint attachment_constraint(const std::vector<vec4>& pos, std::uint32_t first,
-                                         std::uint32_t count, std::uint32_t point) {
-  const auto distance = [&](std::uint32_t i) {
-    const Eigen::Vector3d d(static_cast<double>(pos[i].x) - static_cast<double>(pos[point].x),
-                            static_cast<double>(pos[i].y) - static_cast<double>(pos[point].y),
-                            static_cast<double>(pos[i].z) - static_cast<double>(pos[point].z));
-    return d.norm();
-  };
-  std::uint32_t nearest = first;
-  for (std::uint32_t k = 1; k < count; ++k) {
-    if (distance(first + k) < distance(nearest)) nearest = first + k;
-  }
-  shared::Constraint c{};
-  c.a = nearest;
-  c.b = point;
-  c.rest = static_cast<float>(distance(nearest));
-  c.stiffness = 1.0f;
-  return c;
-}
+using layout::to_vec4;
 
 template <typename T>
 Status write_vector(Device& d, Buffer b, const std::vector<T>& v) {
@@ -75,6 +34,78 @@ template <typename T>
 Status read_vector(Device& d, Buffer b, std::vector<T>& v, std::size_t count) {
   v.resize(count);
   return d.read(b, v.data(), count * sizeof(T));
+}
+
+/// Writes the layout's buffers (after allocating them all), in one loop.
+Status write_layout(Device& d, const layout::HostLayout& host) {
+  struct Upload {
+    Buffer buffer;
+    const void* data;
+    std::size_t bytes;
+  };
+  const auto of = [](Buffer b, const auto& v) {
+    return Upload{b, v.data(), v.size() * sizeof(v[0])};
+  };
+  const layout::ParticleLayout& p = host.particles;
+  const layout::RigidLayout& r = host.rigid;
+  const std::uint32_t neighbour_state[4] = {1u, 0u, 0u, 0u};  // build at the first step
+  std::vector<Upload> uploads = {
+      of(Buffer::ParticlePos, p.pos),
+      of(Buffer::ParticleVel, p.vel),
+      of(Buffer::ParticleLocal, r.local),
+      of(Buffer::ParticleBody, p.body),
+      of(Buffer::ParticleMaterial, p.material),
+      of(Buffer::BodyPos, r.pos),
+      of(Buffer::BodyQuat, r.quat),
+      of(Buffer::BodyVel, r.vel),
+      of(Buffer::BodyAngMom, r.angmom),
+      of(Buffer::BodyAngVel, r.angvel),
+      of(Buffer::BodyInvInertia, r.inv_inertia),
+      of(Buffer::BodyFirst, r.first),
+      of(Buffer::NeighbourRefPos, p.pos),
+      {Buffer::NeighbourState, neighbour_state, sizeof neighbour_state},
+      of(Buffer::ContactLaws, host.tables.laws),
+      of(Buffer::Planes, host.tables.planes),
+      of(Buffer::Constraints, host.linked.colouring.constraints),
+      of(Buffer::Clusters, host.soft.clusters.clusters),
+      of(Buffer::ClusterMembers, host.soft.clusters.members),
+      of(Buffer::ClusterFrames, host.soft.frames),
+      of(Buffer::ClusterGather, host.soft.gather),
+      of(Buffer::LinkExclusions, host.linked.exclusions),
+      of(Buffer::HaloIndex, host.halo.index),
+  };
+  // A rank of a run over MPI ranks: the partition's reference positions.
+  if (host.sizes.partition != 0) uploads.push_back(of(Buffer::PartitionRefPos, p.pos));
+  Status s = d.allocate(host.sizes);
+  for (const Upload& u : uploads) {
+    if (!s) break;
+    s = d.write(u.buffer, u.data, u.bytes);
+  }
+  return s;
+}
+
+/// Host memory for `count` vec4s of the packed halo, freed through the device (none for 0).
+Status allocate_halo(Device& d, std::size_t count, HostMemory<vec4>& memory) {
+  memory = HostMemory<vec4>(
+      count == 0 ? nullptr : static_cast<vec4*>(d.allocate_host(count * sizeof(vec4))),
+      HostFree{&d});
+  if (count > 0 && !memory) {
+    return Status::error(
+        fmt::format("no host memory for a halo of {} bytes", count * sizeof(vec4)));
+  }
+  return Status::ok();
+}
+
+/// The particle lowest along gravity (the first of equals; the first without gravity).
+std::size_t lowest_particle(const Eigen::Vector3d& gravity, const std::vector<vec4>& pos) {
+  const auto g_dot = [&](const vec4& x) {
+    return gravity.dot(Eigen::Vector3f(x.x, x.y, x.z).cast<double>());
+  };
+  std::size_t lowest = 0;
+  for (std::size_t i = 1; i < pos.size(); ++i) {
+    if (g_dot(pos[i]) > g_dot(pos[lowest])) lowest = i;
+  }
+  return lowest;
 }
 
 }  // namespace
@@ -108,540 +139,62 @@ std::unique_ptr<Device> Simulation::take_device(std::unique_ptr<Simulation> sim)
 
 Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
   settings_ = scene.settings;
-  if (!(settings_.dt > 0.0) || !std::isfinite(settings_.dt) || settings_.substeps < 1) {
-    return Status::error(fmt::format("{}: dt must be > 0 and substeps >= 1 (dt {}, substeps {})",
-                                     scene.source, settings_.dt, settings_.substeps));
-  }
-  if (scene.materials.empty()) return Status::error(scene.source + ": the scene has no material");
-  if (settings_.neighbour_capacity < 1) {
-    return Status::error(fmt::format("{}: neighbour_capacity must be at least 1 (got {})",
-                                     scene.source, settings_.neighbour_capacity));
-  }
-
-  // Count first, so an impossible size is refused before anything is allocated. Free spheres
-  // (dynamic one-particle bodies without spin) go after every rigid body's particles.
-  std::uint64_t n = 0;
-  std::uint64_t rigid_particles = 0;
-  std::uint64_t rigid_bodies = 0;
-  std::uint64_t soft_particles = 0;
-  double max_diameter = 0.0;
-  // With impulse contacts every rigid body, one-particle ones too, is integrated as a body (an
-  // impulse at the contact point makes any sphere spin).
-  const bool impulses = settings_.contact_model == ContactModel::Impulses;
-  if (impulses && settings_.impulse_iterations < 1) {
-    return Status::error(fmt::format("{}: impulse_iterations must be at least 1 (got {})",
-                                     scene.source, settings_.impulse_iterations));
-  }
-  if (impulses && (settings_.impulse_substeps < 1 || settings_.impulse_substeps > 64)) {
-    return Status::error(fmt::format("{}: impulse_substeps must be 1 to 64 (got {})", scene.source,
-                                     settings_.impulse_substeps));
-  }
-  const auto is_free_sphere = [impulses](const BodySpec& b) {
-    return !impulses && b.kind == BodyKind::Dynamic && !b.soft && b.shape->points.size() == 1 &&
-           b.angular_velocity.isZero(0.0);
-  };
-  for (const BodySpec& b : scene.bodies) {
-    if (!b.shape || b.shape->points.empty()) {
-      return Status::error(fmt::format("{}: body '{}' has no particles", scene.source, b.name));
-    }
-    n += b.shape->points.size();
-    if (b.soft) {
-      if (b.kind != BodyKind::Dynamic) {
-        return Status::error(
-            fmt::format("{}: body '{}' is static and soft: a static body is "
-                        "rigid (remove \"soft\" or make it dynamic)",
-                        scene.source, b.name));
-      }
-      soft_particles += b.shape->points.size();
-    } else if (!is_free_sphere(b)) {
-      rigid_particles += b.shape->points.size();
-      ++rigid_bodies;
-    }
-    max_diameter = std::max(max_diameter, b.shape->diameter);
-  }
-  const std::uint64_t body_particles = n;
-  if (scene.linked.size() > kLinkedMaxObjects) {
-    return Status::error(fmt::format("{}: {} cloths and ropes; motes supports at most {}",
-                                     scene.source, scene.linked.size(), kLinkedMaxObjects));
-  }
-  std::uint64_t constraint_count = 0;
-  for (const LinkedSpec& l : scene.linked) {
-    const bool mesh = l.lattice.empty() && l.kind == LinkedKind::Cloth;
-    if (l.points.empty() || (!mesh && l.lattice.size() != l.points.size()) ||
-        (mesh && l.points.size() > kLinkedMaxMeshPoints)) {
-      return Status::error(fmt::format(
-          "{}: '{}' has no particles, not one lattice place each, or (a cloth from a mesh) more "
-          "than {} particles",
-          scene.source, l.name, kLinkedMaxMeshPoints));
-    }
-    n += l.points.size();
-    constraint_count += l.links.size() + l.attached.size();
-    max_diameter = std::max(max_diameter, l.diameter);
-  }
-  if (n > std::numeric_limits<std::uint32_t>::max() / 2) {
-    return Status::error(
-        fmt::format("{}: {} particles is more than motes supports (2^31)", scene.source, n));
-  }
-  // One rank of a run over MPI ranks builds the grid the whole scene would have (its largest
-  // diameter, hence cell and skin, and its table size), so that cells hash alike on every rank
-  // and a particle meets its partners in the same order at any rank count.
-  if (halo != nullptr) max_diameter = std::max(max_diameter, halo->scene_diameter);
-  const double skin = neighbour_skin(settings_, max_diameter);
-  sizes_.particles = static_cast<std::uint32_t>(n);
-  sizes_.rigid_particles = static_cast<std::uint32_t>(rigid_particles);
-  sizes_.bodies = static_cast<std::uint32_t>(rigid_bodies);
-  sizes_.table = grid_table_size(
-      halo != nullptr ? std::max<std::uint32_t>(halo->scene_particles, sizes_.particles)
-                      : sizes_.particles);
-  sizes_.materials = static_cast<std::uint32_t>(scene.materials.size());
-  sizes_.planes = static_cast<std::uint32_t>(scene.planes.size());
-  sizes_.neighbour_capacity = static_cast<std::uint32_t>(settings_.neighbour_capacity);
-  sizes_.constraints = static_cast<std::uint32_t>(
-      std::min<std::uint64_t>(constraint_count, std::numeric_limits<std::uint32_t>::max()));
-  if (constraint_count > std::numeric_limits<std::uint32_t>::max() / 2) {
-    return Status::error(fmt::format("{}: {} constraints is more than motes supports (2^31)",
-                                     scene.source, constraint_count));
-  }
-  if (settings_.constraint_iterations < 1 || !(settings_.link_damping >= 0.0)) {
-    return Status::error(fmt::format(
-        "{}: constraint_iterations must be at least 1 and link_damping >= 0 (got {} and {})",
-        scene.source, settings_.constraint_iterations, settings_.link_damping));
-  }
-
-  sizes_.soft_particles = static_cast<std::uint32_t>(soft_particles);
-  sizes_.impulse = impulses ? 1u : 0u;
+  // Count first, so an impossible size is refused before anything is allocated.
+  SceneBodies order = scene_bodies(scene);
+  Result<layout::SceneCounts> counted = layout::count_scene(scene, order, halo);
+  if (!counted) return counted.status();
+  const layout::SceneCounts& counts = counted.value();
+  layout::HostLayout host;
+  host.sizes = layout::count_sizes(scene, counts, halo);
   Device& d = *device_;
   // Device memory and buffer limits: refuse before allocating anything, with both numbers and the
   // largest particle count that fits (again once the clusters are known, before the device
   // allocates).
   const auto check_memory = [&]() -> Status {
-    if (Status st = check_device_fits(d, sizes_); !st) {
+    if (Status st = check_device_fits(d, host.sizes); !st) {
       return Status::error(fmt::format("{}: {}", scene.source, st.message()));
     }
     return Status::ok();
   };
   if (Status st = check_memory(); !st) return st;
 
-  std::vector<vec4> ppos, pvel, plocal, bpos, bquat, bvel, bangmom, bangvel, binertia;
-  std::vector<std::uint32_t> pbody, pmat;
-  try {
-    ppos.resize(n);
-    pvel.resize(n);
-    plocal.reserve(rigid_particles);
-    pbody.resize(n);
-    pmat.resize(n);
-    device_index_.assign(scene.bodies.size(), 0);
-  } catch (const std::bad_alloc&) {
-    return Status::error(fmt::format("{}: out of host memory for {} particles", scene.source, n));
-  }
-  rigid_first_.clear();
-  sphere_turns_.clear();
-
-  bodies_.clear();
-  bodies_.reserve(scene.bodies.size());
-  const ParticleSet* last_shape = nullptr;
-  int last_material = -1;
-  MassProperties mp;
-  std::uint32_t scene_particle = 0;
-  // Device particles: rigid [0, Nr), free spheres [Nr, Ns), soft [Ns, Nl), linked [Nl, N).
-  std::uint32_t next_rigid = 0;
-  auto next_free = static_cast<std::uint32_t>(rigid_particles);
-  const auto soft_first = static_cast<std::uint32_t>(body_particles - soft_particles);
-  std::uint32_t next_soft = soft_first;
-  std::uint32_t soft_bodies = 0;
-  SoftClusters soft;
-  for (std::size_t bi = 0; bi < scene.bodies.size(); ++bi) {
-    const BodySpec& spec = scene.bodies[bi];
-    if (spec.material < 0 || static_cast<std::size_t>(spec.material) >= scene.materials.size()) {
-      return Status::error(
-          fmt::format("{}: body '{}' has no valid material", scene.source, spec.name));
-    }
-    const Material& mat = scene.materials[static_cast<std::size_t>(spec.material)];
-    // Repeated bodies share a shape: compute its mass properties once.
-    if (spec.shape.get() != last_shape || spec.material != last_material) {
-      mp = mass_properties(*spec.shape, mat.density);
-      last_shape = spec.shape.get();
-      last_material = spec.material;
-    }
-    if (!(mp.mass > 0.0) || !std::isfinite(mp.mass)) {
-      return Status::error(fmt::format("{}: body '{}' has no mass (density {})", scene.source,
-                                       spec.name, mat.density));
-    }
-    const bool dynamic = spec.kind == BodyKind::Dynamic;
-    const bool free = is_free_sphere(spec);
-    // Body frame = principal axes: orientation = rotation * (principal -> shape frame).
-    const Eigen::Quaterniond orient =
-        (spec.rotation.normalized() * mp.principal_frame).normalized();
-    const Eigen::Matrix3d to_body = mp.principal_frame.toRotationMatrix().transpose();
-    const Eigen::Matrix3d rot = orient.toRotationMatrix();
-    const Eigen::Vector3d vel = dynamic ? spec.velocity : Eigen::Vector3d::Zero();
-
-    BodyInfo info;
-    info.name = spec.name;
-    info.kind = spec.kind;
-    info.mass = mp.mass;
-    info.first_particle = scene_particle;
-    info.particle_count = static_cast<std::uint32_t>(spec.shape->points.size());
-    info.free_sphere = free;
-    info.soft = spec.soft.has_value();
-    bodies_.push_back(info);
-    scene_particle += info.particle_count;
-
-    const double radius = 0.5 * spec.shape->diameter;
-    const double inv_pm = dynamic ? 1.0 / mp.particle_mass : 0.0;
-    if (spec.soft) {
-      // Free particles of one body (no contact among themselves), pulled to their clusters' goals.
-      device_index_[bi] = next_soft;
-      std::vector<Eigen::Vector3d> world;
-      world.reserve(spec.shape->points.size());
-      const std::uint32_t body_word =
-          sizes_.bodies + (soft_first - sizes_.rigid_particles) + soft_bodies++;
-      for (const Eigen::Vector3f& pt : spec.shape->points) {
-        const Eigen::Vector3d offset = rot * (to_body * (pt.cast<double>() - mp.center));
-        const std::uint32_t i = next_soft++;
-        world.push_back(spec.position + offset);
-        ppos[i] = to_vec4(world.back(), radius);
-        pvel[i] = to_vec4(vel + spec.angular_velocity.cross(offset), inv_pm);
-        pbody[i] = body_word;
-        pmat[i] = static_cast<std::uint32_t>(spec.material);
-      }
-      SoftSpec soft_spec = *spec.soft;
-      if (soft_spec.frequency > 0.0) {
-        const double turn = 2.0 * std::numbers::pi * soft_spec.frequency * settings_.dt /
-                            static_cast<double>(settings_.substeps);
-        soft_spec.stiffness = std::min(1.0, turn * turn);
-      }
-      bodies_.back().first_cluster = static_cast<std::uint32_t>(soft.clusters.size());
-      if (Status st = add_soft_body(soft_spec, world, mp.particle_mass,
-                                    settings_.dt / static_cast<double>(settings_.substeps),
-                                    device_index_[bi], soft);
-          !st) {
-        return Status::error(
-            fmt::format("{}: body '{}': {}", scene.source, spec.name, st.message()));
-      }
-      bodies_.back().cluster_count =
-          static_cast<std::uint32_t>(soft.clusters.size()) - bodies_.back().first_cluster;
-      continue;
-    }
-    if (free) {
-      // The particle is the body: its state is the body's; it never turns.
-      const std::uint32_t i = next_free++;
-      device_index_[bi] = i;
-      const vec4 q = to_quat(orient);
-      if (q.x != 0.0f || q.y != 0.0f || q.z != 0.0f || q.w != 1.0f) {
-        sphere_turns_.emplace_back(static_cast<std::uint32_t>(bi), q);
-      }
-      const Eigen::Vector3d local = to_body * (spec.shape->points[0].cast<double>() - mp.center);
-      ppos[i] = to_vec4(spec.position + rot * local, radius);
-      pvel[i] = to_vec4(vel, inv_pm);
-      pbody[i] = sizes_.bodies + (i - sizes_.rigid_particles);
-      pmat[i] = static_cast<std::uint32_t>(spec.material);
-      continue;
-    }
-    const auto b = static_cast<std::uint32_t>(rigid_first_.size());
-    device_index_[bi] = b;
-    rigid_first_.push_back(next_rigid);
-    const Eigen::Vector3d inv_moments = mp.principal_moments.cwiseInverse();
-    const Eigen::Vector3d omega = dynamic ? spec.angular_velocity : Eigen::Vector3d::Zero();
-    const Eigen::Vector3d angmom =
-        rot * mp.principal_moments.asDiagonal() * rot.transpose() * omega;
-    bpos.push_back(to_vec4(spec.position, dynamic ? 1.0 / mp.mass : 0.0));
-    bquat.push_back(to_quat(orient));
-    bvel.push_back(to_vec4(vel, 0.0));
-    bangmom.push_back(to_vec4(angmom, 0.0));
-    bangvel.push_back(to_vec4(omega, 0.0));
-    binertia.push_back(dynamic ? to_vec4(inv_moments, 0.0) : vec4(0.0f));
-    for (const Eigen::Vector3f& pt : spec.shape->points) {
-      const Eigen::Vector3d local = to_body * (pt.cast<double>() - mp.center);
-      const std::uint32_t i = next_rigid++;
-      plocal.push_back(to_vec4(local, 0.0));
-      // Positions and velocities are recomputed on the device by particles_update below.
-      ppos[i] = to_vec4(spec.position + rot * local, radius);
-      pvel[i] = to_vec4(Eigen::Vector3d::Zero(), inv_pm);
-      pbody[i] = b;
-      pmat[i] = static_cast<std::uint32_t>(spec.material);
-    }
-  }
-  rigid_first_.push_back(next_rigid);
-
-  // Cloth and ropes after the free spheres: particles [Nl, N), each object's in its own order.
-  const auto linked_first = static_cast<std::uint32_t>(body_particles);
-  std::vector<shared::Constraint> constraints;
-  constraints.reserve(sizes_.constraints);
-  std::uint32_t next_linked = linked_first;
-  // LinkExclusions (shared/links.h), when a cloth is made from a mesh: a start for every linked
-  // particle, then the lists.
-  const bool any_mesh = std::any_of(scene.linked.begin(), scene.linked.end(),
-                                    [](const LinkedSpec& l) { return l.lattice.empty(); });
-  std::vector<std::uint32_t> exclusion_start, exclusion_list;
-  if (any_mesh) exclusion_start.push_back(0);
-  for (std::size_t li = 0; li < scene.linked.size(); ++li) {
-    const LinkedSpec& spec = scene.linked[li];
-    if (spec.material < 0 || static_cast<std::size_t>(spec.material) >= scene.materials.size()) {
-      return Status::error(fmt::format("{}: '{}' has no valid material", scene.source, spec.name));
-    }
-    const Material& mat = scene.materials[static_cast<std::size_t>(spec.material)];
-    const double particle_mass = linked_particle_mass(mat.density, spec.diameter);
-    if (!(particle_mass > 0.0) || !std::isfinite(particle_mass)) {
-      return Status::error(fmt::format("{}: '{}' has no mass (density {}, diameter {})",
-                                       scene.source, spec.name, mat.density, spec.diameter));
-    }
-    const auto count = static_cast<std::uint32_t>(spec.points.size());
-    std::vector<bool> pinned(count, false);
-    for (const std::uint32_t k : spec.pinned) {
-      if (k >= count) {
-        return Status::error(
-            fmt::format("{}: '{}' pins particle {} of {}", scene.source, spec.name, k, count));
-      }
-      pinned[k] = true;
-    }
-    BodyInfo info;
-    info.name = spec.name;
-    info.kind = BodyKind::Dynamic;
-    info.mass = particle_mass * static_cast<double>(count);
-    info.first_particle = scene_particle;
-    info.particle_count = count;
-    info.linked = true;
-    bodies_.push_back(info);
-    device_index_.push_back(next_linked);
-    scene_particle += count;
-    const bool mesh = spec.lattice.empty();
-    for (std::uint32_t k = 0; k < count; ++k) {
-      const std::uint32_t i = next_linked + k;
-      ppos[i] = to_vec4(spec.points[k], 0.5 * spec.diameter);
-      pvel[i] = pinned[k] ? vec4(0.0f) : to_vec4(spec.velocity, 1.0 / particle_mass);
-      pmat[i] = static_cast<std::uint32_t>(spec.material);
-      if (mesh) {
-        pbody[i] = shared::linked_mesh_body(static_cast<std::uint32_t>(li), k);
-        continue;
-      }
-      const std::array<std::uint32_t, 2> uv = spec.lattice[k];
-      if (uv[0] >= kLinkedMaxSide || uv[1] >= kLinkedMaxSide) {
-        return Status::error(fmt::format("{}: '{}': lattice place ({}, {}) beyond {}", scene.source,
-                                         spec.name, uv[0], uv[1], kLinkedMaxSide));
-      }
-      pbody[i] = shared::linked_body(static_cast<std::uint32_t>(li), uv[0], uv[1]);
-    }
-    if (any_mesh) {
-      const LinkNeighbourhoods near =
-          mesh ? link_neighbourhoods(spec.links, count) : LinkNeighbourhoods{};
-      for (std::uint32_t k = 0; k < count; ++k) {
-        if (mesh) {
-          for (std::uint32_t e = near.start[k]; e < near.start[k + 1]; ++e) {
-            exclusion_list.push_back(next_linked + near.list[e]);
-          }
-        }
-        if (exclusion_list.size() > std::numeric_limits<std::uint32_t>::max() / 2) {
-          return Status::error(fmt::format(
-              "{}: the cloths made from meshes have more than 2^31 pairs within two links",
-              scene.source));
-        }
-        exclusion_start.push_back(static_cast<std::uint32_t>(exclusion_list.size()));
-      }
-    }
-    for (const LinkSpec& link : spec.links) {
-      if (link.a >= count || link.b >= count || link.a == link.b) {
-        return Status::error(fmt::format("{}: '{}': a link joins particles {} and {} of {}",
-                                         scene.source, spec.name, link.a, link.b, count));
-      }
-      shared::Constraint c{};
-      c.a = next_linked + link.a;
-      c.b = next_linked + link.b;
-      c.rest = static_cast<float>((spec.points[link.a] - spec.points[link.b]).norm());
-      c.stiffness = static_cast<float>(link.stiffness);
-      constraints.push_back(c);
-    }
-    for (const LinkAttachment& a : spec.attached) {
-      const auto it = std::find_if(scene.bodies.begin(), scene.bodies.end(),
-                                   [&](const BodySpec& b) { return b.name == a.body; });
-      if (it == scene.bodies.end() || it->soft || a.point >= count) {
-        return Status::error(
-            fmt::format("{}: '{}' attaches point {} to '{}': no such point, or "
-                        "not a rigid or static body",
-                        scene.source, spec.name, a.point, a.body));
-      }
-      const auto b = static_cast<std::size_t>(it - scene.bodies.begin());
-      const BodyInfo& held = bodies_[b];
-      const std::uint32_t first =
-          held.free_sphere ? device_index_[b] : rigid_first_[device_index_[b]];
-      const shared::Constraint c =
-          attachment_constraint(ppos, first, held.particle_count, next_linked + a.point);
-      // A dynamic rigid body (not a lean free sphere) takes the constraints' pull as impulses.
-      if (!held.free_sphere && pvel[c.a].w != 0.0f) sizes_.absorb = 1;
-      constraints.push_back(c);
-    }
-    next_linked += count;
-  }
-  ConstraintColouring colouring = colour_constraints(constraints, sizes_.particles);
-  colour_first_ = colouring.first;
-  const std::vector<std::uint32_t> gather =
-      soft.clusters.empty() ? std::vector<std::uint32_t>{} : cluster_gather(soft);
-  std::vector<shared::ClusterFrame> frames(soft.clusters.size());
-  for (shared::ClusterFrame& f : frames) f.rotation = vec4(0.0f, 0.0f, 0.0f, 1.0f);
-
-  std::vector<shared::PlaneData> planes;
-  for (const PlaneSpec& pl : scene.planes) {
-    const Eigen::Vector3d nrm = pl.normal.normalized();
-    shared::PlaneData pd{};
-    pd.normal_offset = to_vec4(nrm, nrm.dot(pl.point));
-    pd.material = static_cast<std::uint32_t>(pl.material);
-    planes.push_back(pd);
-  }
-  const std::vector<shared::ContactLaw> laws = contact_law_table(scene.materials);
-
-  params_ = shared::StepParams{};
-  params_.gravity_dt = to_vec4(settings_.gravity, settings_.dt / settings_.substeps);
-  params_.particle_count = sizes_.particles;
-  params_.body_count = sizes_.bodies;
-  params_.table_mask = sizes_.table - 1;
-  params_.plane_count = sizes_.planes;
-  // Cells hold every pair a list can hold: cell edge = largest diameter + skin.
-  params_.cell_size = static_cast<float>(max_diameter + skin);
-  params_.inv_cell_size = static_cast<float>(1.0 / (max_diameter + skin));
-  params_.material_count = sizes_.materials;
-  params_.flags = (settings_.clamp_attraction ? MOTES_FLAG_CLAMP_ATTRACTION : 0u) |
-                  (impulses ? MOTES_FLAG_IMPULSE : 0u);
-  params_.rigid_particle_count = sizes_.rigid_particles;
-  params_.neighbour_capacity = sizes_.neighbour_capacity;
-  params_.neighbour_skin = static_cast<float>(skin);
-  params_.linked_first = linked_first;
-  params_.soft_first = soft_first;
-  params_.cluster_count = static_cast<std::uint32_t>(soft.clusters.size());
-  params_.linked_damping =
-      static_cast<float>(-std::expm1(-settings_.link_damping * settings_.dt / settings_.substeps));
-
-  sizes_.clusters = static_cast<std::uint32_t>(soft.clusters.size());
-  sizes_.cluster_members = static_cast<std::uint32_t>(soft.members.size());
-  std::vector<std::uint32_t> exclusions = std::move(exclusion_start);
-  exclusions.insert(exclusions.end(), exclusion_list.begin(), exclusion_list.end());
-  if (exclusions.size() > std::numeric_limits<std::uint32_t>::max()) {
-    return Status::error(fmt::format("{}: the cloths made from meshes need {} words of lists",
-                                     scene.source, exclusions.size()));
-  }
-  sizes_.link_exclusions = static_cast<std::uint32_t>(exclusions.size());
-  // A rank of a run over MPI ranks: the halo lists as device indices (shared/halo.h).
-  std::vector<std::uint32_t> halo_index;
+  // The host's layout, kind by kind (scene_layout.h).
+  host.bodies = std::move(order.bodies);
+  if (Status st = layout::build_bodies(scene, counts, host); !st) return st;
+  if (Status st = layout::build_linked(scene, counts, host); !st) return st;
+  host.tables = layout::build_tables(scene);
+  host.params = layout::build_params(settings_, counts, host);
   if (halo != nullptr) {
-    std::array<std::vector<std::uint32_t>, 4> parts;
-    const auto add_entries = [&](const std::vector<std::uint32_t>& list,
-                                 std::vector<std::uint32_t>& particles,
-                                 std::vector<std::uint32_t>& rigid) -> Status {
-      for (const std::uint32_t b : list) {
-        if (b >= bodies_.size()) {
-          return Status::error(
-              fmt::format("{}: halo list names body {} of {}", scene.source, b, bodies_.size()));
-        }
-        const BodyInfo& info = bodies_[b];
-        const bool body_state = !info.free_sphere && !info.linked && !info.soft;
-        const std::uint32_t first = body_state ? rigid_first_[device_index_[b]] : device_index_[b];
-        for (std::uint32_t k = 0; k < info.particle_count; ++k) particles.push_back(first + k);
-        if (body_state) rigid.push_back(device_index_[b]);
-      }
-      return Status::ok();
-    };
-    if (Status st = add_entries(halo->send, parts[0], parts[1]); !st) return st;
-    if (Status st = add_entries(halo->receive, parts[2], parts[3]); !st) return st;
-    std::uint64_t data = 0;
-    for (std::size_t k = 0; k < 4; ++k) {
-      halo_entries_[k] = static_cast<std::uint32_t>(parts[k].size());
-      halo_index.insert(halo_index.end(), parts[k].begin(), parts[k].end());
-      if (k % 2 == 1) {
-        data = std::max<std::uint64_t>(
-            data, std::uint64_t{MOTES_HALO_PARTICLE_VEC4S} * parts[k - 1].size() +
-                      std::uint64_t{MOTES_HALO_BODY_VEC4S} * parts[k].size());
-      }
-    }
-    if (data > std::numeric_limits<std::uint32_t>::max() / 2) {
-      return Status::error(fmt::format("{}: a halo of {} vec4s", scene.source, data));
-    }
-    sizes_.halo_index = static_cast<std::uint32_t>(halo_index.size());
-    sizes_.halo_data = static_cast<std::uint32_t>(data);
-    sizes_.partition = 1;
+    if (Status st = layout::build_halo(scene.source, *halo, host); !st) return st;
     // The packed halo's host memory, sent and received.
+    halo_entries_ = host.halo.entries;
     halo_out_count_ = std::size_t{MOTES_HALO_PARTICLE_VEC4S} * halo_entries_[0] +
                       std::size_t{MOTES_HALO_BODY_VEC4S} * halo_entries_[1];
     halo_in_count_ = std::size_t{MOTES_HALO_PARTICLE_VEC4S} * halo_entries_[2] +
                      std::size_t{MOTES_HALO_BODY_VEC4S} * halo_entries_[3];
     for (auto [memory, count] :
          {std::pair{&halo_out_, halo_out_count_}, std::pair{&halo_in_, halo_in_count_}}) {
-      *memory = HostMemory<vec4>(
-          count == 0 ? nullptr : static_cast<vec4*>(d.allocate_host(count * sizeof(vec4))),
-          HostFree{&d});
-      if (count > 0 && !*memory) {
-        return Status::error(fmt::format("{}: no host memory for a halo of {} bytes", scene.source,
-                                         count * sizeof(vec4)));
+      if (Status st = allocate_halo(d, count, *memory); !st) {
+        return Status::error(fmt::format("{}: {}", scene.source, st.message()));
       }
     }
   }
   if (Status st = check_memory(); !st) return st;
 
-  // The setup's fingerprint: every fixed input of a step (checkpoints load only where it is
-  // equal). Computed from the host's copies, so it is the same on every backend.
-  // Sizes before the fields of runs over MPI ranks: a single process's hash (and so a
-  // checkpoint's) is what it was before they existed, and the halo's sizes, which change with
-  // every partition of a run over MPI ranks, say nothing about the physics.
-  std::uint64_t h = fnv1a64(&sizes_, kSizesBeforeMpi);
-  h = fnv1a64(&params_, sizeof params_, h);
-  const std::int64_t counts[2] = {settings_.substeps, settings_.constraint_iterations};
-  h = fnv1a64(counts, sizeof counts, h);
-  h = fnv1a64(&settings_.dt, sizeof settings_.dt, h);
-  if (impulses) {  // the impulse stage's sweeps and substeps (not hashed before they existed)
-    const std::int64_t stage[2] = {settings_.impulse_iterations, settings_.impulse_substeps};
-    h = fnv1a64(stage, sizeof stage, h);
-  }
-  const auto add = [&h](const auto& v) { h = fnv1a64(v.data(), v.size() * sizeof(v[0]), h); };
-  add(plocal);
-  add(pbody);
-  add(pmat);
-  add(binertia);
-  add(rigid_first_);
-  add(laws);
-  add(planes);
-  add(colouring.constraints);
-  add(colour_first_);
-  add(soft.clusters);
-  add(soft.members);
-  add(gather);
-  add(exclusions);
-  for (const auto& [body, q] : sphere_turns_) {
-    h = fnv1a64(&body, sizeof body, h);
-    h = fnv1a64(&q, sizeof q, h);
-  }
-  std::uint64_t w = fnv1a64(nullptr, 0);
-  for (std::size_t i = 0; i < ppos.size(); ++i) {
-    const float pair[2] = {ppos[i].w, pvel[i].w};
-    w = fnv1a64(pair, sizeof pair, w);
-  }
-  particle_w_hash_ = w;
-  setup_hash_ = fnv1a64(&w, sizeof w, h);
+  // What the host keeps of the layout, and the setup's fingerprint (scene_layout.h).
+  const layout::Fingerprint fingerprint = layout::fingerprint(settings_, host);
+  setup_hash_ = fingerprint.setup;
+  particle_w_hash_ = fingerprint.particle_w;
+  sizes_ = host.sizes;
+  params_ = host.params;
+  bodies_ = std::move(host.bodies);
+  device_index_ = std::move(host.device_index);
+  rigid_first_ = host.rigid.first;
+  rigid_inv_inertia_ = host.rigid.inv_inertia;
+  colour_first_ = host.linked.colouring.first;
+  sphere_turns_ = std::move(host.sphere_turns);
 
-  const std::uint32_t neighbour_state[4] = {1u, 0u, 0u, 0u};  // build at the first step
-  Status s = d.allocate(sizes_);
-  if (s) s = write_vector(d, Buffer::ParticlePos, ppos);
-  if (s) s = write_vector(d, Buffer::ParticleVel, pvel);
-  if (s) s = write_vector(d, Buffer::ParticleLocal, plocal);
-  if (s) s = write_vector(d, Buffer::ParticleBody, pbody);
-  if (s) s = write_vector(d, Buffer::ParticleMaterial, pmat);
-  if (s) s = write_vector(d, Buffer::BodyPos, bpos);
-  if (s) s = write_vector(d, Buffer::BodyQuat, bquat);
-  if (s) s = write_vector(d, Buffer::BodyVel, bvel);
-  if (s) s = write_vector(d, Buffer::BodyAngMom, bangmom);
-  if (s) s = write_vector(d, Buffer::BodyAngVel, bangvel);
-  if (s) s = write_vector(d, Buffer::BodyInvInertia, binertia);
-  rigid_inv_inertia_ = binertia;
-  if (s) s = write_vector(d, Buffer::BodyFirst, rigid_first_);
-  if (s) s = write_vector(d, Buffer::NeighbourRefPos, ppos);
-  if (s) s = d.write(Buffer::NeighbourState, neighbour_state, sizeof neighbour_state);
-  if (s) s = write_vector(d, Buffer::ContactLaws, laws);
-  if (s) s = write_vector(d, Buffer::Planes, planes);
-  if (s) s = write_vector(d, Buffer::Constraints, colouring.constraints);
-  if (s) s = write_vector(d, Buffer::Clusters, soft.clusters);
-  if (s) s = write_vector(d, Buffer::ClusterMembers, soft.members);
-  if (s) s = write_vector(d, Buffer::ClusterFrames, frames);
-  if (s) s = write_vector(d, Buffer::ClusterGather, gather);
-  if (s) s = write_vector(d, Buffer::LinkExclusions, exclusions);
-  if (s) s = write_vector(d, Buffer::HaloIndex, halo_index);
-  if (s && sizes_.partition != 0) s = write_vector(d, Buffer::PartitionRefPos, ppos);
+  Status s = write_layout(d, host);
   if (s) s = clear_contact_history();
   if (!s) return s;
   // The energy guard: the scene's model, and the reference point potential energy is measured
@@ -650,19 +203,11 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
   energy_model_ = motes::energy_model(scene);
   rigid_scene_body_.assign(sizes_.bodies, 0u);
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
-    const BodyInfo& info = bodies_[b];
-    if (!info.free_sphere && !info.linked && !info.soft) {
+    if (bodies_[b].has_body_state())
       rigid_scene_body_[device_index_[b]] = static_cast<std::uint32_t>(b);
-    }
   }
-  std::size_t lowest = 0;
-  for (std::size_t i = 1; i < ppos.size(); ++i) {
-    const auto g_dot = [&](const vec4& x) {
-      return settings_.gravity.dot(Eigen::Vector3f(x.x, x.y, x.z).cast<double>());
-    };
-    if (g_dot(ppos[i]) > g_dot(ppos[lowest])) lowest = i;
-  }
-  const vec4 origin = ppos.empty() ? vec4(0.0f) : ppos[lowest];
+  const std::vector<vec4>& ppos = host.particles.pos;
+  const vec4 origin = ppos.empty() ? vec4(0.0f) : ppos[lowest_particle(settings_.gravity, ppos)];
   energy_origin_ = Eigen::Vector3f(origin.x, origin.y, origin.z).cast<double>();
   const std::uint32_t header[MOTES_ENERGY_HEADER] = {
       shared::float_bits(origin.x), shared::float_bits(origin.y), shared::float_bits(origin.z), 0u};

@@ -152,8 +152,9 @@ std::string describe_edges(const winding::EdgeCounts& edges) {
   return open + " and " + non_manifold;
 }
 
-Result<PreparedMesh> prepare(const TriangleMesh& mesh, winding::InsideTest test) {
-  PreparedMesh out;
+/// The mesh's name and the bounding box of the vertices its triangles use; every index in range,
+/// every coordinate finite and within the range of particle positions.
+Status measure(const TriangleMesh& mesh, PreparedMesh& out) {
   out.name = mesh.source.empty() ? std::string("<mesh>") : mesh.source;
   const auto& name = out.name;
   if (mesh.triangles.empty()) {
@@ -184,6 +185,13 @@ Result<PreparedMesh> prepare(const TriangleMesh& mesh, winding::InsideTest test)
       out.hi = out.hi.cwiseMax(p);
     }
   }
+  return Status::ok();
+}
+
+/// Refuses a mesh too small for float particles, or flat (along an axis, or tilted: every vertex
+/// in the plane of the largest triangle), which encloses no volume.
+Status check_extent(const TriangleMesh& mesh, const PreparedMesh& out) {
+  const auto& name = out.name;
   const Eigen::Vector3d extent = out.hi - out.lo;
   if (extent.maxCoeff() < kMinExtent) {
     return Status::error(fmt::format(
@@ -199,34 +207,57 @@ Result<PreparedMesh> prepare(const TriangleMesh& mesh, winding::InsideTest test)
                       name, axis_names[a], extent[a]));
     }
   }
-  // Flat but tilted (a single square sheet at an angle): every vertex in the plane of the largest
-  // triangle.
-  {
-    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-    Eigen::Vector3d point = Eigen::Vector3d::Zero();
-    for (const auto& t : mesh.triangles) {
-      const Eigen::Vector3d n = (mesh.vertices[t[1]] - mesh.vertices[t[0]])
-                                    .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
-      if (n.squaredNorm() > normal.squaredNorm()) {
-        normal = n;
-        point = mesh.vertices[t[0]];
-      }
-    }
-    double thickness = 0.0;
-    if (normal.squaredNorm() > 0.0) {
-      normal.normalize();
-      for (const auto& t : mesh.triangles) {
-        for (int c = 0; c < 3; ++c) {
-          thickness = std::max(thickness, std::abs(normal.dot(mesh.vertices[t[c]] - point)));
-        }
-      }
-    }
-    if (!(thickness > 1e-10 * extent.maxCoeff())) {
-      return Status::error(fmt::format(
-          "{}: the mesh is flat (all its vertices lie in one plane): it encloses no volume", name));
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d n = (mesh.vertices[t[1]] - mesh.vertices[t[0]])
+                                  .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+    if (n.squaredNorm() > normal.squaredNorm()) {
+      normal = n;
+      point = mesh.vertices[t[0]];
     }
   }
+  double thickness = 0.0;
+  if (normal.squaredNorm() > 0.0) {
+    normal.normalize();
+    for (const auto& t : mesh.triangles) {
+      for (int c = 0; c < 3; ++c) {
+        thickness = std::max(thickness, std::abs(normal.dot(mesh.vertices[t[c]] - point)));
+      }
+    }
+  }
+  if (!(thickness > 1e-10 * extent.maxCoeff())) {
+    return Status::error(fmt::format(
+        "{}: the mesh is flat (all its vertices lie in one plane): it encloses no volume", name));
+  }
+  return Status::ok();
+}
 
+/// The automatic test's warning for a mesh that is not closed or not manifold.
+std::string winding_warning(const PreparedMesh& out, const winding::Orientation& orientation) {
+  std::string repaired;
+  if (orientation.reversed > 0) {
+    repaired = fmt::format("; {} triangle{} facing against {} neighbours {} turned first",
+                           orientation.reversed, orientation.reversed == 1 ? "" : "s",
+                           orientation.reversed == 1 ? "its" : "their",
+                           orientation.reversed == 1 ? "was" : "were");
+  }
+  if (!orientation.orientable) {
+    repaired +=
+        "; some triangles cannot face the same way as all their neighbours (a "
+        "non-orientable surface), so parts of the fill may be missing";
+  }
+  return fmt::format(
+      "{}: the mesh is {}: it was filled where its generalized winding number is above 0.5, "
+      "which bridges holes and tolerates overlaps{}; check the particles, or repair the mesh "
+      "(e.g. in MeshLab or Blender) for an exact fill",
+      out.name, out.condition, repaired);
+}
+
+/// The rule that finds the cells inside (out.rule, out.condition, out.warning) and the triangles
+/// it uses: the mesh's, turned to face like their neighbours for the signed and winding rules.
+Result<std::vector<Eigen::Vector3i>> choose_rule(const TriangleMesh& mesh, winding::InsideTest test,
+                                                 PreparedMesh& out) {
   const winding::EdgeCounts edges = winding::count_edges(mesh.triangles);
   const bool closed_manifold = edges.open == 0 && edges.non_manifold == 0;
   out.condition = describe_edges(edges);
@@ -239,7 +270,7 @@ Result<PreparedMesh> prepare(const TriangleMesh& mesh, winding::InsideTest test)
         return Status::error(fmt::format(
             "{}: the mesh is not closed: {} open edge{} (edges not shared by exactly two "
             "triangles), so its inside is undefined for ray parity",
-            name, open, open == 1 ? "" : "s"));
+            out.name, open, open == 1 ? "" : "s"));
       }
       out.rule = Rule::parity;
       break;
@@ -261,27 +292,17 @@ Result<PreparedMesh> prepare(const TriangleMesh& mesh, winding::InsideTest test)
         out.rule = winding::oriented_boundary(oriented).size() <= kMaxCurtains
                        ? Rule::winding_boundary
                        : Rule::winding;
-        std::string repaired;
-        if (orientation.reversed > 0) {
-          repaired = fmt::format("; {} triangle{} facing against {} neighbours {} turned first",
-                                 orientation.reversed, orientation.reversed == 1 ? "" : "s",
-                                 orientation.reversed == 1 ? "its" : "their",
-                                 orientation.reversed == 1 ? "was" : "were");
-        }
-        if (!orientation.orientable) {
-          repaired +=
-              "; some triangles cannot face the same way as all their neighbours (a "
-              "non-orientable surface), so parts of the fill may be missing";
-        }
-        out.warning = fmt::format(
-            "{}: the mesh is {}: it was filled where its generalized winding number is above 0.5, "
-            "which bridges holes and tolerates overlaps{}; check the particles, or repair the mesh "
-            "(e.g. in MeshLab or Blender) for an exact fill",
-            name, out.condition, repaired);
+        out.warning = winding_warning(out, orientation);
       }
       break;
   }
+  return oriented;
+}
 
+/// The enclosed volume, the xy coordinates on the fixed-point grid, the triangles a ray along z
+/// can cross and, for the winding rules, the winding-number hierarchy.
+void project(const TriangleMesh& mesh, std::vector<Eigen::Vector3i> oriented, PreparedMesh& out) {
+  const Eigen::Vector3d extent = out.hi - out.lo;
   const Eigen::Vector3d centre = 0.5 * (out.lo + out.hi);
   double signed_volume = 0.0;
   for (const auto& t : oriented) {
@@ -318,6 +339,15 @@ Result<PreparedMesh> prepare(const TriangleMesh& mesh, winding::InsideTest test)
     }
     out.winding = std::make_unique<winding::WindingNumber>(mesh.vertices, std::move(oriented));
   }
+}
+
+Result<PreparedMesh> prepare(const TriangleMesh& mesh, winding::InsideTest test) {
+  PreparedMesh out;
+  if (Status s = measure(mesh, out); !s) return s;
+  if (Status s = check_extent(mesh, out); !s) return s;
+  Result<std::vector<Eigen::Vector3i>> oriented = choose_rule(mesh, test, out);
+  if (!oriented) return oriented.status();
+  project(mesh, std::move(oriented).value(), out);
   return out;
 }
 

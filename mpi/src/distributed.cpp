@@ -250,32 +250,13 @@ Result<std::unique_ptr<DistributedSimulation>> DistributedSimulation::create(
   if (Status s = agree(comm, status_of(decomposition)); !s) return s;
   d->decomposition_ = decomposition.value();
 
-  // The scene's bodies as a gathered Snapshot lays them out.
-  double diameter = 0.0;
-  std::uint32_t first = 0;
-  for (const BodySpec& b : scene.bodies) {
-    BodyInfo info;
-    info.name = b.name;
-    info.kind = b.kind;
-    info.first_particle = first;
-    info.particle_count = static_cast<std::uint32_t>(b.shape ? b.shape->points.size() : 0);
-    info.soft = b.soft.has_value();  // its energy is its particles' (motes/energy.h)
-    first += info.particle_count;
-    if (b.shape) diameter = std::max(diameter, b.shape->diameter);
-    d->bodies_.push_back(info);
-  }
-  for (const LinkedSpec& l : scene.linked) {
-    BodyInfo info;
-    info.name = l.name;
-    info.linked = true;
-    info.first_particle = first;
-    info.particle_count = static_cast<std::uint32_t>(l.points.size());
-    first += info.particle_count;
-    diameter = std::max(diameter, l.diameter);
-    d->bodies_.push_back(info);
-  }
-  d->particles_ = first;
-  d->scene_diameter_ = diameter;
+  // The scene's bodies as a gathered Snapshot lays them out, as Simulation::create starts its
+  // layout (a soft body's energy is its particles', motes/energy.h).
+  SceneBodies all = scene_bodies(scene);
+  d->bodies_ = std::move(all.bodies);
+  d->particles_ = all.particles;
+  d->scene_diameter_ = all.largest_diameter;
+  const double diameter = d->scene_diameter_;
   // Every rank's lists have the skin of one process's (Simulation: the scene's largest diameter).
   d->skin_ = Simulation::neighbour_skin(scene.settings, diameter);
   // Between two list builds a particle moves up to 0.45 skin (a rebuild is due then), also right
@@ -601,25 +582,13 @@ Status DistributedSimulation::build_local(
   stats_.halo_bodies = entries.size() - owned_bodies;
   stats_.owned_particles = 0;
   stats_.halo_particles = 0;
-  HaloLists lists;
-  lists.scene_particles = static_cast<std::uint32_t>(particles_);
-  lists.scene_diameter = scene_diameter_;
-  for (std::size_t r = 0; r < ranks; ++r) {
-    lists.send.insert(lists.send.end(), send_[r].begin(), send_[r].end());
-    lists.receive.insert(lists.receive.end(), receive_[r].begin(), receive_[r].end());
-  }
   for (auto* halves : {&send_counts_, &receive_counts_}) {
     for (std::vector<int>& c : *halves) c.assign(ranks, 0);
   }
   if (!entries.empty()) {
-    Result<std::unique_ptr<Device>> device =
-        spare_ ? Result<std::unique_ptr<Device>>(std::move(spare_)) : open_device_();
-    // One rank holds the whole scene: no copy of it is needed.
-    Result<std::unique_ptr<Simulation>> sim =
-        !device ? Result<std::unique_ptr<Simulation>>(status_of(device))
-        : size_ > 1
-            ? Simulation::create(sub_scene(scene_, local_bodies_), std::move(device).value(), lists)
-            : Simulation::create(scene_, std::move(device).value());
+    Result<std::unique_ptr<Simulation>> sim = local_simulation(
+        local_bodies_, send_, receive_,
+        spare_ ? Result<std::unique_ptr<Device>>(std::move(spare_)) : open_device_());
     if (sim) {
       local_ = std::move(sim).value();
       device_info_ = local_->device().info();
@@ -631,9 +600,7 @@ Status DistributedSimulation::build_local(
           for (const std::uint32_t k : by_rank[r]) {
             const BodyInfo& info = infos[k];
             halves[0][r] += static_cast<int>(MOTES_HALO_PARTICLE_VEC4S * info.particle_count);
-            if (!info.free_sphere && !info.linked && !info.soft) {
-              halves[1][r] += static_cast<int>(MOTES_HALO_BODY_VEC4S);
-            }
+            if (info.has_body_state()) halves[1][r] += static_cast<int>(MOTES_HALO_BODY_VEC4S);
           }
         }
       };
@@ -658,6 +625,23 @@ Status DistributedSimulation::build_local(
   halo_bodies_ = bodies_anywhere != 0;
   ++stats_.partitions;
   return connect_halos();
+}
+
+Result<std::unique_ptr<Simulation>> DistributedSimulation::local_simulation(
+    const std::vector<std::uint32_t>& bodies, const std::vector<std::vector<std::uint32_t>>& send,
+    const std::vector<std::vector<std::uint32_t>>& receive,
+    Result<std::unique_ptr<Device>> device) const {
+  if (!device) return device.status();
+  // One rank holds the whole scene: no copy of it is needed.
+  if (size_ == 1) return Simulation::create(scene_, std::move(device).value());
+  HaloLists lists;
+  lists.scene_particles = static_cast<std::uint32_t>(particles_);
+  lists.scene_diameter = scene_diameter_;
+  for (std::size_t r = 0; r < send.size(); ++r) {
+    lists.send.insert(lists.send.end(), send[r].begin(), send[r].end());
+    lists.receive.insert(lists.receive.end(), receive[r].begin(), receive[r].end());
+  }
+  return Simulation::create(sub_scene(scene_, bodies), std::move(device).value(), lists);
 }
 
 Status DistributedSimulation::connect_halos() {

@@ -593,20 +593,9 @@ Status DistributedSimulation::load_checkpoint(const std::string& set,
   std::unique_ptr<Device> device =
       local_ ? Simulation::take_device(std::move(local_)) : std::move(spare_);
   if (listed.has_file) {
-    Result<std::unique_ptr<Device>> opened =
-        device ? Result<std::unique_ptr<Device>>(std::move(device)) : open_device_();
-    HaloLists lists;
-    lists.scene_particles = static_cast<std::uint32_t>(particles_);
-    lists.scene_diameter = scene_diameter_;
-    for (std::size_t q = 0; q < ranks; ++q) {
-      lists.send.insert(lists.send.end(), state.send[q].begin(), state.send[q].end());
-      lists.receive.insert(lists.receive.end(), state.receive[q].begin(), state.receive[q].end());
-    }
-    const Scene sub = detail::sub_scene(scene_, state.bodies);
-    Result<std::unique_ptr<Simulation>> sim =
-        !opened     ? Result<std::unique_ptr<Simulation>>(status_of(opened))
-        : size_ > 1 ? Simulation::create(sub, std::move(opened).value(), lists)
-                    : Simulation::create(sub, std::move(opened).value());
+    Result<std::unique_ptr<Simulation>> sim = local_simulation(
+        state.bodies, state.send, state.receive,
+        device ? Result<std::unique_ptr<Device>>(std::move(device)) : open_device_());
     if (sim) status = sim.value()->load_state(path);
     if (sim && status) {
       local_ = std::move(sim).value();

@@ -64,7 +64,23 @@ struct BodyInfo {
   /// + cluster_count).
   std::uint32_t first_cluster = 0;
   std::uint32_t cluster_count = 0;
+
+  /// A rigid body on the device, a static one too: it has body state (BodyPos ... BodyAngVel),
+  /// and in a halo its five vectors travel after its particles' (shared/halo.h).
+  [[nodiscard]] bool has_body_state() const { return !free_sphere && !linked && !soft; }
 };
+
+/// A scene's bodies, then its cloths and ropes, in the scene's order with the particle ranges of
+/// a Snapshot (BodyInfo's name, kind, first_particle, particle_count, soft, linked; a body's
+/// mass, free_sphere and clusters are the Simulation's: Simulation::bodies), with the particle
+/// count and the largest particle diameter. Simulation::create lays a scene out from it; a run
+/// over MPI ranks describes the whole scene with it.
+struct SceneBodies {
+  std::vector<BodyInfo> bodies;
+  std::uint64_t particles = 0;
+  double largest_diameter = 0.0;
+};
+SceneBodies scene_bodies(const Scene& scene);
 
 /// Neighbour-list figures since the simulation was created (NeighbourState).
 struct NeighbourStats {

@@ -173,6 +173,13 @@ class DistributedSimulation {
   /// their counts.
   Status build_local(std::vector<LocalEntry> entries,
                      const std::vector<std::vector<std::uint32_t>>& sent_bodies);
+  /// The local simulation of scene bodies `bodies` (ascending) with the halo lists `send` and
+  /// `receive` (local indices, by rank) on `device`: the whole scene when this is the only rank.
+  /// Every partition and a resume build it so.
+  Result<std::unique_ptr<Simulation>> local_simulation(
+      const std::vector<std::uint32_t>& bodies, const std::vector<std::vector<std::uint32_t>>& send,
+      const std::vector<std::vector<std::uint32_t>>& receive,
+      Result<std::unique_ptr<Device>> device) const;
   /// Collective: the partition at create, from the scene (`centres`: body_centres).
   Status first_partition(const std::vector<Eigen::Vector3d>& centres);
   /// Writes the entries' records into the local simulation (build_local).
