@@ -3,10 +3,10 @@
 // One Simulation of a small fixed scene (a repeated box, a static box, a free sphere, a rope, a
 // cloth and a soft box: every kind of body a checkpoint restores) on the OpenMP backend with one
 // thread. Each input is loaded as it is, and again with its checksum made right, so that mutations
-// get past it and reach the payload: for version 2 the header's file size is set to the input's
-// size and the last 8 bytes to the FNV-1a 64 of every byte before them; for version 1 the last 8
-// bytes to the FNV-1a 64 of the bytes between the 48-byte header and them. A state that loads is
-// stepped once and checked (check_finite, snapshot, save_state).
+// get past it and reach the payload: for versions 2 and 3 the header's file size is set to the
+// input's size and the last 8 bytes to the FNV-1a 64 of every byte before them; for version 1 the
+// last 8 bytes to the FNV-1a 64 of the bytes between the 48-byte header and them. A state that
+// loads is stepped once and checked (check_finite, snapshot, save_state).
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
