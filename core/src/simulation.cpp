@@ -157,6 +157,14 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
     return Status::ok();
   };
   if (Status st = check_memory(); !st) return st;
+  // Every family a run may call (the step's, the guards', the halo's) must be one the device runs.
+  for (std::size_t k = 0; k < kKernelCount; ++k) {
+    if (!d.supports(static_cast<Kernel>(k))) {
+      return Status::error(fmt::format("{}: the {} device does not run the kernel family {}",
+                                       scene.source, d.info().backend,
+                                       kernel_name(static_cast<Kernel>(k))));
+    }
+  }
 
   // The host's layout, kind by kind (scene_layout.h).
   host.bodies = std::move(order.bodies);

@@ -69,6 +69,11 @@ if want conformance; then
     MOTES_CONFORMANCE_BACKENDS=vulkan \
     part "${LIMIT_2D:-150}" conformance motes_conformance_tests --gtest_brief=1 --gtest_filter=-*Scenes* ||
     status=1
+  # The kernel cases once more with every buffer a call neither reads nor writes poisoned
+  # (core/include/motes/backend/kernels.h: a kernel reading a buffer its entry does not list fails).
+  MOTES_CONFORMANCE_POISON_UNREAD=1 MOTES_CONFORMANCE_BACKENDS=cuda,vulkan \
+    part "${LIMIT_POISON:-180}" conformance motes_conformance_tests --gtest_brief=1 \
+    --gtest_filter='Conformance/*:-*Scenes*' || status=1
   # The README's main job, on each GPU backend.
   for backend in cuda vulkan; do
     MOTES_VULKAN_VALIDATION=1 part 60 conformance motes run examples/scenes/dominoes.json \

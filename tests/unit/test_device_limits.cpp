@@ -49,6 +49,11 @@ class LimitedDevice final : public motes::Device {
   }
   Status read(Buffer b, void* dst, std::size_t n) override { return inner_->read(b, dst, n); }
   void enqueue(motes::Kernel k, const StepParams& p) override { inner_->enqueue(k, p); }
+  [[nodiscard]] bool supports(motes::Kernel k) const override {
+    return k != unsupported && inner_->supports(k);
+  }
+  /// A family this device claims not to run (Kernel::Count: none).
+  motes::Kernel unsupported = motes::Kernel::Count;
   Status synchronize() override { return inner_->synchronize(); }
   Status check_guards() override { return inner_->check_guards(); }
   void set_timing(bool on) override { inner_->set_timing(on); }
@@ -251,6 +256,21 @@ TEST(DeviceLimits, SimulationRefusesMoreThanTheDeviceHasBeforeAllocating) {
   EXPECT_TRUE(stepped) << stepped.message();
   auto one_more = motes::Simulation::create(scene(0, largest + 1), limited_openmp());
   EXPECT_FALSE(one_more);
+}
+
+// A device that does not run a family the simulation may call is refused before anything is
+// allocated, naming the family.
+TEST(DeviceLimits, SimulationRefusesADeviceWithoutAFamily) {
+  int allocations = 0;
+  auto device = limited_openmp(&allocations);
+  device->unsupported = motes::Kernel::ClustersGoal;
+  auto refused = motes::Simulation::create(scene(2, 10), std::move(device));
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(allocations, 0) << "refused after allocating";
+  EXPECT_NE(refused.message().find(
+                "limits.json: the openmp device does not run the kernel family clusters_goal"),
+            std::string::npos)
+      << refused.message();
 }
 
 // A scene of rigid boxes and free spheres: the largest count keeps the proportions (here a box
