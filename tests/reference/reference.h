@@ -5,6 +5,9 @@
 // The per-particle and per-body math comes from the same shared headers the backends use
 // (shaders/shared/), so the oracle checks each backend's scaffolding (indexing, sorting, ranges,
 // neighbour search, summation, which buffers are read and written), not the physics formulas.
+//
+// One file per family, named after it (tests/reference/FAMILY.cpp, as the family's files on
+// every backend); reference_common.cpp holds what several share (the whole step).
 #pragma once
 
 #include <cstdint>
