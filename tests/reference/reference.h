@@ -96,6 +96,11 @@ std::vector<uint> walk_buckets(vec4 x, const StepParams& p);
 /// ref = pos. over_capacity and max_count against p.neighbour_capacity.
 Neighbours neighbours_build(const Particles& particles, const Grid& grid, const StepParams& p);
 
+/// neighbours_update: when state[MOTES_NEIGHBOUR_REBUILD] (NeighbourState) is nonzero,
+/// grid = grid_build and nb = neighbours_build, and true; otherwise nothing is written, and false.
+bool neighbours_update(const Particles& particles, const std::vector<uint>& state,
+                       const StepParams& p, Grid& grid, Neighbours& nb);
+
 /// contacts_compute, by brute force over all pairs: the force on dynamic particle i is the sum,
 /// over every particle j of another body, of shared::particle_contact_force with law
 /// laws[material_i * M + material_j], plus shared::plane_contact_force of each plane with law
