@@ -1,4 +1,6 @@
-// impulses_compute and impulses_apply against the oracle, as the core runs them: the counting
+// impulses_compute against the oracle, with impulses_apply.
+//
+// ImpulsesComputeThenApply: impulses_compute and impulses_apply as the core runs them: the counting
 // pass (compute, apply: each body's contacts counted, the stage's start kept and the warm start
 // applied), then three sweeps with position correction (compute, apply; the last apply with
 // MOTES_FLAG_IMPULSE_PUSH: BodyVelPush and BodyAngMomPush kept), then two relaxing sweeps
@@ -44,7 +46,41 @@ constexpr uint kBuilds = 7;
 constexpr int kIterations = 3;
 constexpr int kRelaxing = 2;
 
-class Impulses : public DeviceTest {
+/// The contacts' memory of the last substep for lists of capacity K (Sizes::impulse = 1): random
+/// accumulated impulses in every ContactImpulse slot, the same in the two slots of a contact
+/// listed on both sides, ImpulseStamp kBuilds for most particles (their slots are warm-started)
+/// and 6 for the others (void: lists rebuilt); builds = kBuilds, BodyVelStart and
+/// BodyAngVelStart 0.
+motes_ref::ImpulseState contact_memory(const World& w, const motes_ref::Neighbours& nb,
+                                       uint capacity, std::uint32_t seed) {
+  const std::size_t nr = w.particles.rigid;
+  const std::size_t slots = motes::buffer_layout(Buffer::ContactImpulse, w.sizes).count;
+  Rng rng(seed);
+  motes_ref::ImpulseState s;
+  s.builds = kBuilds;
+  s.vel0.assign(w.bodies.size(), vec4(0.0f));
+  s.angvel0.assign(w.bodies.size(), vec4(0.0f));
+  for (std::size_t k = 0; k < slots; ++k) {
+    s.acc.emplace_back(rng.uniform(-1e-3f, 1e-3f), rng.uniform(-1e-3f, 1e-3f),
+                       rng.uniform(-1e-3f, 1e-3f), rng.uniform(0.0f, 1e-3f));
+  }
+  // A contact's two slots hold the same bits (both particles evaluate it in one order and write
+  // the same total): the higher id's slot takes the lower id's.
+  for (std::size_t i = 0; i < nr; ++i) {
+    if (nb.count[i] > capacity) continue;
+    for (std::size_t k = 0; k < nb.count[i]; ++k) {
+      const uint j = nb.lists[i][k];
+      if (j >= nr || j < i || nb.count[j] > capacity) continue;
+      for (std::size_t m = 0; m < nb.count[j]; ++m) {
+        if (nb.lists[j][m] == i) s.acc[m * nr + j] = s.acc[k * nr + i];
+      }
+    }
+  }
+  for (std::size_t i = 0; i < nr; ++i) s.stamp.push_back(rng.chance(0.8f) ? kBuilds : 6u);
+  return s;
+}
+
+class ImpulsesComputeThenApply : public DeviceTest {
  protected:
   /// The counting pass and kIterations iterations on the device and the oracle, lists of
   /// capacity K; `acc` and `stamp` are the contacts' memory at the start.
@@ -54,29 +90,7 @@ class Impulses : public DeviceTest {
     w.params.neighbour_capacity = capacity;
     w.sizes.impulse = 1;
     const std::size_t nr = w.particles.rigid;
-    const std::size_t slots = motes::buffer_layout(Buffer::ContactImpulse, w.sizes).count;
-    Rng rng(seed);
-    motes_ref::ImpulseState s;
-    s.builds = kBuilds;
-    s.vel0.assign(w.bodies.size(), vec4(0.0f));
-    s.angvel0.assign(w.bodies.size(), vec4(0.0f));
-    for (std::size_t k = 0; k < slots; ++k) {
-      s.acc.emplace_back(rng.uniform(-1e-3f, 1e-3f), rng.uniform(-1e-3f, 1e-3f),
-                         rng.uniform(-1e-3f, 1e-3f), rng.uniform(0.0f, 1e-3f));
-    }
-    // A contact's two slots hold the same bits (both particles evaluate it in one order and write
-    // the same total): the higher id's slot takes the lower id's.
-    for (std::size_t i = 0; i < nr; ++i) {
-      if (nb.count[i] > capacity) continue;
-      for (std::size_t k = 0; k < nb.count[i]; ++k) {
-        const uint j = nb.lists[i][k];
-        if (j >= nr || j < i || nb.count[j] > capacity) continue;
-        for (std::size_t m = 0; m < nb.count[j]; ++m) {
-          if (nb.lists[j][m] == i) s.acc[m * nr + j] = s.acc[k * nr + i];
-        }
-      }
-    }
-    for (std::size_t i = 0; i < nr; ++i) s.stamp.push_back(rng.chance(0.8f) ? kBuilds : 6u);
+    motes_ref::ImpulseState s = contact_memory(w, nb, capacity, seed);
     const std::vector<vec4> acc0 = s.acc;
     const std::vector<uint> stamp0 = s.stamp;
 
@@ -209,20 +223,21 @@ World impulse_world(std::uint32_t seed, std::size_t n) {
   return random_world(seed, n, MOTES_FLAG_IMPULSE, kTestSkin);
 }
 
-TEST_P(Impulses, Empty) { run_case("random", impulse_world(61, 0)); }
-TEST_P(Impulses, One) { run_case("random", impulse_world(62, 1)); }
-TEST_P(Impulses, Random31) { run_case("random", impulse_world(63, 31)); }
-TEST_P(Impulses, Random1234) { run_case("random", impulse_world(64, 1234)); }
-TEST_P(Impulses, Random5000) { run_case("random", impulse_world(65, 5000)); }
+TEST_P(ImpulsesComputeThenApply, Empty) { run_case("random", impulse_world(61, 0)); }
+TEST_P(ImpulsesComputeThenApply, One) { run_case("random", impulse_world(62, 1)); }
+TEST_P(ImpulsesComputeThenApply, Random31) { run_case("random", impulse_world(63, 31)); }
+TEST_P(ImpulsesComputeThenApply, Random1234) { run_case("random", impulse_world(64, 1234)); }
+TEST_P(ImpulsesComputeThenApply, Random5000) { run_case("random", impulse_world(65, 5000)); }
 
-TEST_P(Impulses, FarFromOrigin) {
+TEST_P(ImpulsesComputeThenApply, FarFromOrigin) {
   Rng rng(66);
   const float rmax = 0.05f;
   auto pos = random_cloud(rng, 1234, rmax, dense_side(1234, rmax), vec3(1e5f, -1e5f, 1e5f));
   run_case("far_1e5", make_world(rng, std::move(pos), MOTES_FLAG_IMPULSE, false, 0.1f));
 }
 
-INSTANTIATE_TEST_SUITE_P(Conformance, Impulses, testing::ValuesIn(device_params()), param_name);
+INSTANTIATE_TEST_SUITE_P(Conformance, ImpulsesComputeThenApply, testing::ValuesIn(device_params()),
+                         param_name);
 
 }  // namespace
 }  // namespace motes_conf
