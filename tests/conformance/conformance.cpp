@@ -96,6 +96,20 @@ const std::vector<DeviceParam>& device_params() {
 
 std::string param_name(const testing::TestParamInfo<DeviceParam>& info) { return info.param.label; }
 
+std::string family_suite(motes::Kernel k) {
+  std::string out = "Conformance/";
+  bool upper = true;
+  for (const char* c = motes::kernel_name(k); *c != '\0'; ++c) {
+    if (*c == '_') {
+      upper = true;
+      continue;
+    }
+    out += upper ? static_cast<char>(std::toupper(static_cast<unsigned char>(*c))) : *c;
+    upper = false;
+  }
+  return out;
+}
+
 bool Comparison::pass(double tolerance) const {
   if (oracle_non_finite || non_finite > 0) return false;
   return error <= (zero_reference ? kZeroReferenceBound : tolerance);

@@ -40,6 +40,12 @@ const std::vector<DeviceParam>& device_params();
 /// The parameter's label, for INSTANTIATE_TEST_SUITE_P.
 std::string param_name(const testing::TestParamInfo<DeviceParam>& info);
 
+/// How the suites of family k start: "Conformance/" and the family's name in CamelCase
+/// (constraints_solve: "Conformance/ConstraintsSolve"). Every suite of a family is named so
+/// (ConstraintsSolve, or ConstraintsSolve and more: NeighboursBuildStamps is neighbours_build's),
+/// in its file tests/conformance/test_FAMILY.cpp; the driver's --family selects them by it.
+std::string family_suite(motes::Kernel k);
+
 /// Bound on the error when the oracle is exactly zero: the error is then the plain sum of
 /// squares of the device's output (in its own units squared), which must be at most this.
 constexpr double kZeroReferenceBound = 1.0e-12;

@@ -1,25 +1,21 @@
-// neighbours_build and neighbours_update against the oracle: every output must be IDENTICAL.
+// neighbours_build against the oracle: every output must be IDENTICAL.
 //
-// neighbours_build alone: the particles (ParticlePos/Vel/Body), the oracle's grid (GridOrder,
-// GridCellStart, SortedPos, SortedBody) and a NeighbourState are written, every other buffer is
-// poisoned. Read back: NeighbourCount (every particle's full count), the first min(count, K)
-// entries of each list (entry k of particle i at k * N + i; the rest is unspecified),
-// NeighbourRefPos (= ParticlePos, bitwise) and NeighbourState (rebuild 0, builds + 1, particles
-// over capacity, largest count).
+// The particles (ParticlePos/Vel/Body), the oracle's grid (GridOrder, GridCellStart, SortedPos,
+// SortedBody) and a NeighbourState are written, every other buffer is poisoned. Read back:
+// NeighbourCount (every particle's full count), the first min(count, K) entries of each list (entry
+// k of particle i at k * N + i; the rest is unspecified), NeighbourRefPos (= ParticlePos, bitwise)
+// and NeighbourState (rebuild 0, builds + 1, particles over capacity, largest count).
 //
 // Tolerance: none. Which pairs are listed is decided by shared::neighbour_within, whose products
 // are rounded on their own on every backend (mul_rn), so that no fused multiply-add can move a
 // pair across the cutoff; the order is the canonical walk, which the oracle writes differently (as
 // the first occurrence of each bucket among the 27 cells, then grid order), by brute force.
 //
-// With impulse contacts (ImpulseStampKept*), the lists of the last build are written too, most of
-// them equal to the new ones and some changed (an entry replaced, two swapped, one dropped), with
-// ImpulseStamp at the last build's count for most rigid particles: the stamps read back must
+// With impulse contacts (NeighboursBuildStamps), the lists of the last build are written too, most
+// of them equal to the new ones and some changed (an entry replaced, two swapped, one dropped),
+// with ImpulseStamp at the last build's count for most rigid particles: the stamps read back must
 // equal the oracle's (motes_ref::impulse_stamps_after_build: moved on where the list is unchanged),
 // bitwise.
-//
-// neighbours_update: with the rebuild word 0 nothing may be written (every grid and list buffer
-// comes back poisoned); with it set, the grid and the lists must equal the oracle's.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -27,6 +23,7 @@
 #include <vector>
 
 #include "conformance.h"
+#include "list_support.h"
 #include "reference/reference.h"
 #include "shared/neighbours.h"
 #include "test_data.h"
@@ -35,48 +32,6 @@ namespace motes_conf {
 namespace {
 
 using motes::Buffer;
-
-/// The first min(count, K) entries of every list, from a NeighbourList buffer (K * N).
-std::vector<uint> kept_entries(const std::vector<uint>& list, const std::vector<uint>& count,
-                               uint capacity) {
-  const std::size_t n = count.size();
-  std::vector<uint> out;
-  for (std::size_t i = 0; i < n; ++i) {
-    for (uint k = 0; k < std::min(count[i], capacity); ++k) out.push_back(list[k * n + i]);
-  }
-  return out;
-}
-
-std::vector<uint> kept_entries(const motes_ref::Neighbours& want, uint capacity) {
-  std::vector<uint> out;
-  for (const std::vector<uint>& l : want.lists) {
-    for (std::size_t k = 0; k < std::min<std::size_t>(l.size(), capacity); ++k) out.push_back(l[k]);
-  }
-  return out;
-}
-
-constexpr uint kBuildsBefore = 41;
-
-std::vector<uint> state_after(const motes_ref::Neighbours& want) {
-  return {0u, kBuildsBefore + 1u, want.over_capacity, want.max_count};
-}
-
-/// The list checks shared by both fixtures.
-class ListTest : public DeviceTest {
- protected:
-  /// EXPECTs the lists read back from the device equal to the oracle's.
-  void check_lists(const std::vector<uint>& list, const std::vector<uint>& count,
-                   const std::vector<vec4>& ref, const std::vector<uint>& state,
-                   const motes_ref::Neighbours& want, uint capacity) {
-    check_identical("NeighbourCount", count, want.count);
-    if (count.size() == want.count.size()) {
-      check_identical("NeighbourList (kept entries)", kept_entries(list, count, capacity),
-                      kept_entries(want, capacity));
-    }
-    check_identical("NeighbourRefPos", ref, want.ref);
-    check_identical("NeighbourState", state, state_after(want));
-  }
-};
 
 class NeighboursBuild : public ListTest {
  protected:
@@ -269,56 +224,6 @@ TEST_P(NeighboursBuild, MeshLinked1234) {
 INSTANTIATE_TEST_SUITE_P(Conformance, NeighboursBuild, testing::ValuesIn(device_params()),
                          param_name);
 
-class NeighboursUpdate : public ListTest {
- protected:
-  void run_case(const std::string& layout, const World& w, bool rebuild) {
-    const motes_ref::Grid g = motes_ref::grid_build(w.particles, w.params);
-    const motes_ref::Neighbours want = motes_ref::neighbours_build(w.particles, g, w.params);
-    const std::vector<uint> state_in = {rebuild ? 1u : 0u, kBuildsBefore, 77u, 88u};
-    ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
-    ASSERT_NO_FATAL_FAILURE(
-        poison_all_but({Buffer::ParticlePos, Buffer::ParticleVel, Buffer::ParticleBody,
-                        Buffer::ParticleMaterial, Buffer::NeighbourState}));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleVel, w.particles.vel));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleBody, w.particles.body));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleMaterial, w.particles.material));
-    ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourState, state_in));
-    // Twice: the first call rebuilds (when asked), the second must then do nothing more.
-    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::NeighboursUpdate, w.params));
-    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::NeighboursUpdate, w.params));
-    ASSERT_NO_FATAL_FAILURE(finish_kernel());
-
-    motes_ref::Grid got;
-    std::vector<uint> list, count, state;
-    std::vector<vec4> ref;
-    ASSERT_NO_FATAL_FAILURE(read(Buffer::GridOrder, got.order));
-    ASSERT_NO_FATAL_FAILURE(read(Buffer::GridCellStart, got.cell_start));
-    ASSERT_NO_FATAL_FAILURE(read(Buffer::SortedPos, got.sorted_pos));
-    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourList, list));
-    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourCount, count));
-    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourRefPos, ref));
-    ASSERT_NO_FATAL_FAILURE(read(Buffer::NeighbourState, state));
-
-    const std::size_t n = w.particles.size();
-    begin_case(std::string("neighbours_update/") + layout + (rebuild ? " rebuild" : " no rebuild"),
-               n);
-    if (rebuild) {
-      check_identical("GridOrder", got.order, g.order);
-      check_identical("GridCellStart", got.cell_start, g.cell_start);
-      check_identical("SortedPos", got.sorted_pos, g.sorted_pos);
-      check_lists(list, count, ref, state, want, w.params.neighbour_capacity);
-    } else {
-      // Untouched: still the poison (0xFF bytes) of every output.
-      check_identical("GridOrder untouched", got.order, std::vector<uint>(n, 0xFFFFFFFFu));
-      check_identical("NeighbourCount untouched", count, std::vector<uint>(n, 0xFFFFFFFFu));
-      check_identical("NeighbourList untouched", list, std::vector<uint>(list.size(), 0xFFFFFFFFu));
-      check_identical("NeighbourState untouched", state, state_in);
-    }
-    end_case();
-  }
-};
-
 TEST_P(NeighboursBuildStamps, Random1234) {
   run_case("impulse stamps", random_world(211, 1234, MOTES_FLAG_IMPULSE, kTestSkin));
 }
@@ -327,20 +232,6 @@ TEST_P(NeighboursBuildStamps, CapacityTwo) {
            with_capacity(random_world(212, 1234, MOTES_FLAG_IMPULSE, kTestSkin), 2));
 }
 INSTANTIATE_TEST_SUITE_P(Conformance, NeighboursBuildStamps, testing::ValuesIn(device_params()),
-                         param_name);
-
-TEST_P(NeighboursUpdate, NoRebuild) {
-  run_case("random", random_world(221, 1234, 0, kTestSkin), false);
-}
-TEST_P(NeighboursUpdate, Rebuild) {
-  run_case("random", random_world(221, 1234, 0, kTestSkin), true);
-}
-TEST_P(NeighboursUpdate, Rebuild20000) {
-  // Large enough for a two-level bucket scan on Vulkan; the oracle's lists are O(N^2).
-  run_case("random", random_world(222, 20000, 0, kTestSkin), true);
-}
-
-INSTANTIATE_TEST_SUITE_P(Conformance, NeighboursUpdate, testing::ValuesIn(device_params()),
                          param_name);
 
 }  // namespace

@@ -5,7 +5,9 @@
 // backend). The cases: random displacements of up to 2 skin, every particle where it was
 // partitioned (0), one particle moved, the last (the kernel must reach the end of a partial
 // workgroup), a NaN or infinity in a position or a reference (0x7F800000, an infinity's bits), a
-// square beyond the float range (the same), and no particle at all.
+// square beyond the float range (the same), and no particle at all. A call without the partition's
+// buffers (Sizes::partition = 0) is refused before it runs by the GPU backends' launch guard
+// (ParticlesDisplacementLaunchGuard; openmp, which checks no launch parameters, skips it).
 #include <gtest/gtest.h>
 
 #include <limits>
@@ -13,6 +15,7 @@
 #include <vector>
 
 #include "conformance.h"
+#include "halo_support.h"
 #include "reference/reference.h"
 #include "shared/halo.h"
 #include "test_data.h"
@@ -112,6 +115,16 @@ TEST_P(ParticlesDisplacement, Overflow) {
 
 INSTANTIATE_TEST_SUITE_P(Conformance, ParticlesDisplacement, testing::ValuesIn(device_params()),
                          param_name);
+
+class ParticlesDisplacementLaunchGuard : public HaloLaunchGuardTest {};
+
+TEST_P(ParticlesDisplacementLaunchGuard, WithoutPartition) {
+  const Halo h = make_halo(333, 31, 31);  // Sizes::partition = 0
+  run_case("refused_without_partition", motes::Kernel::ParticlesDisplacement, h, h.params);
+}
+
+INSTANTIATE_TEST_SUITE_P(Conformance, ParticlesDisplacementLaunchGuard,
+                         testing::ValuesIn(device_params()), param_name);
 
 }  // namespace
 }  // namespace motes_conf

@@ -5,6 +5,9 @@
 // The per-particle and per-body math comes from the same shared headers the backends use
 // (shaders/shared/), so the oracle checks each backend's scaffolding (indexing, sorting, ranges,
 // neighbour search, summation, which buffers are read and written), not the physics formulas.
+//
+// One file per family, named after it (tests/reference/FAMILY.cpp, as the family's files on
+// every backend); reference_common.cpp holds what several share (the whole step).
 #pragma once
 
 #include <cstdint>
@@ -92,6 +95,11 @@ std::vector<uint> walk_buckets(vec4 x, const StepParams& p);
 /// by (place of j's bucket on the walk, j's slot in grid.order); static particles get none.
 /// ref = pos. over_capacity and max_count against p.neighbour_capacity.
 Neighbours neighbours_build(const Particles& particles, const Grid& grid, const StepParams& p);
+
+/// neighbours_update: when state[MOTES_NEIGHBOUR_REBUILD] (NeighbourState) is nonzero,
+/// grid = grid_build and nb = neighbours_build, and true; otherwise nothing is written, and false.
+bool neighbours_update(const Particles& particles, const std::vector<uint>& state,
+                       const StepParams& p, Grid& grid, Neighbours& nb);
 
 /// contacts_compute, by brute force over all pairs: the force on dynamic particle i is the sum,
 /// over every particle j of another body, of shared::particle_contact_force with law

@@ -1,6 +1,5 @@
-// The oracle of the impulse families (impulses_compute, impulses_apply): reference.h has the
-// contracts. Naive loops over the oracle's full neighbour lists; the physics comes from
-// shaders/shared/impulse.h, as on every backend.
+// The oracle of impulses_compute (reference.h has the contract): naive loops over the oracle's
+// full neighbour lists; the physics comes from shaders/shared/impulse.h, as on every backend.
 #include <cstddef>
 
 #include "reference.h"
@@ -67,57 +66,6 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
     }
     s.impulse[i] = sum;
     s.moment[i] = vec4(moment, 0.0f);
-  }
-}
-
-void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s) {
-  const bool counting = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
-  const bool push = (p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u;
-  if (push) {
-    s.vel_push.resize(bodies.size(), vec4(0.0f));
-    s.angmom_push.resize(bodies.size(), vec4(0.0f));
-  }
-  for (std::size_t b = 0; b < bodies.size(); ++b) {
-    vec4 sum(0.0f);
-    vec3 m(0.0f);
-    if (bodies.pos[b].w != 0.0f) {
-      for (uint i = bodies.first[b]; i < bodies.first[b + 1]; ++i) {
-        sum = sum + s.impulse[i];
-        m += xyz(s.moment[i]);
-      }
-    }
-    if (counting) {
-      s.vel0[b] = vec4(xyz(bodies.vel[b]), sum.w);
-      s.angvel0[b] = bodies.angvel[b];
-      if (bodies.pos[b].w != 0.0f) {
-        for (uint i = bodies.first[b]; i < bodies.first[b + 1]; ++i) s.stamp[i] = s.builds;
-      }
-    }
-    motes::shared::body_apply_impulse(bodies.pos[b], bodies.quat[b], bodies.inv_inertia[b],
-                                      bodies.vel[b], bodies.angmom[b], bodies.angvel[b], xyz(sum),
-                                      m);
-    if (push) {
-      s.vel_push[b] = bodies.vel[b];
-      s.angmom_push[b] = bodies.angmom[b];
-    }
-  }
-}
-
-void impulse_stamps_after_build(const Particles& particles, const std::vector<uint>& old_list,
-                                const std::vector<uint>& old_count, const Neighbours& now,
-                                const StepParams& p, uint built, std::vector<uint>& stamp) {
-  const std::size_t n = now.count.size();
-  for (std::size_t i = 0; i < stamp.size() && i < n; ++i) {
-    if (stamp[i] != built || particles.vel[i].w == 0.0f) continue;
-    const std::vector<uint>& list = now.lists[i];
-    bool same = true;
-    for (std::size_t k = 0; k < list.size() && k < p.neighbour_capacity; ++k) {
-      same = same && old_list[k * n + i] == list[k];
-    }
-    if (motes::shared::neighbour_keeps_slots(old_count[i], now.count[i], same,
-                                             p.neighbour_capacity)) {
-      stamp[i] = built + 1u;
-    }
   }
 }
 

@@ -1,0 +1,180 @@
+// impulses_apply against the oracle, the kernel alone (test_impulses_compute.cpp runs it after
+// impulses_compute as the core does). Written: the bodies of random_world (poses, velocities,
+// angular momenta and velocities, inverse inertia, about 10% static; runs of 1 to 64 particles),
+// BodyFirst, random impulses in ParticleForce (xyz up to 1e-3 N s: velocity changes of the order of
+// the bodies' own, w a whole count of contacts 0 to 6) and moments in ParticleMoment for every
+// particle (static bodies' and free spheres' too: they must not be summed), random BodyVelStart,
+// BodyAngVelStart, BodyVelPush and BodyAngMomPush, ImpulseStamp 6 or 7 and NeighbourState with
+// builds = 9. Every other buffer is poisoned. Read back: BodyVel, BodyAngMom, BodyAngVel (a static
+// body's angular velocity from its angular momentum), BodyVelStart and BodyAngVelStart,
+// ImpulseStamp, BodyVelPush and BodyAngMomPush. Without MOTES_FLAG_IMPULSE_COUNT the start and the
+// stamps must come back as written, bitwise; with it the start is (BodyVel, the summed count) and
+// BodyAngVel as they were, and the dynamic bodies' particles are stamped 9. Without
+// MOTES_FLAG_IMPULSE_PUSH the pushed velocities must come back as written; with it they are the
+// velocities the call leaves.
+//
+// Tolerance: NMSE 1e-7, as for the same outputs in test_impulses_compute.cpp. The sums are in
+// float in particle order on every backend and the update is the shared body_apply_impulse, so
+// openmp matches bitwise (0); a GPU may fuse multiply-adds in the angular velocity. The counts
+// are sums of whole numbers (exact). The oracle made to leave each body's last particle out fails
+// every case but the empty one (NMSE 0.5 to 2.4); made to stamp nothing, or to keep no count, the
+// three count cases; made to sum static bodies' counts, the count cases of 1,234 and 65,536
+// particles (BodyVelStart, NMSE 6e-2 and 9e-2); made to keep no BodyAngMomPush, the two push
+// cases.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "conformance.h"
+#include "reference/reference.h"
+#include "test_data.h"
+
+namespace motes_conf {
+namespace {
+
+using motes::Buffer;
+
+constexpr double kApplyTolerance = 1.0e-7;
+constexpr uint kApplyBuilds = 9;
+
+class ImpulsesApply : public DeviceTest {
+ protected:
+  void run_case(const std::string& layout, World w, uint flags) {
+    w.sizes.impulse = 1;
+    w.params.flags |= flags;
+    const bool counting = (flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
+    const bool push = (flags & MOTES_FLAG_IMPULSE_PUSH) != 0u;
+    const std::size_t n = w.particles.size();
+    const std::size_t nr = w.particles.rigid;
+    const std::size_t b = w.bodies.size();
+    Rng rng(static_cast<std::uint32_t>(n) + 17u);
+    std::vector<vec4> force;  // N: ParticleForce
+    for (std::size_t i = 0; i < n; ++i) {
+      force.emplace_back(rng.uniform(-1e-3f, 1e-3f), rng.uniform(-1e-3f, 1e-3f),
+                         rng.uniform(-1e-3f, 1e-3f), static_cast<float>(rng.below(7)));
+    }
+    motes_ref::ImpulseState s;
+    s.builds = kApplyBuilds;
+    s.impulse = slice(force, 0, nr);
+    for (std::size_t i = 0; i < nr; ++i) {
+      s.moment.emplace_back(rng.uniform(-1e-4f, 1e-4f), rng.uniform(-1e-4f, 1e-4f),
+                            rng.uniform(-1e-4f, 1e-4f), 0.0f);
+      s.stamp.push_back(rng.chance(0.5f) ? 7u : 6u);
+    }
+    const auto random_body_vectors = [&](float scale) {
+      std::vector<vec4> out;
+      for (std::size_t k = 0; k < b; ++k) {
+        out.emplace_back(rng.uniform(-scale, scale), rng.uniform(-scale, scale),
+                         rng.uniform(-scale, scale), rng.uniform(0.0f, scale));
+      }
+      return out;
+    };
+    s.vel0 = random_body_vectors(1.0f);
+    s.angvel0 = random_body_vectors(20.0f);
+    s.vel_push = random_body_vectors(1.0f);
+    s.angmom_push = random_body_vectors(1e-3f);
+    const motes_ref::ImpulseState given = s;
+    motes_ref::Bodies want = w.bodies;
+    motes_ref::impulses_apply(want, w.params, s);
+
+    ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
+    ASSERT_NO_FATAL_FAILURE(poison_all_but(
+        {Buffer::ParticleForce, Buffer::ParticleMoment, Buffer::BodyPos, Buffer::BodyQuat,
+         Buffer::BodyVel, Buffer::BodyAngMom, Buffer::BodyAngVel, Buffer::BodyInvInertia,
+         Buffer::BodyFirst, Buffer::BodyVelStart, Buffer::BodyAngVelStart, Buffer::NeighbourState,
+         Buffer::ImpulseStamp, Buffer::BodyVelPush, Buffer::BodyAngMomPush}));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleForce, force));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleMoment, given.moment));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyPos, w.bodies.pos));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyQuat, w.bodies.quat));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyVel, w.bodies.vel));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyAngMom, w.bodies.angmom));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyAngVel, w.bodies.angvel));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyInvInertia, w.bodies.inv_inertia));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyFirst, w.bodies.first));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyVelStart, given.vel0));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyAngVelStart, given.angvel0));
+    ASSERT_NO_FATAL_FAILURE(
+        write(Buffer::NeighbourState, std::vector<uint>{0u, kApplyBuilds, 0u, 0u}));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ImpulseStamp, given.stamp));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyVelPush, given.vel_push));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyAngMomPush, given.angmom_push));
+    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesApply, w.params));
+    std::vector<vec4> vel, angmom, angvel, vel0, angvel0, vel_push, angmom_push;
+    std::vector<uint> stamp;
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyVel, vel));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngMom, angmom));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngVel, angvel));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyVelStart, vel0));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngVelStart, angvel0));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::ImpulseStamp, stamp));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyVelPush, vel_push));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngMomPush, angmom_push));
+
+    // The impulses must change most bodies' velocities, and the counting pass count contacts and
+    // stamp particles, or the case proves little.
+    std::size_t changed = 0;
+    for (std::size_t k = 0; k < b; ++k) {
+      const vec4 a = want.vel[k], o = w.bodies.vel[k];
+      changed += a.x != o.x || a.y != o.y || a.z != o.z ? 1 : 0;
+    }
+    std::size_t counted = 0;
+    for (const vec4& v : s.vel0) counted += counting && v.w > 0.0f ? 1 : 0;
+    std::size_t stamped = 0;
+    for (std::size_t i = 0; i < nr; ++i) stamped += s.stamp[i] != given.stamp[i] ? 1 : 0;
+
+    begin_case("impulses_apply/" + layout, b);
+    check_close("BodyVel", vel, want.vel, kApplyTolerance);
+    check_close("BodyAngMom", angmom, want.angmom, kApplyTolerance);
+    check_close("BodyAngVel", angvel, want.angvel, kApplyTolerance);
+    if (counting) {
+      check_close("BodyVelStart", vel0, s.vel0, kApplyTolerance);
+      check_close("BodyAngVelStart", angvel0, s.angvel0, kApplyTolerance);
+    } else {
+      check_identical("BodyVelStart untouched", vel0, given.vel0);
+      check_identical("BodyAngVelStart untouched", angvel0, given.angvel0);
+    }
+    check_identical("ImpulseStamp", stamp, s.stamp);
+    if (push) {
+      check_close("BodyVelPush", vel_push, s.vel_push, kApplyTolerance);
+      check_close("BodyAngMomPush", angmom_push, s.angmom_push, kApplyTolerance);
+    } else {
+      check_identical("BodyVelPush untouched", vel_push, given.vel_push);
+      check_identical("BodyAngMomPush untouched", angmom_push, given.angmom_push);
+    }
+    check_that("the impulses change most bodies' velocities", b < 3 || changed >= b / 2);
+    check_that("the counting pass counts contacts and stamps particles",
+               !counting || nr < 31 || (counted >= b / 2 && stamped > 0));
+    end_case();
+  }
+};
+
+World apply_world(std::uint32_t seed, std::size_t n) {
+  return random_world(seed, n, MOTES_FLAG_IMPULSE);
+}
+
+TEST_P(ImpulsesApply, Empty) { run_case("random", apply_world(81, 0), 0u); }
+TEST_P(ImpulsesApply, One) { run_case("random", apply_world(82, 1), 0u); }
+TEST_P(ImpulsesApply, Random31) { run_case("random", apply_world(83, 31), 0u); }
+TEST_P(ImpulsesApply, Random1234) { run_case("random", apply_world(84, 1234), 0u); }
+TEST_P(ImpulsesApply, Random65536) { run_case("random", apply_world(85, 65536), 0u); }
+TEST_P(ImpulsesApply, Count31) { run_case("count", apply_world(86, 31), MOTES_FLAG_IMPULSE_COUNT); }
+TEST_P(ImpulsesApply, Count1234) {
+  run_case("count", apply_world(87, 1234), MOTES_FLAG_IMPULSE_COUNT);
+}
+TEST_P(ImpulsesApply, Count65536) {
+  run_case("count", apply_world(88, 65536), MOTES_FLAG_IMPULSE_COUNT);
+}
+TEST_P(ImpulsesApply, Push1234) {
+  run_case("push", apply_world(89, 1234), MOTES_FLAG_IMPULSE_PUSH);
+}
+TEST_P(ImpulsesApply, Push65536) {
+  run_case("push", apply_world(90, 65536), MOTES_FLAG_IMPULSE_PUSH);
+}
+
+INSTANTIATE_TEST_SUITE_P(Conformance, ImpulsesApply, testing::ValuesIn(device_params()),
+                         param_name);
+
+}  // namespace
+}  // namespace motes_conf

@@ -1,0 +1,58 @@
+// The oracle of contacts_compute (reference.h has the contract): O(N^2) over all pairs, no grid,
+// each particle's terms summed in double in id order and rounded once.
+#include <cstddef>
+
+#include "reference.h"
+#include "shared/contact_force.h"
+
+namespace motes_ref {
+
+using motes::shared::vec3;
+using motes::shared::xyz;
+
+std::vector<vec4> contacts_compute(const Particles& particles, const std::vector<ContactLaw>& laws,
+                                   const std::vector<PlaneData>& planes, const StepParams& p) {
+  const std::size_t n = particles.size();
+  const std::size_t m = p.material_count;
+  std::vector<vec4> force(n, vec4(0.0f));
+  for (std::size_t i = 0; i < n; ++i) {
+    const vec4 xi = particles.pos[i];
+    const vec4 vi = particles.vel[i];
+    if (vi.w == 0.0f) continue;  // static particles get no force
+    double sum[3] = {0.0, 0.0, 0.0};
+    auto add = [&](vec3 f) {
+      sum[0] += static_cast<double>(f.x);
+      sum[1] += static_cast<double>(f.y);
+      sum[2] += static_cast<double>(f.z);
+    };
+    for (std::size_t j = 0; j < n; ++j) {
+      const vec4 xj = particles.pos[j];
+      // Apart along x by the radii's sum or more: particle_contact_force returns 0 (its float
+      // dx * dx alone reaches rsum * rsum), which adds nothing.
+      const float dx = xj.x - xi.x;
+      if (dx >= xi.w + xj.w || -dx >= xi.w + xj.w) continue;
+      const vec4 vj = particles.vel[j];
+      const ContactLaw law = laws[particles.material[i] * m + particles.material[j]];
+      const vec3 f = motes::shared::particle_contact_force(xyz(xi), xyz(vi), xi.w, vi.w, xyz(xj),
+                                                           xyz(vj), xj.w, vj.w, law, p.flags);
+      // A zero term adds nothing (the sum starts at +0 and so is never -0): the exclusions, a set
+      // lookup, are asked only of pairs that touch.
+      if (f.x == 0.0f && f.y == 0.0f && f.z == 0.0f) continue;
+      if (motes::shared::contact_excluded(particles.body[j], particles.body[i]) ||
+          particles.never_touch.count({uint(i), uint(j)}) != 0) {
+        continue;  // j == i, or j never touches i
+      }
+      add(f);
+    }
+    for (std::size_t k = 0; k < p.plane_count; ++k) {
+      const ContactLaw law = laws[particles.material[i] * m + planes[k].material];
+      add(motes::shared::plane_contact_force(xyz(xi), xyz(vi), xi.w, vi.w, planes[k].normal_offset,
+                                             law, p.flags));
+    }
+    force[i] = vec4(static_cast<float>(sum[0]), static_cast<float>(sum[1]),
+                    static_cast<float>(sum[2]), 0.0f);
+  }
+  return force;
+}
+
+}  // namespace motes_ref

@@ -1,0 +1,47 @@
+// The oracle of impulses_apply (reference.h has the contract): each dynamic body's particles'
+// impulses and moments summed in float in particle order, then the shared body_apply_impulse, body
+// after body.
+#include <cstddef>
+
+#include "reference.h"
+#include "shared/impulse.h"
+
+namespace motes_ref {
+
+using motes::shared::vec3;
+using motes::shared::xyz;
+
+void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s) {
+  const bool counting = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
+  const bool push = (p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u;
+  if (push) {
+    s.vel_push.resize(bodies.size(), vec4(0.0f));
+    s.angmom_push.resize(bodies.size(), vec4(0.0f));
+  }
+  for (std::size_t b = 0; b < bodies.size(); ++b) {
+    vec4 sum(0.0f);
+    vec3 m(0.0f);
+    if (bodies.pos[b].w != 0.0f) {
+      for (uint i = bodies.first[b]; i < bodies.first[b + 1]; ++i) {
+        sum = sum + s.impulse[i];
+        m += xyz(s.moment[i]);
+      }
+    }
+    if (counting) {
+      s.vel0[b] = vec4(xyz(bodies.vel[b]), sum.w);
+      s.angvel0[b] = bodies.angvel[b];
+      if (bodies.pos[b].w != 0.0f) {
+        for (uint i = bodies.first[b]; i < bodies.first[b + 1]; ++i) s.stamp[i] = s.builds;
+      }
+    }
+    motes::shared::body_apply_impulse(bodies.pos[b], bodies.quat[b], bodies.inv_inertia[b],
+                                      bodies.vel[b], bodies.angmom[b], bodies.angvel[b], xyz(sum),
+                                      m);
+    if (push) {
+      s.vel_push[b] = bodies.vel[b];
+      s.angmom_push[b] = bodies.angmom[b];
+    }
+  }
+}
+
+}  // namespace motes_ref
