@@ -110,8 +110,7 @@ Status OpenMPDevice::allocate(const Sizes& sizes) {
     keys_tmp_.assign(sizes.particles, 0);
     ids_tmp_.assign(sizes.particles, 0);
     buffers_ = std::move(fresh);
-    impulse_mirror_.clear();
-    impulse_contacts_ready_ = false;
+    forget_impulse_passes();
   } catch (const std::bad_alloc&) {
     return Status::error(
         fmt::format("out of host memory allocating {} particles and {} bodies on the openmp device",
@@ -131,6 +130,10 @@ Status OpenMPDevice::write(Buffer b, const void* src, std::size_t bytes) {
   if (bytes > 0) std::memcpy(buffers_[i].data(), src, bytes);
   impulse_contacts_ready_ = false;  // what the kept contact frames were made from may have changed
   if (b == Buffer::NeighbourList || b == Buffer::NeighbourCount) impulse_mirror_.clear();
+  // New positions or lists: the last counting pass no longer says who touches whom.
+  if (b == Buffer::ParticlePos || b == Buffer::NeighbourList || b == Buffer::NeighbourCount) {
+    forget_impulse_passes();
+  }
   return Status::ok();
 }
 
@@ -156,6 +159,15 @@ void OpenMPDevice::enqueue(Kernel k, const shared::StepParams& p) {
     case Kernel::Count:
       break;
   }
+}
+
+void OpenMPDevice::forget_impulse_passes() {
+  impulse_mirror_.clear();
+  impulse_touches_.clear();
+  impulse_active_.clear();
+  impulse_body_active_.clear();
+  impulse_frames_.clear();
+  impulse_contacts_ready_ = false;
 }
 
 Status OpenMPDevice::check_guards() {

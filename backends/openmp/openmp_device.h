@@ -146,6 +146,9 @@ class OpenMPDevice final : public Device {
   std::vector<std::uint32_t> impulse_entries_, impulse_entry_first_, impulse_slot_contact_;
   std::vector<shared::ImpulseBody> impulse_bodies_;
   bool impulse_contacts_ready_ = false, impulse_responses_ready_ = false;
+  /// Drops what the last counting pass found (after allocate, or a write of positions or lists):
+  /// the next sweep without a counting pass visits every particle.
+  void forget_impulse_passes();
   bool timing_ = false;
   KernelTimes times_;
 };

@@ -51,7 +51,10 @@
 //   plane_contact_impulse over the planes; w = the contacts counted; ParticleMoment = the sum of
 //   (c - x_com) x J; the contacts' accumulated impulses in ContactImpulse (ImpulseStamp says
 //   which are valid). Static particles get 0. With MOTES_FLAG_IMPULSE_COUNT the same (only w is
-//   used).
+//   used). A sweep (no MOTES_FLAG_IMPULSE_COUNT) after its substep's counting pass, positions and
+//   lists unchanged since, may visit only the particles that pass found within reach of a
+//   contact (the others' impulses are 0, as the step needs); a backend that keeps that must forget
+//   it at allocate and at a write of positions or lists.
 // impulses_apply: every dynamic body sums its particles' ParticleForce and ParticleMoment in
 //   particle order, then shared/impulse.h: body_apply_impulse (BodyVel, BodyAngMom, BodyAngVel).
 //   With MOTES_FLAG_IMPULSE_COUNT instead: BodyVelStart = (BodyVel xyz, the summed count),
