@@ -5,8 +5,8 @@
 // As backends/openmp/contacts_compute.cpp and shaders/contacts_compute.comp. The list's entry k of
 // particle i is at k * N + i, so a warp's loads of its k-th entries are one coalesced read.
 #include "cuda_device.h"
-#include "grid_walk.cuh"
 #include "shared/contact_force.h"
+#include "shared/grid_walk.h"
 #include "shared/links.h"
 
 namespace motes::cuda {
@@ -62,7 +62,7 @@ __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
     for (uint k = 0; k < c; ++k) add_contact(in.list[std::size_t{k} * stride + i]);
   } else {
     const uint body_i = in.body[i];
-    grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
+    shared::grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
       for (uint t = lo; t < hi; ++t) {
         const uint j = in.order[t];
         if (!shared::contact_skipped(body_i, in.sbody[t], uint(i), j, in.exclusions,

@@ -7,7 +7,7 @@
 // ContactImpulse (valid while ImpulseStamp matches the lists' build). As
 // backends/openmp/impulses_compute.cpp and shaders/impulses_compute.comp.
 #include "cuda_device.h"
-#include "grid_walk.cuh"
+#include "shared/grid_walk.h"
 #include "shared/impulse.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
@@ -97,7 +97,7 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
       add_contact(j, slotted ? acc + std::size_t{k} * nr + i : nullptr);
     }
   } else {
-    grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
+    shared::grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
       for (uint s = lo; s < hi; ++s) {
         if (!shared::contact_excluded(in.sbody[s], bi)) add_contact(in.order[s], nullptr);
       }

@@ -5,9 +5,9 @@
 #include <chrono>
 #include <cstdint>
 
-#include "grid_walk.h"
 #include "openmp_device.h"
 #include "shared/contact_force.h"
+#include "shared/grid_walk.h"
 #include "shared/links.h"
 
 namespace motes::openmp {
@@ -63,16 +63,15 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
       for (uint k = 0; k < c; ++k) add_contact(list[std::size_t{k} * stride + std::size_t(i)]);
     } else {
       const uint body_i = body[i];
-      const GridRanges ranges = grid_walk(p, ref[i], cell_start);
-      for (int r = 0; r < ranges.count; ++r) {
-        for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
+      shared::grid_walk(p, ref[i], cell_start, [&](uint lo, uint hi) {
+        for (uint t = lo; t < hi; ++t) {
           const uint j = order[t];
           if (!shared::contact_skipped(body_i, sbody[t], uint(i), j, exclusions, p.particle_count,
                                        p.linked_first)) {
             add_contact(j);
           }
         }
-      }
+      });
     }
     for (uint k = 0; k < (by_impulse ? 0u : p.plane_count); ++k) {
       const shared::PlaneData pl = planes[k];

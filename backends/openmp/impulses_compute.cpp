@@ -11,8 +11,8 @@
 #include <chrono>
 #include <cstdint>
 
-#include "grid_walk.h"
 #include "openmp_device.h"
+#include "shared/grid_walk.h"
 #include "shared/impulse.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
@@ -214,12 +214,11 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
         add_contact(j, slotted ? acc + std::size_t{k} * nr + std::size_t(i) : nullptr);
       }
     } else {
-      const GridRanges ranges = grid_walk(p, ref[i], cell_start);
-      for (int r = 0; r < ranges.count; ++r) {
-        for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
+      shared::grid_walk(p, ref[i], cell_start, [&](uint lo, uint hi) {
+        for (uint t = lo; t < hi; ++t) {
           if (!shared::contact_excluded(sbody[t], bi)) add_contact(order[t], nullptr);
         }
-      }
+      });
     }
     for (uint k = 0; k < p.plane_count; ++k) {
       const shared::PlaneData pl = planes[k];
