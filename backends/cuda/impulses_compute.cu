@@ -20,19 +20,8 @@ using shared::vec4;
 
 namespace {
 
-struct ImpulseInputs {
-  const vec4* __restrict__ pos;
-  const vec4* __restrict__ vel;
-  const uint* __restrict__ body;
-  const uint* __restrict__ material;
-  const uint* __restrict__ list;
-  const uint* __restrict__ count;
-  const vec4* __restrict__ ref;
-  const uint* __restrict__ order;
-  const uint* __restrict__ cell_start;
-  const uint* __restrict__ sbody;
-  const shared::ContactLaw* __restrict__ laws;
-  const shared::PlaneData* __restrict__ planes;
+/// impulses_compute's inputs: those of every contact, and the bodies' state.
+struct ImpulseInputs : ContactInputs {
   const vec4* __restrict__ com;
   const vec4* __restrict__ quat;
   const vec4* __restrict__ inv_inertia;
@@ -119,18 +108,7 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
 
 void CudaDevice::launch_impulses_compute(const shared::StepParams& p) {
   if (p.rigid_particle_count == 0) return;
-  const ImpulseInputs in{buf<vec4>(Buffer::ParticlePos),
-                         buf<vec4>(Buffer::ParticleVel),
-                         buf<uint>(Buffer::ParticleBody),
-                         buf<uint>(Buffer::ParticleMaterial),
-                         buf<uint>(Buffer::NeighbourList),
-                         buf<uint>(Buffer::NeighbourCount),
-                         buf<vec4>(Buffer::NeighbourRefPos),
-                         buf<uint>(Buffer::GridOrder),
-                         buf<uint>(Buffer::GridCellStart),
-                         buf<uint>(Buffer::SortedBody),
-                         buf<shared::ContactLaw>(Buffer::ContactLaws),
-                         buf<shared::PlaneData>(Buffer::Planes),
+  const ImpulseInputs in{contact_inputs(),
                          buf<vec4>(Buffer::BodyPos),
                          buf<vec4>(Buffer::BodyQuat),
                          buf<vec4>(Buffer::BodyInvInertia),
