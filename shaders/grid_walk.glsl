@@ -1,6 +1,7 @@
 // The canonical 27-cell walk of the hashed grid (docs/architecture.md): the sorted ranges a
-// particle visits, in order, as backends/openmp/grid_walk.h. Used by neighbours_build and by
-// contacts_compute's fallback for particles with more neighbours than their list holds.
+// particle visits, in order, as shared/grid_walk.h (C++ and CUDA). Used by neighbours_build and by
+// the fallback of contacts_compute and impulses_compute for particles with more neighbours than
+// their list holds.
 // Needs kernel_common.glsl and shared/grid_hash.h.
 #ifndef MOTES_GRID_WALK_GLSL
 #define MOTES_GRID_WALK_GLSL

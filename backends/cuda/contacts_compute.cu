@@ -5,8 +5,8 @@
 // As backends/openmp/contacts_compute.cpp and shaders/contacts_compute.comp. The list's entry k of
 // particle i is at k * N + i, so a warp's loads of its k-th entries are one coalesced read.
 #include "cuda_device.h"
-#include "grid_walk.cuh"
 #include "shared/contact_force.h"
+#include "shared/grid_walk.h"
 #include "shared/links.h"
 
 namespace motes::cuda {
@@ -17,24 +17,10 @@ using shared::vec4;
 
 namespace {
 
-struct ContactInputs {
-  const vec4* __restrict__ pos;
-  const vec4* __restrict__ vel;
-  const uint* __restrict__ body;
-  const uint* __restrict__ material;
-  const uint* __restrict__ list;
-  const uint* __restrict__ count;
-  const vec4* __restrict__ ref;
-  const uint* __restrict__ order;
-  const uint* __restrict__ cell_start;
-  const uint* __restrict__ sbody;
-  const shared::ContactLaw* __restrict__ laws;
-  const shared::PlaneData* __restrict__ planes;
-  const uint* __restrict__ exclusions;  ///< LinkExclusions (shared/links.h)
-};
-
+/// exclusions: LinkExclusions (shared/links.h), for the grid walk; not __restrict__, as when it was
+/// a member of the inputs (a __restrict__ parameter moves its loads to the read-only path).
 __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
-                                        vec4* __restrict__ force) {
+                                        const uint* exclusions, vec4* __restrict__ force) {
   const std::uint64_t i = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
   if (i >= p.particle_count) return;
   const vec4 pi = in.pos[i];
@@ -62,11 +48,11 @@ __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
     for (uint k = 0; k < c; ++k) add_contact(in.list[std::size_t{k} * stride + i]);
   } else {
     const uint body_i = in.body[i];
-    grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
+    shared::grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
       for (uint t = lo; t < hi; ++t) {
         const uint j = in.order[t];
-        if (!shared::contact_skipped(body_i, in.sbody[t], uint(i), j, in.exclusions,
-                                     p.particle_count, p.linked_first)) {
+        if (!shared::contact_skipped(body_i, in.sbody[t], uint(i), j, exclusions, p.particle_count,
+                                     p.linked_first)) {
           add_contact(j);
         }
       }
@@ -84,21 +70,8 @@ __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
 
 void CudaDevice::launch_contacts_compute(const shared::StepParams& p) {
   if (p.particle_count == 0) return;
-  const ContactInputs in{buf<vec4>(Buffer::ParticlePos),
-                         buf<vec4>(Buffer::ParticleVel),
-                         buf<uint>(Buffer::ParticleBody),
-                         buf<uint>(Buffer::ParticleMaterial),
-                         buf<uint>(Buffer::NeighbourList),
-                         buf<uint>(Buffer::NeighbourCount),
-                         buf<vec4>(Buffer::NeighbourRefPos),
-                         buf<uint>(Buffer::GridOrder),
-                         buf<uint>(Buffer::GridCellStart),
-                         buf<uint>(Buffer::SortedBody),
-                         buf<shared::ContactLaw>(Buffer::ContactLaws),
-                         buf<shared::PlaneData>(Buffer::Planes),
-                         buf<uint>(Buffer::LinkExclusions)};
   contacts_compute_kernel<<<blocks_for(p.particle_count), kBlock, 0, stream_>>>(
-      p, in, buf<vec4>(Buffer::ParticleForce));
+      p, contact_inputs(), buf<uint>(Buffer::LinkExclusions), buf<vec4>(Buffer::ParticleForce));
 }
 
 }  // namespace motes::cuda

@@ -249,6 +249,15 @@ HaloBodies CudaDevice::halo_bodies() const {
            buf<shared::vec4>(Buffer::BodyAngVel)}};
 }
 
+ContactInputs CudaDevice::contact_inputs() const {
+  return {buf<shared::vec4>(Buffer::ParticlePos),       buf<shared::vec4>(Buffer::ParticleVel),
+          buf<shared::uint>(Buffer::ParticleBody),      buf<shared::uint>(Buffer::ParticleMaterial),
+          buf<shared::uint>(Buffer::NeighbourList),     buf<shared::uint>(Buffer::NeighbourCount),
+          buf<shared::vec4>(Buffer::NeighbourRefPos),   buf<shared::uint>(Buffer::GridOrder),
+          buf<shared::uint>(Buffer::GridCellStart),     buf<shared::uint>(Buffer::SortedBody),
+          buf<shared::ContactLaw>(Buffer::ContactLaws), buf<shared::PlaneData>(Buffer::Planes)};
+}
+
 void CudaDevice::update_fusable() {
   // Bodies of up to this many particles take the fused pass (one thread per body, looping over
   // its particles). Measured on an H100: a win for free spheres (W1), a loss for 15-particle

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "body_buffers.h"
+#include "contact_inputs.h"
 #include "halo_buffers.h"
 #include "motes/backend/device.h"
 #include "motes/backend/kernel_queue.h"
@@ -109,6 +110,8 @@ class CudaDevice final : public Device {
   [[nodiscard]] BodyBuffers body_buffers() const;
   /// The body buffers of a halo entry, in HaloData's order.
   [[nodiscard]] HaloBodies halo_bodies() const;
+  /// The buffers of contacts_compute and impulses_compute.
+  [[nodiscard]] ContactInputs contact_inputs() const;
 
   DeviceInfo info_;
   int ordinal_ = 0;

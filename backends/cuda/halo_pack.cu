@@ -3,6 +3,7 @@
 // whole vec4s, so the bits are those of every other backend.
 #include "cuda_device.h"
 #include "halo_buffers.h"
+#include "halo_entries.cuh"
 
 namespace motes::cuda {
 
@@ -14,22 +15,17 @@ namespace {
 __global__ void halo_pack_kernel(shared::StepParams p, const uint* __restrict__ index,
                                  const vec4* __restrict__ pos, const vec4* __restrict__ vel,
                                  HaloBodies bodies, vec4* __restrict__ data) {
-  const std::uint64_t np = p.halo_particles;
-  const std::uint64_t total = np + p.halo_bodies;
-  const std::uint64_t stride = std::uint64_t{gridDim.x} * blockDim.x;
-  for (std::uint64_t t = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x; t < total;
-       t += stride) {
-    const uint i = index[p.halo_first + t];
-    if (t < np) {
-      if (i >= p.particle_count) continue;  // not a particle: the entry is left as it is
-      data[MOTES_HALO_PARTICLE_VEC4S * t] = pos[i];
-      data[MOTES_HALO_PARTICLE_VEC4S * t + 1] = vel[i];
-    } else {
-      if (i >= p.body_count) continue;
-      vec4* out = data + MOTES_HALO_PARTICLE_VEC4S * np + MOTES_HALO_BODY_VEC4S * (t - np);
-      for (uint c = 0; c < MOTES_HALO_BODY_VEC4S; ++c) out[c] = bodies.state[c][i];
-    }
-  }
+  // An entry that names no particle or body is left as it is.
+  halo_entries(
+      p, index,
+      [&](std::uint64_t t, uint i) {
+        data[MOTES_HALO_PARTICLE_VEC4S * t] = pos[i];
+        data[MOTES_HALO_PARTICLE_VEC4S * t + 1] = vel[i];
+      },
+      [&](std::uint64_t at, uint i) {
+        vec4* out = data + at;
+        for (uint c = 0; c < MOTES_HALO_BODY_VEC4S; ++c) out[c] = bodies.state[c][i];
+      });
 }
 
 }  // namespace

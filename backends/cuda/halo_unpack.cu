@@ -3,6 +3,7 @@
 // wrote is too far from its NeighbourRefPos (one store per block at most).
 #include "cuda_device.h"
 #include "halo_buffers.h"
+#include "halo_entries.cuh"
 #include "shared/neighbours.h"
 
 namespace motes::cuda {
@@ -16,25 +17,20 @@ __global__ void halo_unpack_kernel(shared::StepParams p, const uint* __restrict_
                                    const vec4* __restrict__ data, const vec4* __restrict__ ref,
                                    vec4* __restrict__ pos, vec4* __restrict__ vel,
                                    HaloBodies bodies, uint* __restrict__ state) {
-  const std::uint64_t np = p.halo_particles;
-  const std::uint64_t total = np + p.halo_bodies;
-  const std::uint64_t stride = std::uint64_t{gridDim.x} * blockDim.x;
   bool moved = false;
-  for (std::uint64_t t = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x; t < total;
-       t += stride) {
-    const uint i = index[p.halo_first + t];
-    if (t < np) {
-      if (i >= p.particle_count) continue;  // not a particle: nothing written
-      const vec4 x = data[MOTES_HALO_PARTICLE_VEC4S * t];
-      pos[i] = x;
-      vel[i] = data[MOTES_HALO_PARTICLE_VEC4S * t + 1];
-      moved = shared::neighbour_moved_too_far(x, ref[i], p.neighbour_skin) || moved;
-    } else {
-      if (i >= p.body_count) continue;
-      const vec4* in = data + MOTES_HALO_PARTICLE_VEC4S * np + MOTES_HALO_BODY_VEC4S * (t - np);
-      for (uint c = 0; c < MOTES_HALO_BODY_VEC4S; ++c) bodies.state[c][i] = in[c];
-    }
-  }
+  // An entry that names no particle or body writes nothing.
+  halo_entries(
+      p, index,
+      [&](std::uint64_t t, uint i) {
+        const vec4 x = data[MOTES_HALO_PARTICLE_VEC4S * t];
+        pos[i] = x;
+        vel[i] = data[MOTES_HALO_PARTICLE_VEC4S * t + 1];
+        moved |= shared::neighbour_moved_too_far(x, ref[i], p.neighbour_skin);
+      },
+      [&](std::uint64_t at, uint i) {
+        const vec4* in = data + at;
+        for (uint c = 0; c < MOTES_HALO_BODY_VEC4S; ++c) bodies.state[c][i] = in[c];
+      });
   // Every thread of the block reaches this (no early return above).
   if (__syncthreads_or(moved) != 0 && threadIdx.x == 0) state[MOTES_NEIGHBOUR_REBUILD] = 1;
 }

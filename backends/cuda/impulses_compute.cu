@@ -7,7 +7,7 @@
 // ContactImpulse (valid while ImpulseStamp matches the lists' build). As
 // backends/openmp/impulses_compute.cpp and shaders/impulses_compute.comp.
 #include "cuda_device.h"
-#include "grid_walk.cuh"
+#include "shared/grid_walk.h"
 #include "shared/impulse.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
@@ -20,19 +20,8 @@ using shared::vec4;
 
 namespace {
 
-struct ImpulseInputs {
-  const vec4* __restrict__ pos;
-  const vec4* __restrict__ vel;
-  const uint* __restrict__ body;
-  const uint* __restrict__ material;
-  const uint* __restrict__ list;
-  const uint* __restrict__ count;
-  const vec4* __restrict__ ref;
-  const uint* __restrict__ order;
-  const uint* __restrict__ cell_start;
-  const uint* __restrict__ sbody;
-  const shared::ContactLaw* __restrict__ laws;
-  const shared::PlaneData* __restrict__ planes;
+/// impulses_compute's inputs: those of every contact, and the bodies' state.
+struct ImpulseInputs : ContactInputs {
   const vec4* __restrict__ com;
   const vec4* __restrict__ quat;
   const vec4* __restrict__ inv_inertia;
@@ -97,7 +86,7 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
       add_contact(j, slotted ? acc + std::size_t{k} * nr + i : nullptr);
     }
   } else {
-    grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
+    shared::grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
       for (uint s = lo; s < hi; ++s) {
         if (!shared::contact_excluded(in.sbody[s], bi)) add_contact(in.order[s], nullptr);
       }
@@ -119,18 +108,7 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
 
 void CudaDevice::launch_impulses_compute(const shared::StepParams& p) {
   if (p.rigid_particle_count == 0) return;
-  const ImpulseInputs in{buf<vec4>(Buffer::ParticlePos),
-                         buf<vec4>(Buffer::ParticleVel),
-                         buf<uint>(Buffer::ParticleBody),
-                         buf<uint>(Buffer::ParticleMaterial),
-                         buf<uint>(Buffer::NeighbourList),
-                         buf<uint>(Buffer::NeighbourCount),
-                         buf<vec4>(Buffer::NeighbourRefPos),
-                         buf<uint>(Buffer::GridOrder),
-                         buf<uint>(Buffer::GridCellStart),
-                         buf<uint>(Buffer::SortedBody),
-                         buf<shared::ContactLaw>(Buffer::ContactLaws),
-                         buf<shared::PlaneData>(Buffer::Planes),
+  const ImpulseInputs in{contact_inputs(),
                          buf<vec4>(Buffer::BodyPos),
                          buf<vec4>(Buffer::BodyQuat),
                          buf<vec4>(Buffer::BodyInvInertia),

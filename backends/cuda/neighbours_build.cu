@@ -5,7 +5,7 @@
 // NeighbourState, then a thread per particle; the build's figures are reduced per block and added
 // with integer atomics.
 #include "cuda_device.h"
-#include "grid_walk.cuh"
+#include "shared/grid_walk.h"
 #include "shared/impulse.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
@@ -61,7 +61,7 @@ __global__ void neighbours_build_kernel(shared::StepParams p, BuildInputs in, Bu
     if (in.vel[i].w != 0.0f) {  // static particles never move and get no force
       const uint body_i = in.body[i];
       const std::size_t stride = p.particle_count;
-      grid_walk(p, pi, in.cell_start, [&](uint lo, uint hi) {
+      shared::grid_walk(p, pi, in.cell_start, [&](uint lo, uint hi) {
         for (uint t = lo; t < hi; ++t) {
           const uint j = in.order[t];
           if (shared::contact_skipped(body_i, in.sbody[t], uint(i), j, in.exclusions,

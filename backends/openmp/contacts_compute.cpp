@@ -5,9 +5,9 @@
 #include <chrono>
 #include <cstdint>
 
-#include "grid_walk.h"
 #include "openmp_device.h"
 #include "shared/contact_force.h"
+#include "shared/grid_walk.h"
 #include "shared/links.h"
 
 namespace motes::openmp {
@@ -22,60 +22,48 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
   const std::size_t stride = p.particle_count;
   const uint capacity = p.neighbour_capacity;
   const uint materials = p.material_count;
-  const vec4* pos = buf<vec4>(Buffer::ParticlePos);
-  const vec4* vel = buf<vec4>(Buffer::ParticleVel);
-  const uint* body = buf<uint>(Buffer::ParticleBody);
-  const uint* material = buf<uint>(Buffer::ParticleMaterial);
-  const uint* list = buf<uint>(Buffer::NeighbourList);
-  const uint* count = buf<uint>(Buffer::NeighbourCount);
-  const vec4* ref = buf<vec4>(Buffer::NeighbourRefPos);
-  const uint* order = buf<uint>(Buffer::GridOrder);
-  const uint* cell_start = buf<uint>(Buffer::GridCellStart);
-  const uint* sbody = buf<uint>(Buffer::SortedBody);
+  const ContactInputs in = contact_inputs();
   const uint* exclusions = buf<uint>(Buffer::LinkExclusions);
-  const auto* laws = buf<shared::ContactLaw>(Buffer::ContactLaws);
-  const auto* planes = buf<shared::PlaneData>(Buffer::Planes);
   vec4* force = buf<vec4>(Buffer::ParticleForce);
 
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
   for (std::int64_t i = 0; i < n; ++i) {
-    const vec4 pi = pos[i];
-    const vec4 vi = vel[i];
+    const vec4 pi = in.pos[i];
+    const vec4 vi = in.vel[i];
     if (vi.w == 0.0f) {  // static particle: its force is never used
       force[i] = vec4(0.0f);
       continue;
     }
     const vec3 xi = shared::xyz(pi);
     const vec3 ui = shared::xyz(vi);
-    const shared::ContactLaw* law_row = laws + std::size_t{material[i]} * materials;
+    const shared::ContactLaw* law_row = in.laws + std::size_t{in.material[i]} * materials;
     vec3 f(0.0f);
     // The force of particle j on i (zero unless they overlap), added in order.
     const bool by_impulse = shared::impulse_particle(p.flags, uint(i), p.rigid_particle_count);
     auto add_contact = [&](uint j) {
       if (by_impulse && j < p.rigid_particle_count) return;
-      const vec4 pj = pos[j];
-      const vec4 vj = vel[j];
+      const vec4 pj = in.pos[j];
+      const vec4 vj = in.vel[j];
       f += shared::particle_contact_force(xi, ui, pi.w, vi.w, shared::xyz(pj), shared::xyz(vj),
-                                          pj.w, vj.w, law_row[material[j]], p.flags);
+                                          pj.w, vj.w, law_row[in.material[j]], p.flags);
     };
-    const uint c = count[i];
+    const uint c = in.count[i];
     if (c <= capacity) {
-      for (uint k = 0; k < c; ++k) add_contact(list[std::size_t{k} * stride + std::size_t(i)]);
+      for (uint k = 0; k < c; ++k) add_contact(in.list[std::size_t{k} * stride + std::size_t(i)]);
     } else {
-      const uint body_i = body[i];
-      const GridRanges ranges = grid_walk(p, ref[i], cell_start);
-      for (int r = 0; r < ranges.count; ++r) {
-        for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
-          const uint j = order[t];
-          if (!shared::contact_skipped(body_i, sbody[t], uint(i), j, exclusions, p.particle_count,
-                                       p.linked_first)) {
+      const uint body_i = in.body[i];
+      shared::grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
+        for (uint t = lo; t < hi; ++t) {
+          const uint j = in.order[t];
+          if (!shared::contact_skipped(body_i, in.sbody[t], uint(i), j, exclusions,
+                                       p.particle_count, p.linked_first)) {
             add_contact(j);
           }
         }
-      }
+      });
     }
     for (uint k = 0; k < (by_impulse ? 0u : p.plane_count); ++k) {
-      const shared::PlaneData pl = planes[k];
+      const shared::PlaneData pl = in.planes[k];
       f += shared::plane_contact_force(xi, ui, pi.w, vi.w, pl.normal_offset, law_row[pl.material],
                                        p.flags);
     }

@@ -3,21 +3,13 @@
 #include <chrono>
 #include <cstdint>
 
+#include "halo_buffers.h"
 #include "openmp_device.h"
-#include "shared/halo.h"
 
 namespace motes::openmp {
 
 using shared::uint;
 using shared::vec4;
-
-namespace {
-
-/// The body buffers of a halo body entry, in HaloData's order.
-constexpr Buffer kBodyState[MOTES_HALO_BODY_VEC4S] = {
-    Buffer::BodyPos, Buffer::BodyQuat, Buffer::BodyVel, Buffer::BodyAngMom, Buffer::BodyAngVel};
-
-}  // namespace
 
 void OpenMPDevice::halo_pack(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
@@ -37,7 +29,7 @@ void OpenMPDevice::halo_pack(const shared::StepParams& p) {
   }
   vec4* bodies = data + MOTES_HALO_PARTICLE_VEC4S * np;
   for (uint c = 0; c < MOTES_HALO_BODY_VEC4S; ++c) {
-    const vec4* state = buf<vec4>(kBodyState[c]);
+    const vec4* state = buf<vec4>(kHaloBodyState[c]);
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(nb))
     for (std::int64_t j = 0; j < nb; ++j) {
       const uint b = index[first + np + j];

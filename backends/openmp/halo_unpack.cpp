@@ -4,22 +4,14 @@
 #include <chrono>
 #include <cstdint>
 
+#include "halo_buffers.h"
 #include "openmp_device.h"
-#include "shared/halo.h"
 #include "shared/neighbours.h"
 
 namespace motes::openmp {
 
 using shared::uint;
 using shared::vec4;
-
-namespace {
-
-/// The body buffers of a halo body entry, in HaloData's order.
-constexpr Buffer kBodyState[MOTES_HALO_BODY_VEC4S] = {
-    Buffer::BodyPos, Buffer::BodyQuat, Buffer::BodyVel, Buffer::BodyAngMom, Buffer::BodyAngVel};
-
-}  // namespace
 
 void OpenMPDevice::halo_unpack(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
@@ -45,7 +37,7 @@ void OpenMPDevice::halo_unpack(const shared::StepParams& p) {
   if (moved != 0) buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_REBUILD] = 1;
   const vec4* bodies = data + MOTES_HALO_PARTICLE_VEC4S * np;
   for (uint c = 0; c < MOTES_HALO_BODY_VEC4S; ++c) {
-    vec4* state = buf<vec4>(kBodyState[c]);
+    vec4* state = buf<vec4>(kHaloBodyState[c]);
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(nb))
     for (std::int64_t j = 0; j < nb; ++j) {
       const uint b = index[first + np + j];

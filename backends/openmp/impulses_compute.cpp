@@ -11,8 +11,8 @@
 #include <chrono>
 #include <cstdint>
 
-#include "grid_walk.h"
 #include "openmp_device.h"
+#include "shared/grid_walk.h"
 #include "shared/impulse.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
@@ -30,18 +30,7 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
   const uint capacity = p.neighbour_capacity;
   const uint materials = p.material_count;
   const float margin = shared::impulse_margin(p.neighbour_skin);
-  const vec4* pos = buf<vec4>(Buffer::ParticlePos);
-  const vec4* vel = buf<vec4>(Buffer::ParticleVel);
-  const uint* body = buf<uint>(Buffer::ParticleBody);
-  const uint* material = buf<uint>(Buffer::ParticleMaterial);
-  const uint* list = buf<uint>(Buffer::NeighbourList);
-  const uint* count = buf<uint>(Buffer::NeighbourCount);
-  const vec4* ref = buf<vec4>(Buffer::NeighbourRefPos);
-  const uint* order = buf<uint>(Buffer::GridOrder);
-  const uint* cell_start = buf<uint>(Buffer::GridCellStart);
-  const uint* sbody = buf<uint>(Buffer::SortedBody);
-  const auto* laws = buf<shared::ContactLaw>(Buffer::ContactLaws);
-  const auto* planes = buf<shared::PlaneData>(Buffer::Planes);
+  const ContactInputs in = contact_inputs();
   const vec4* com = buf<vec4>(Buffer::BodyPos);
   const vec4* quat = buf<vec4>(Buffer::BodyQuat);
   const vec4* inv_inertia = buf<vec4>(Buffer::BodyInvInertia);
@@ -85,13 +74,13 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     uint* mirror = impulse_mirror_.data();
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel_heavy(n))
     for (std::int64_t i = 0; i < n; ++i) {
-      const uint c = count[i];
-      if (vel[i].w == 0.0f || c > capacity) continue;
+      const uint c = in.count[i];
+      if (in.vel[i].w == 0.0f || c > capacity) continue;
       for (uint k = 0; k < c; ++k) {
-        const uint j = list[std::size_t{k} * stride + std::size_t(i)];
-        if (j >= p.rigid_particle_count || vel[j].w == 0.0f || count[j] > capacity) continue;
-        for (uint m = 0; m < count[j]; ++m) {
-          if (list[std::size_t{m} * stride + j] == uint(i)) {
+        const uint j = in.list[std::size_t{k} * stride + std::size_t(i)];
+        if (j >= p.rigid_particle_count || in.vel[j].w == 0.0f || in.count[j] > capacity) continue;
+        for (uint m = 0; m < in.count[j]; ++m) {
+          if (in.list[std::size_t{m} * stride + j] == uint(i)) {
             mirror[std::size_t{k} * nr + std::size_t(i)] = m;
             break;
           }
@@ -106,25 +95,25 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
   // The contacts of an active particle i in its mirrored slots with the higher ids, and with the
   // lower ids that are not active (none evaluates those for them: out of reach, the same result).
   const auto lower_pairs = [&](std::int64_t i, const std::uint8_t* active) {
-    const uint c = count[i];
-    if (vel[i].w == 0.0f || c > capacity) return;
-    const vec4 xi = pos[i];
+    const uint c = in.count[i];
+    if (in.vel[i].w == 0.0f || c > capacity) return;
+    const vec4 xi = in.pos[i];
     bool built = false;
     shared::ImpulseBody own;
     for (uint k = 0; k < c; ++k) {
       const std::size_t at = std::size_t{k} * nr + std::size_t(i);
       const uint m = mirror[at];
-      const uint j = list[std::size_t{k} * stride + std::size_t(i)];
+      const uint j = in.list[std::size_t{k} * stride + std::size_t(i)];
       if (m == kNoMirror || (j < uint(i) && active[j] != 0)) continue;
       if (!built) {
-        own = impulse_body(body[i]);
+        own = impulse_body(in.body[i]);
         built = true;
       }
       const std::size_t other_at = std::size_t{m} * nr + j;
       vec4 a = acc[at];
       const vec4 r = shared::pair_impulse(
-          own, xi, impulse_body(body[j]), pos[j], uint(i) < j, margin,
-          laws[shared::pair_law_index(uint(i), material[i], j, material[j], materials)],
+          own, xi, impulse_body(in.body[j]), in.pos[j], uint(i) < j, margin,
+          in.laws[shared::pair_law_index(uint(i), in.material[i], j, in.material[j], materials)],
           p.gravity_dt, p.flags, a);
       acc[at] = a;
       acc[other_at] = a;
@@ -137,13 +126,13 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
   // pass that keeps its contacts (impulses_count_kept) only finds which particles touch.
   bool defer = false;
   const auto particle = [&](std::int64_t i) {
-    const vec4 xi = pos[i];
-    if (vel[i].w == 0.0f) {  // static particle: its impulse is never used
+    const vec4 xi = in.pos[i];
+    if (in.vel[i].w == 0.0f) {  // static particle: its impulse is never used
       impulse[i] = vec4(0.0f);
       moment[i] = vec4(0.0f);
       return false;
     }
-    const uint c = count[i];
+    const uint c = in.count[i];
     if (counting && c <= capacity) {
       // Nothing within reach (the common case: most particles touch nothing): the result of the
       // full evaluation below, without building the bodies: every slot of a contact out of reach
@@ -151,22 +140,23 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
       const float reach_add = margin;
       bool touches = false;
       for (uint k = 0; k < c && !touches; ++k) {
-        const uint j = list[std::size_t{k} * stride + std::size_t(i)];
+        const uint j = in.list[std::size_t{k} * stride + std::size_t(i)];
         if (j >= p.rigid_particle_count) continue;
-        const vec4 xj = pos[j];
+        const vec4 xj = in.pos[j];
         const vec3 d = shared::xyz(xi) - shared::xyz(xj);
         const float dist2 = shared::dot(d, d);
         const float reach = xi.w + xj.w + reach_add;
         touches = dist2 < reach * reach && dist2 != 0.0f;
       }
       for (uint k = 0; k < p.plane_count && !touches; ++k) {
-        const vec4 no = planes[k].normal_offset;
+        const vec4 no = in.planes[k].normal_offset;
         touches = shared::dot(shared::xyz(no), shared::xyz(xi)) - no.w - xi.w < margin;
       }
       if (!touches) {
         for (uint k = 0; k < c; ++k) {
-          const uint j = list[std::size_t{k} * stride + std::size_t(i)];
-          if (j < p.rigid_particle_count && shared::impulse_pair_slotted(c, count[j], capacity)) {
+          const uint j = in.list[std::size_t{k} * stride + std::size_t(i)];
+          if (j < p.rigid_particle_count &&
+              shared::impulse_pair_slotted(c, in.count[j], capacity)) {
             acc[std::size_t{k} * nr + std::size_t(i)] = vec4(0.0f);
           }
         }
@@ -179,9 +169,9 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
       }
       if (defer) return true;
     }
-    const uint bi = body[i];
+    const uint bi = in.body[i];
     const shared::ImpulseBody own = impulse_body(bi);
-    const shared::ContactLaw* law_row = laws + std::size_t{material[i]} * materials;
+    const shared::ContactLaw* law_row = in.laws + std::size_t{in.material[i]} * materials;
     const uint own_stamp = stamp[i];
     vec4 sum(0.0f);
     vec3 moment_sum(0.0f);
@@ -189,40 +179,39 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     // accumulated impulse in slot `slot` (nullptr: none).
     auto add_contact = [&](uint j, vec4* slot) {
       if (j >= p.rigid_particle_count) return;
-      const vec4 xj = pos[j];
-      const shared::ImpulseBody other = impulse_body(body[j]);
+      const vec4 xj = in.pos[j];
+      const shared::ImpulseBody other = impulse_body(in.body[j]);
       const bool valid =
-          !counting || shared::impulse_slots_valid(own_stamp, stamp[j], vel[j].w, builds);
+          !counting || shared::impulse_slots_valid(own_stamp, stamp[j], in.vel[j].w, builds);
       vec4 a = slot != nullptr && valid ? *slot : vec4(0.0f);
       const vec4 r = shared::pair_impulse(
           own, xi, other, xj, static_cast<uint>(i) < j, margin,
-          laws[shared::pair_law_index(uint(i), material[i], j, material[j], materials)],
+          in.laws[shared::pair_law_index(uint(i), in.material[i], j, in.material[j], materials)],
           p.gravity_dt, p.flags, a);
       if (slot != nullptr) *slot = a;
       shared::impulse_add(sum, moment_sum, r, shared::pair_contact_point(xi, xj), own.com);
     };
     if (c <= capacity) {
       for (uint k = 0; k < c; ++k) {
-        const uint j = list[std::size_t{k} * stride + std::size_t(i)];
+        const uint j = in.list[std::size_t{k} * stride + std::size_t(i)];
         if (pairs_once && mirror[std::size_t{k} * nr + std::size_t(i)] != kNoMirror) {
           shared::impulse_add(sum, moment_sum, pair_r[std::size_t{k} * nr + std::size_t(i)],
-                              shared::pair_contact_point(xi, pos[j]), own.com);
+                              shared::pair_contact_point(xi, in.pos[j]), own.com);
           continue;
         }
         const bool slotted =
-            j < p.rigid_particle_count && shared::impulse_pair_slotted(c, count[j], capacity);
+            j < p.rigid_particle_count && shared::impulse_pair_slotted(c, in.count[j], capacity);
         add_contact(j, slotted ? acc + std::size_t{k} * nr + std::size_t(i) : nullptr);
       }
     } else {
-      const GridRanges ranges = grid_walk(p, ref[i], cell_start);
-      for (int r = 0; r < ranges.count; ++r) {
-        for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
-          if (!shared::contact_excluded(sbody[t], bi)) add_contact(order[t], nullptr);
+      shared::grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
+        for (uint t = lo; t < hi; ++t) {
+          if (!shared::contact_excluded(in.sbody[t], bi)) add_contact(in.order[t], nullptr);
         }
-      }
+      });
     }
     for (uint k = 0; k < p.plane_count; ++k) {
-      const shared::PlaneData pl = planes[k];
+      const shared::PlaneData pl = in.planes[k];
       vec4& a = acc[(std::size_t{capacity} + k) * nr + std::size_t(i)];
       const vec4 r = shared::plane_contact_impulse(own, xi, pl.normal_offset, margin,
                                                    law_row[pl.material], p.gravity_dt, p.flags, a);
@@ -241,7 +230,7 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     // (2), from kept contact frames where they can be (impulses_sweep.cpp), else here.
     defer = true;
     for_items(n, parallel_heavy(n), [&](std::int64_t i) {
-      touches[i] = particle(i) ? (count[i] <= capacity ? 2 : 1) : 0;
+      touches[i] = particle(i) ? (in.count[i] <= capacity ? 2 : 1) : 0;
     });
     defer = false;
     impulse_active_.clear();

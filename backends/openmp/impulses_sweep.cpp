@@ -29,16 +29,9 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
   const uint capacity = p.neighbour_capacity;
   const uint materials = p.material_count;
   const float margin = shared::impulse_margin(p.neighbour_skin);
-  const vec4* pos = buf<vec4>(Buffer::ParticlePos);
-  const uint* body = buf<uint>(Buffer::ParticleBody);
-  const uint* material = buf<uint>(Buffer::ParticleMaterial);
-  const uint* list = buf<uint>(Buffer::NeighbourList);
-  const uint* count = buf<uint>(Buffer::NeighbourCount);
-  const auto* laws = buf<shared::ContactLaw>(Buffer::ContactLaws);
-  const auto* planes = buf<shared::PlaneData>(Buffer::Planes);
+  const ContactInputs in = contact_inputs();
   const uint* stamp = buf<uint>(Buffer::ImpulseStamp);
   const uint builds = buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_BUILDS];
-  const vec4* vel = buf<vec4>(Buffer::ParticleVel);
   vec4* acc = buf<vec4>(Buffer::ContactImpulse);
   const uint wall = p.body_count;
   const shared::ImpulseBody* bodies = impulse_bodies_.data();
@@ -46,7 +39,7 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
   const std::uint8_t* touches = impulse_touches_.data();
   // Every contact of a particle beyond its list's capacity walks the grid: not kept.
   for (const uint i : active) {
-    if (count[i] > capacity) return false;
+    if (in.count[i] > capacity) return false;
   }
   const bool mirrored = impulse_mirror_.size() == std::size_t{capacity} * nr;
   impulse_contacts_.clear();
@@ -56,10 +49,10 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
   uint* slot_contact = impulse_slot_contact_.data();
   for (std::size_t a = 0; a < active.size(); ++a) {
     const uint i = active[a];
-    const vec4 xi = pos[i];
-    const uint c = count[i];
+    const vec4 xi = in.pos[i];
+    const uint c = in.count[i];
     for (uint k = 0; k < c; ++k) {
-      const uint j = list[std::size_t{k} * stride + i];
+      const uint j = in.list[std::size_t{k} * stride + i];
       if (j >= p.rigid_particle_count) continue;
       const std::size_t at = std::size_t{k} * nr + i;
       const uint m = mirrored ? impulse_mirror_[at] : kNone;
@@ -74,14 +67,14 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
       }
       // particle_contact_impulse's test and frame, the lower id as a.
       const bool own_first = i < j;
-      const vec4 xa = own_first ? xi : pos[j];
-      const vec4 xb = own_first ? pos[j] : xi;
+      const vec4 xa = own_first ? xi : in.pos[j];
+      const vec4 xb = own_first ? in.pos[j] : xi;
       const vec3 d = shared::xyz(xa) - shared::xyz(xb);
       const float dist2 = shared::dot(d, d);
       const float rsum = xa.w + xb.w;
       const float reach = rsum + margin;
       const bool near = !(dist2 >= reach * reach || dist2 == 0.0f);
-      const bool slotted = shared::impulse_pair_slotted(c, count[j], capacity);
+      const bool slotted = shared::impulse_pair_slotted(c, in.count[j], capacity);
       if (m != kNone) {
         slot_contact[std::size_t{m} * nr + j] = near ? uint(impulse_contacts_.size()) : kNone;
       }
@@ -91,9 +84,9 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
       }
       const float dist = shared::sqrt(dist2);
       ImpulseContact ct;
-      ct.a = own_first ? body[i] : body[j];
-      ct.b = own_first ? body[j] : body[i];
-      ct.law = laws[shared::pair_law_index(i, material[i], j, material[j], materials)];
+      ct.a = own_first ? in.body[i] : in.body[j];
+      ct.b = own_first ? in.body[j] : in.body[i];
+      ct.law = in.laws[shared::pair_law_index(i, in.material[i], j, in.material[j], materials)];
       ct.frame =
           shared::contact_frame(bodies[ct.a], bodies[ct.b], shared::pair_contact_point(xa, xb),
                                 d / dist, dist - rsum, rsum, ct.law.restitution, p.gravity_dt);
@@ -101,13 +94,13 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
       ct.slot = slotted ? uint(at) : kNone;
       ct.mirror = m != kNone ? uint(std::size_t{m} * nr + j) : kNone;
       // The counting pass's warm start (impulse_slots_valid, alike for both particles of a pair).
-      ct.warm = !counting || shared::impulse_slots_valid(stamp[i], stamp[j], vel[j].w, builds);
+      ct.warm = !counting || shared::impulse_slots_valid(stamp[i], stamp[j], in.vel[j].w, builds);
       impulse_entries_.push_back(uint(impulse_contacts_.size()) * 2u + (own_first ? 0u : 1u));
       impulse_contacts_.push_back(ct);
     }
-    const uint own_law = material[i] * materials;
+    const uint own_law = in.material[i] * materials;
     for (uint k = 0; k < p.plane_count; ++k) {
-      const vec4 no = planes[k].normal_offset;
+      const vec4 no = in.planes[k].normal_offset;
       const float sep = shared::dot(shared::xyz(no), shared::xyz(xi)) - no.w - xi.w;
       const std::size_t slot = (std::size_t{capacity} + k) * nr + i;
       if (sep >= margin) {  // plane_contact_impulse's test and clearing
@@ -115,9 +108,9 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
         continue;
       }
       ImpulseContact ct;
-      ct.a = body[i];
+      ct.a = in.body[i];
       ct.b = wall;
-      ct.law = laws[own_law + planes[k].material];
+      ct.law = in.laws[own_law + in.planes[k].material];
       ct.frame =
           shared::contact_frame(bodies[ct.a], bodies[wall], shared::plane_contact_point(xi, no),
                                 shared::xyz(no), sep, xi.w, ct.law.restitution, p.gravity_dt);

@@ -5,8 +5,8 @@
 #include <chrono>
 #include <cstdint>
 
-#include "grid_walk.h"
 #include "openmp_device.h"
+#include "shared/grid_walk.h"
 #include "shared/impulse.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
@@ -52,12 +52,11 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
       continue;
     }
     const uint body_i = body[i];
-    const GridRanges ranges = grid_walk(p, pi, cell_start);
     const uint old_count = count[i];
     bool same = true;
     uint c = 0;
-    for (int r = 0; r < ranges.count; ++r) {
-      for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
+    shared::grid_walk(p, pi, cell_start, [&](uint lo, uint hi) {
+      for (uint t = lo; t < hi; ++t) {
         const uint j = order[t];
         if (shared::contact_skipped(body_i, sbody[t], uint(i), j, exclusions, p.particle_count,
                                     p.linked_first) ||
@@ -71,7 +70,7 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
         }
         ++c;
       }
-    }
+    });
     count[i] = c;
     if (stamps && static_cast<std::size_t>(i) < sizes_.rigid_particles && stamp[i] == built &&
         shared::neighbour_keeps_slots(old_count, c, same, capacity)) {

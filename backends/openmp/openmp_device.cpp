@@ -180,6 +180,15 @@ Status OpenMPDevice::check_guards() {
   return Status::ok();
 }
 
+ContactInputs OpenMPDevice::contact_inputs() {
+  return {buf<shared::vec4>(Buffer::ParticlePos),       buf<shared::vec4>(Buffer::ParticleVel),
+          buf<shared::uint>(Buffer::ParticleBody),      buf<shared::uint>(Buffer::ParticleMaterial),
+          buf<shared::uint>(Buffer::NeighbourList),     buf<shared::uint>(Buffer::NeighbourCount),
+          buf<shared::vec4>(Buffer::NeighbourRefPos),   buf<shared::uint>(Buffer::GridOrder),
+          buf<shared::uint>(Buffer::GridCellStart),     buf<shared::uint>(Buffer::SortedBody),
+          buf<shared::ContactLaw>(Buffer::ContactLaws), buf<shared::PlaneData>(Buffer::Planes)};
+}
+
 void OpenMPDevice::record(Kernel k, std::chrono::steady_clock::time_point start) {
   if (!timing_) return;
   const auto i = static_cast<std::size_t>(k);

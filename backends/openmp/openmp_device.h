@@ -8,6 +8,7 @@
 #include <new>
 #include <vector>
 
+#include "contact_inputs.h"
 #include "motes/backend/device.h"
 #include "shared/impulse.h"
 
@@ -92,6 +93,8 @@ class OpenMPDevice final : public Device {
   T* buf(Buffer b) {
     return reinterpret_cast<T*>(buffers_[static_cast<std::size_t>(b)].data());
   }
+  /// The buffers of contacts_compute and impulses_compute (contact_inputs.h).
+  [[nodiscard]] ContactInputs contact_inputs();
   /// Stable LSD radix sort of (GridBucket[i], i) into (sorted_keys_, GridOrder).
   void sort_by_bucket(std::uint32_t n, std::uint32_t key_bits);
 
