@@ -34,5 +34,5 @@ for what in "$@"; do
     timeout "${LIMIT_AB:-240}" "$exe" bench --backend "$backend" $args >>"$log" 2>&1 || status=1
   done
 done
-grep -E "^== |ms/step|^\| " "$log" | tail -n 60
+grep -vE "^motes bench|^workload" "$log" | tail -n 60
 exit $status
