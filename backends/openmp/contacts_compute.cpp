@@ -22,48 +22,61 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
   const std::size_t stride = p.particle_count;
   const uint capacity = p.neighbour_capacity;
   const uint materials = p.material_count;
-  const ContactInputs in = contact_inputs();
+  const ContactInputs in = contact_inputs();  // local copies: the loop reads registers
+  const vec4* pos = in.pos;
+  const vec4* vel = in.vel;
+  const uint* body = in.body;
+  const uint* material = in.material;
+  const uint* list = in.list;
+  const uint* count = in.count;
+  const vec4* ref = in.ref;
+  const uint* order = in.order;
+  const uint* cell_start = in.cell_start;
+  const uint* sbody = in.sbody;
+  const auto* laws = in.laws;
+  const auto* planes = in.planes;
   const uint* exclusions = buf<uint>(Buffer::LinkExclusions);
   vec4* force = buf<vec4>(Buffer::ParticleForce);
 
 #pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
   for (std::int64_t i = 0; i < n; ++i) {
-    const vec4 pi = in.pos[i];
-    const vec4 vi = in.vel[i];
+    const vec4 pi = pos[i];
+    const vec4 vi = vel[i];
     if (vi.w == 0.0f) {  // static particle: its force is never used
       force[i] = vec4(0.0f);
       continue;
     }
     const vec3 xi = shared::xyz(pi);
     const vec3 ui = shared::xyz(vi);
-    const shared::ContactLaw* law_row = in.laws + std::size_t{in.material[i]} * materials;
+    const shared::ContactLaw* law_row = laws + std::size_t{material[i]} * materials;
     vec3 f(0.0f);
     // The force of particle j on i (zero unless they overlap), added in order.
     const bool by_impulse = shared::impulse_particle(p.flags, uint(i), p.rigid_particle_count);
     auto add_contact = [&](uint j) {
       if (by_impulse && j < p.rigid_particle_count) return;
-      const vec4 pj = in.pos[j];
-      const vec4 vj = in.vel[j];
+      const vec4 pj = pos[j];
+      const vec4 vj = vel[j];
       f += shared::particle_contact_force(xi, ui, pi.w, vi.w, shared::xyz(pj), shared::xyz(vj),
-                                          pj.w, vj.w, law_row[in.material[j]], p.flags);
+                                          pj.w, vj.w, law_row[material[j]], p.flags);
     };
-    const uint c = in.count[i];
+    const uint c = count[i];
     if (c <= capacity) {
-      for (uint k = 0; k < c; ++k) add_contact(in.list[std::size_t{k} * stride + std::size_t(i)]);
+      for (uint k = 0; k < c; ++k) add_contact(list[std::size_t{k} * stride + std::size_t(i)]);
     } else {
-      const uint body_i = in.body[i];
-      shared::grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
-        for (uint t = lo; t < hi; ++t) {
-          const uint j = in.order[t];
-          if (!shared::contact_skipped(body_i, in.sbody[t], uint(i), j, exclusions,
-                                       p.particle_count, p.linked_first)) {
+      const uint body_i = body[i];
+      const shared::GridRanges ranges = shared::grid_ranges(p, ref[i], cell_start);
+      for (int r = 0; r < ranges.count; ++r) {
+        for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
+          const uint j = order[t];
+          if (!shared::contact_skipped(body_i, sbody[t], uint(i), j, exclusions, p.particle_count,
+                                       p.linked_first)) {
             add_contact(j);
           }
         }
-      });
+      }
     }
     for (uint k = 0; k < (by_impulse ? 0u : p.plane_count); ++k) {
-      const shared::PlaneData pl = in.planes[k];
+      const shared::PlaneData pl = planes[k];
       f += shared::plane_contact_force(xi, ui, pi.w, vi.w, pl.normal_offset, law_row[pl.material],
                                        p.flags);
     }

@@ -46,6 +46,25 @@ MOTES_FN void grid_walk(MOTES_IN(StepParams) p, vec4 x, const uint* __restrict__
   }
 }
 
+#ifndef __CUDACC__
+/// The ranges grid_walk visits, gathered, for a CPU loop that walks them itself: the OpenMP
+/// contact loop keeps the callback out of its body this way (with the callback inlined, W1's
+/// contacts_compute ran 5% more instructions).
+struct GridRanges {
+  uint lo[27];
+  uint hi[27];
+  int count = 0;
+};
+inline GridRanges grid_ranges(const StepParams& p, vec4 x, const uint* cell_start) {
+  GridRanges out;
+  grid_walk(p, x, cell_start, [&out](uint lo, uint hi) {
+    out.lo[out.count] = lo;
+    out.hi[out.count++] = hi;
+  });
+  return out;
+}
+#endif
+
 MOTES_SHARED_END
 #endif  // __cplusplus
 
