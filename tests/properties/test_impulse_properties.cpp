@@ -15,7 +15,8 @@
 // for CI's two cores; the sanitizer build 2, 1 and 8 for their first 0.5 s),
 // MOTES_PROPERTY_DURATION (s: stop there, rest not checked),
 // MOTES_PROPERTY_FIRST (first seed, default 1), MOTES_PROPERTY_KIND (only this kind),
-// MOTES_PROPERTY_BATCH (cases per simulation, default 20), MOTES_PROPERTY_SEED (one seed alone);
+// MOTES_PROPERTY_BATCH (cases per simulation, default 20), MOTES_PROPERTY_SEED (one seed alone),
+// MOTES_PROPERTY_DUMP (a folder: each case's last state, for scripts/static_balance.py);
 // to look into a failure, MOTES_PROPERTY_TRACE=1 (each case's fastest body every 25 ms, the
 // particles that drifted) and MOTES_PROPERTY_ITERATIONS / MOTES_PROPERTY_SUBSTEPS (the scene's
 // impulse_iterations and impulse_substeps instead of the defaults).
@@ -82,6 +83,33 @@ double case_energy(const motes::Snapshot& s, std::size_t first, std::size_t last
     e += 9.81 * static_cast<double>(s.body_pos[b].y) / inv_m;
   }
   return e;
+}
+
+/// MOTES_PROPERTY_DUMP=DIR: each case's last state as DIR/KIND-SEED.txt (for looking into a
+/// failure): "mu F", then a line per body of the case ("body INDEX static|dynamic INV_MASS X Y Z")
+/// and per particle ("particle BODY X Y Z RADIUS VX VY VZ").
+void dump_case(const std::string& dir, const Case& c, const motes::Snapshot& s,
+               const std::vector<motes::BodyInfo>& info, std::size_t first, std::size_t last) {
+  const std::string path = fmt::format("{}/{}-{}.txt", dir, kind_name(c.kind), c.seed);
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) {
+    ADD_FAILURE() << "cannot write " << path;
+    return;
+  }
+  std::fprintf(f, "mu %.9g\n", double{c.material.friction});
+  for (std::size_t b = first; b < last; ++b) {
+    const motes::shared::vec4 x = s.body_pos[b];
+    std::fprintf(f, "body %zu %s %.9g %.9g %.9g %.9g\n", b - first,
+                 info[b].kind == motes::BodyKind::Static ? "static" : "dynamic", double{x.w},
+                 double{x.x}, double{x.y}, double{x.z});
+    for (std::size_t i = info[b].first_particle;
+         i < info[b].first_particle + info[b].particle_count; ++i) {
+      const motes::shared::vec4 p = s.particle_pos[i], v = s.particle_vel[i];
+      std::fprintf(f, "particle %zu %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", b - first, double{p.x},
+                   double{p.y}, double{p.z}, double{p.w}, double{v.x}, double{v.y}, double{v.z});
+    }
+  }
+  std::fclose(f);
 }
 
 /// Runs `cases` side by side on `backend`; one outcome per case.
@@ -175,6 +203,13 @@ std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Cas
             (case_energy(*snap, first[k], first[k + 1]) - e0[k]) / out[k].scale, which,
             info[b].particle_count, fastest, double{x.x}, double{x.y}, double{x.z}, double{v.x},
             double{v.y}, double{v.z}, double{w.x}, double{w.y}, double{w.z});
+      }
+    }
+    if (done == steps) {
+      if (const char* dir = std::getenv("MOTES_PROPERTY_DUMP"); dir != nullptr && *dir != '\0') {
+        for (std::size_t k = 0; k < cases.size(); ++k) {
+          dump_case(dir, cases[k], *snap, info, first[k], first[k + 1]);
+        }
       }
     }
     for (std::size_t k = 0; k < cases.size(); ++k) {
@@ -305,9 +340,13 @@ void check_cases(const std::string& backend, const std::vector<Case>& cases,
       ADD_FAILURE() << fmt::format(
           "{} seed {} on {} ({}): {}\n  replay alone: MOTES_PROPERTY_KIND={} "
           "MOTES_PROPERTY_SEED={}; its batch: MOTES_PROPERTY_KIND={} MOTES_PROPERTY_FIRST={} "
-          "MOTES_PROPERTY_SEEDS={} MOTES_PROPERTY_BATCH={}",
+          "MOTES_PROPERTY_SEEDS={} MOTES_PROPERTY_BATCH={}{}",
           kind_name(c.kind), c.seed, backend, c.summary, o.failure, kind_name(c.kind), c.seed,
-          kind_name(c.kind), part.front().seed, part.size(), part.size());
+          kind_name(c.kind), part.front().seed, part.size(), part.size(),
+          o.failure.rfind("not at rest", 0) == 0
+              ? "\n  could its bodies stand? add MOTES_PROPERTY_DUMP=DIR, then "
+                "scripts/static_balance.py DIR/KIND-SEED.txt"
+              : "");
     }
   }
   std::printf(
