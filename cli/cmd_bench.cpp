@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "motes/devices.h"
+#include "motes/scene.h"
 #include "motes/simulation.h"
 #include "motes/workloads.h"
 
@@ -48,6 +50,9 @@ struct BenchOptions {
   std::string cache = "bench-cache";
   std::string dense_from;  // LAMMPS data file: the dense phase starts from LAMMPS's settled state
   std::string json_path;
+  std::vector<std::string> scenes = {"examples/scenes"};  // realtime: scene files or folders
+  double realtime_seconds = 2.0;                          // realtime: simulated seconds a run
+  int frame_rate = 60;                                    // realtime: frames per simulated second
 };
 
 struct Measurement {
@@ -319,12 +324,133 @@ void print_row(const Measurement& m) {
   std::fflush(stdout);
 }
 
+/// The scene files `realtime` runs: each file of --scenes, and each .json file of each folder
+/// there (sorted by name).
+std::vector<std::string> realtime_scene_files(const BenchOptions& o) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> files;
+  for (const std::string& path : o.scenes) {
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) {
+      std::vector<std::string> found;
+      for (const fs::directory_entry& e : fs::directory_iterator(path, ec)) {
+        if (e.is_regular_file() && e.path().extension() == ".json") {
+          found.push_back(e.path().string());
+        }
+      }
+      if (found.empty()) fail(fmt::format("--scenes: {} holds no .json scene file", path));
+      std::sort(found.begin(), found.end());
+      files.insert(files.end(), found.begin(), found.end());
+    } else if (fs::is_regular_file(path, ec)) {
+      files.push_back(path);
+    } else {
+      fail(
+          fmt::format("--scenes: {} is neither a scene file nor a folder of them (the default, "
+                      "examples/scenes, is the repository's: run from its root or name the scenes)",
+                      path));
+    }
+  }
+  return files;
+}
+
+/// One scene at frame-sized chunks: `--realtime-seconds` of simulated time, each frame
+/// (1 / --frame-rate s, rounded to whole steps) one Simulation::step call that returns when the
+/// device is done, as an interactive program steps; stepping only (no output, no guards).
+/// Repeats from a fresh simulation each; the median wall time gives simulated seconds per second.
+void run_realtime_scene(const std::string& path, const BenchOptions& o, nlohmann::json& results) {
+  const motes::Scene scene = must(motes::load_scene_file(path));
+  const double dt = scene.settings.dt;
+  const auto frame_steps =
+      static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / (o.frame_rate * dt))));
+  const auto frames = static_cast<std::uint64_t>(std::max<long long>(
+      1, std::llround(o.realtime_seconds / (static_cast<double>(frame_steps) * dt))));
+  const double simulated = static_cast<double>(frames * frame_steps) * dt;
+  {  // Warm-up: first touch of memory, thread pool start, graph capture.
+    auto sim = make_sim(scene, o);
+    must(sim->step(std::min<std::uint64_t>(frame_steps, 50)));
+  }
+  std::vector<double> seconds;
+  std::uint32_t particles = 0;
+  for (int r = 0; r < o.repeats; ++r) {
+    auto sim = make_sim(scene, o);
+    particles = sim->particle_count();
+    double wall = 0.0;
+    for (std::uint64_t f = 0; f < frames; ++f) {
+      const auto t0 = std::chrono::steady_clock::now();
+      must(sim->step(frame_steps));
+      wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    seconds.push_back(wall);
+  }
+  const double med = median(seconds);
+  const std::string name = std::filesystem::path(path).stem().string();
+  const char* contacts =
+      scene.settings.contact_model == motes::ContactModel::Impulses ? "impulse" : "force";
+  fmt::print("{:<18} {:<8} {:>9} {:>8.3f} {:>6} {:>9.3f} {:>9.3f} {:>9.3f}\n", name, contacts,
+             particles, 1e3 * dt, frame_steps, 1e3 * med / static_cast<double>(frames),
+             simulated / med, 1e3 * med / static_cast<double>(frames * frame_steps));
+  std::fflush(stdout);
+  results.push_back({{"workload", "realtime"},
+                     {"scene", path},
+                     {"contact_model", contacts},
+                     {"particles", particles},
+                     {"dt", dt},
+                     {"frame_rate", o.frame_rate},
+                     {"steps_per_frame", frame_steps},
+                     {"frames", frames},
+                     {"simulated_seconds", simulated},
+                     {"repeats", o.repeats},
+                     {"seconds", seconds},
+                     {"ms_per_frame_median", 1e3 * med / static_cast<double>(frames)},
+                     {"realtime_factor_median", simulated / med}});
+}
+
+/// `--workload realtime`: every scene of --scenes at frame-sized steps (docs/benchmarks.md,
+/// "Real time").
+void run_realtime(const BenchOptions& o) {
+  const std::vector<std::string> files = realtime_scene_files(o);
+  {
+    auto probe = must(motes::open_device(o.backend, o.device, {o.threads}));
+    fmt::print(
+        "motes bench realtime on {} device {}: {} ({}); each scene {} simulated s in frames of "
+        "1/{} s (one step call each), stepping only; median of {} repeats after a warm-up\n",
+        probe->info().backend, probe->info().index, probe->info().name, probe->info().detail,
+        o.realtime_seconds, o.frame_rate, o.repeats);
+  }
+  fmt::print(
+      "{:<18} {:<8} {:>9} {:>8} {:>6} {:>9} {:>9} {:>9}   (x real: simulated s per s of "
+      "stepping)\n",
+      "scene", "contacts", "particles", "dt ms", "steps", "ms/frame", "x real", "ms/step");
+  nlohmann::json results = nlohmann::json::array();
+  bool any_failed = false;
+  for (const std::string& path : files) {
+    try {
+      run_realtime_scene(path, o, results);
+    } catch (const CLI::RuntimeError&) {  // fail() has printed why
+      any_failed = true;
+    }
+  }
+  if (!o.json_path.empty()) {
+    std::ofstream out(o.json_path);
+    out << results.dump(2) << "\n";
+    if (!out) fail(fmt::format("{}: cannot write JSON results", o.json_path));
+    fmt::print("results written to {}\n", o.json_path);
+  }
+  if (any_failed) throw CLI::RuntimeError(kErrorExit);
+}
+
 void run_bench(const BenchOptions& o) {
   if (o.workload != "all" && o.workload != "settle" && o.workload != "dominoes" &&
-      o.workload != "cloth" && o.workload != "soft" && o.workload != "impulse-dominoes") {
+      o.workload != "cloth" && o.workload != "soft" && o.workload != "impulse-dominoes" &&
+      o.workload != "realtime") {
     fail(fmt::format(
-        "--workload must be settle, dominoes, cloth, soft, impulse-dominoes or all, got '{}'",
+        "--workload must be settle, dominoes, cloth, soft, impulse-dominoes, realtime or all, "
+        "got '{}'",
         o.workload));
+  }
+  if (o.workload == "realtime") {
+    run_realtime(o);
+    return;
   }
   if (o.domino_rows > o.dominoes) {  // a usage error, as CLI11's own checks report them
     throw CLI::ValidationError(
@@ -477,8 +603,19 @@ void add_bench_command(CLI::App& app) {
       "Run the fixed benchmark workloads (docs/benchmarks.md): W1 settle, W2 dominoes, W3 cloth, "
       "W4 soft");
   cmd->add_option("--workload", opts->workload,
-                  "settle, dominoes, all (settle and dominoes), cloth, soft or impulse-dominoes "
-                  "(W2's dominoes with impulse contacts)")
+                  "settle, dominoes, all (settle and dominoes), cloth, soft, impulse-dominoes "
+                  "(W2's dominoes with impulse contacts) or realtime (scenes at frame-sized steps)")
+      ->capture_default_str();
+  cmd->add_option("--scenes", opts->scenes,
+                  "realtime: scene files, or folders whose .json files are scenes")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--realtime-seconds", opts->realtime_seconds,
+                  "realtime: simulated seconds of each scene")
+      ->check(CLI::Range(1e-3, 3600.0))
+      ->capture_default_str();
+  cmd->add_option("--frame-rate", opts->frame_rate, "realtime: frames per simulated second")
+      ->check(whole_number_of<int>(1, 10000))
       ->capture_default_str();
   cmd->add_option("--cloth-sides", opts->cloth_sides,
                   "W3: cloth sides in particles (a side x side cloth each)")

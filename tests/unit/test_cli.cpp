@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cstdlib>
@@ -436,6 +437,54 @@ TEST(Cli, VoxelizeBunnyToCsv) {
   EXPECT_NE(neither.exit_code, 0) << describe(neither);
   const Outcome both = run_motes(tmp, {"voxelize", kBunny, "--count", "10", "--diameter", "0.1"});
   EXPECT_NE(both.exit_code, 0) << describe(both);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(Cli, BenchRealtimeStepsScenesInFrames) {
+  // Every .json of a folder, in name order, in frames of 1/60 s: small.json's dt of 50 us makes
+  // 333 steps a frame, and 0.05 s three frames.
+  TempDir tmp;
+  const fs::path scenes = tmp / "scenes";
+  fs::create_directories(scenes);
+  fs::copy_file(kSmallScene, scenes / "b.json");
+  fs::copy_file(kSmallScene, scenes / "a.json");
+  std::ofstream(scenes / "notes.txt") << "not a scene\n";
+  const std::string json = tmp / "rt.json";
+  const Outcome o = run_motes(
+      tmp, {"bench", "--workload", "realtime", "--scenes", scenes.string(), "--realtime-seconds",
+            "0.05", "--repeats", "2", "--backend", "openmp", "--threads", "1", "--json", json});
+  ASSERT_EQ(o.exit_code, 0) << describe(o);
+  EXPECT_TRUE(std::regex_search(o.out, std::regex(R"(\na +force +108 .*\nb +force +108 )")))
+      << describe(o);
+  const nlohmann::json r = nlohmann::json::parse(read_text(json));
+  ASSERT_EQ(r.size(), 2u);
+  for (const nlohmann::json& row : r) {
+    EXPECT_EQ(row["workload"], "realtime");
+    EXPECT_EQ(row["steps_per_frame"], 333);
+    EXPECT_EQ(row["frames"], 3);
+    EXPECT_NEAR(row["simulated_seconds"].get<double>(), 3 * 333 * 5e-5, 1e-12);
+    ASSERT_EQ(row["seconds"].size(), 2u);
+    for (const auto& s : row["seconds"]) EXPECT_GT(s.get<double>(), 0.0);
+    EXPECT_GT(row["realtime_factor_median"].get<double>(), 0.0);
+  }
+  EXPECT_TRUE(contains(r[0]["scene"].get<std::string>(), "a.json"));
+}
+
+TEST(Cli, BenchRealtimeNamesScenesItCannotRun) {
+  TempDir tmp;
+  const Outcome missing = run_motes(
+      tmp, {"bench", "--workload", "realtime", "--scenes", tmp / "nowhere", "--backend", "openmp"});
+  EXPECT_EQ(missing.exit_code, 2) << describe(missing);
+  EXPECT_TRUE(contains(missing.err, "nowhere is neither a scene file nor a folder of them"))
+      << describe(missing);
+  fs::create_directories(tmp / "empty");
+  const Outcome empty = run_motes(
+      tmp, {"bench", "--workload", "realtime", "--scenes", tmp / "empty", "--backend", "openmp"});
+  EXPECT_EQ(empty.exit_code, 2) << describe(empty);
+  EXPECT_TRUE(contains(empty.err, "holds no .json scene file")) << describe(empty);
 }
 
 }  // namespace
