@@ -642,7 +642,9 @@ void add_bench_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--device", opts->device, "device index within the backend")
       ->check(whole_number_of<int>(0));
-  cmd->add_option("--threads", opts->threads, "OpenMP threads (0: OpenMP's default)")
+  cmd->add_option("--threads", opts->threads,
+                  "OpenMP threads, kept whatever the load (0: OpenMP's default, fewer while "
+                  "other processes keep the CPUs busy)")
       ->check(whole_number_of<int>(0, kMaxThreads));
   cmd->add_option("--repeats", opts->repeats, "timed repeats (the median is reported)")
       ->check(whole_number_of<int>(1, 1000))

@@ -176,8 +176,10 @@ void add_resume_command(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "openmp", "cuda", "vulkan"}));
   sub->add_option("--device", args->device, "device index within the backend (motes devices)")
       ->check(whole_number(0));
-  sub->add_option("--threads", args->threads,
-                  "OpenMP backend threads (default: OMP_NUM_THREADS or every core)")
+  sub->add_option(
+         "--threads", args->threads,
+         "OpenMP backend threads, kept whatever the load (default: OMP_NUM_THREADS or every core, "
+         "fewer while other processes keep the CPUs busy)")
       ->check(whole_number(1));
   args->steps_option = sub->add_option("--steps", args->steps,
                                        "steps to run from the checkpoint (default: the rest of "

@@ -211,8 +211,10 @@ void add_run_command(CLI::App& app) {
   sub->add_option("--format", args->format, "output files: vtu (+ .pvd), csv or none")
       ->check(CLI::IsMember({"vtu", "csv", "none"}))
       ->capture_default_str();
-  sub->add_option("--threads", args->threads,
-                  "OpenMP backend threads (default: OMP_NUM_THREADS or every core)")
+  sub->add_option(
+         "--threads", args->threads,
+         "OpenMP backend threads, kept whatever the load (default: OMP_NUM_THREADS or every core, "
+         "fewer while other processes keep the CPUs busy)")
       ->check(whole_number_of<int>(1, kMaxThreads));
   sub->add_option("--render", args->render_dir,
                   "also draw every frame as a PNG in this directory, and an MP4 when ffmpeg is "

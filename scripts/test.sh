@@ -14,6 +14,9 @@ stage "tests"
 cd "$build"
 # Tests run side by side: OpenMP threads that spin while waiting would starve each other.
 export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
+# Each would also see the others as load and run on one thread (backends/openmp/cpu_share.h): keep
+# the thread counts the tests ask for (tests/unit/test_cpu_share.cpp checks the adapting itself).
+export MOTES_CPU_ADAPT=${MOTES_CPU_ADAPT:-0}
 # Vulkan runs with the Khronos validation layer (synchronization validation included): any message
 # it prints fails the test that caused it.
 export MOTES_VULKAN_VALIDATION=${MOTES_VULKAN_VALIDATION:-1}

@@ -21,7 +21,7 @@ void OpenMPDevice::bodies_reduce(const shared::StepParams& p) {
   vec4* body_force = buf<vec4>(Buffer::BodyForce);
   vec4* body_torque = buf<vec4>(Buffer::BodyTorque);
 
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(bodies))
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(bodies))
   for (std::int64_t b = 0; b < bodies; ++b) {
     const vec4 com = body_pos[b];
     vec3 f(0.0f);

@@ -21,7 +21,7 @@ void OpenMPDevice::clusters_fit(const shared::StepParams& p) {
   const vec4* vel = buf<vec4>(Buffer::ParticleVel);
   auto* frames = buf<shared::ClusterFrame>(Buffer::ClusterFrames);
 
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(count * 64))
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(count * 64))
   for (std::int64_t k = 0; k < count; ++k) {
     const shared::Cluster& cl = clusters[k];
     vec4 sum(0.0f);

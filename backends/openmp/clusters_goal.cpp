@@ -29,7 +29,7 @@ void OpenMPDevice::clusters_goal(const shared::StepParams& p) {
   vec4* vel = buf<vec4>(Buffer::ParticleVel);
   uint moved = 0;
 
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(end - first)) \
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(end - first)) \
     reduction(|                                                                            \
               : moved)
   for (std::int64_t i = first; i < end; ++i) {

@@ -26,7 +26,7 @@ void OpenMPDevice::constraints_solve(const shared::StepParams& p) {
   uint moved = 0;
   const bool check = (p.flags & MOTES_FLAG_SKIN_CHECK) != 0;
 
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(end - first)) \
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(end - first)) \
     reduction(|                                                                            \
               : moved)
   for (std::int64_t k = first; k < end; ++k) {

@@ -38,7 +38,7 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
   const uint* exclusions = buf<uint>(Buffer::LinkExclusions);
   vec4* force = buf<vec4>(Buffer::ParticleForce);
 
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n))
   for (std::int64_t i = 0; i < n; ++i) {
     const vec4 pi = pos[i];
     const vec4 vi = vel[i];

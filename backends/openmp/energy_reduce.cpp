@@ -33,7 +33,7 @@ void OpenMPDevice::energy_reduce(const shared::StepParams& p) {
                  shared::bits_float(out[2]));
   const vec4 gravity = p.gravity_dt;
 
-#pragma omp parallel for num_threads(threads_) \
+#pragma omp parallel for num_threads(team_) \
     schedule(static) if (parallel(blocks * MOTES_ENERGY_BLOCK))
   for (std::int64_t k = 0; k < blocks; ++k) {
     float kinetic[MOTES_ENERGY_BLOCK];

@@ -54,7 +54,7 @@ void OpenMPDevice::sort_by_bucket(std::uint32_t n, std::uint32_t key_bits) {
   uint* ids[2] = {ids_tmp_.data(), order};
   std::uint32_t out = (passes % 2 == 1) ? 1 : 0;
 
-#pragma omp parallel num_threads(threads_) if (parallel(n))
+#pragma omp parallel num_threads(team_) if (parallel(n))
   {
     const auto t = static_cast<std::size_t>(thread_id());
     const auto nt = static_cast<std::size_t>(thread_count());
@@ -105,7 +105,7 @@ void OpenMPDevice::grid_build(const shared::StepParams& p) {
   const vec4* pos = buf<vec4>(Buffer::ParticlePos);
   uint* bucket = buf<uint>(Buffer::GridBucket);
 
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n))
   for (std::int64_t i = 0; i < n; ++i) {
     const vec4 x = pos[i];
     bucket[i] = shared::grid_bucket(shared::grid_cell_coord(x.x, p.inv_cell_size),
@@ -122,7 +122,7 @@ void OpenMPDevice::grid_build(const shared::StepParams& p) {
   if (n == 0) {
     std::fill(cell_start, cell_start + table + 1, 0u);
   } else {
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n))
     for (std::int64_t s = 0; s <= n; ++s) {
       const std::int64_t lo = s == 0 ? 0 : std::int64_t{keys[s - 1]} + 1;
       const std::int64_t hi = s == n ? table : std::int64_t{keys[s]};
@@ -134,7 +134,7 @@ void OpenMPDevice::grid_build(const shared::StepParams& p) {
   const uint* body = buf<uint>(Buffer::ParticleBody);
   vec4* spos = buf<vec4>(Buffer::SortedPos);
   uint* sbody = buf<uint>(Buffer::SortedBody);
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n))
   for (std::int64_t s = 0; s < n; ++s) {
     const uint i = order[s];
     spos[s] = pos[i];

@@ -20,7 +20,7 @@ void OpenMPDevice::halo_pack(const shared::StepParams& p) {
   const vec4* pos = buf<vec4>(Buffer::ParticlePos);
   const vec4* vel = buf<vec4>(Buffer::ParticleVel);
   vec4* data = buf<vec4>(Buffer::HaloData);
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(np))
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(np))
   for (std::int64_t k = 0; k < np; ++k) {
     const uint i = index[first + k];
     if (i >= p.particle_count) continue;  // not a particle: the entry is left as it is
@@ -30,7 +30,7 @@ void OpenMPDevice::halo_pack(const shared::StepParams& p) {
   vec4* bodies = data + MOTES_HALO_PARTICLE_VEC4S * np;
   for (uint c = 0; c < MOTES_HALO_BODY_VEC4S; ++c) {
     const vec4* state = buf<vec4>(kHaloBodyState[c]);
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(nb))
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(nb))
     for (std::int64_t j = 0; j < nb; ++j) {
       const uint b = index[first + np + j];
       if (b < p.body_count) bodies[MOTES_HALO_BODY_VEC4S * j + c] = state[b];

@@ -24,7 +24,7 @@ void OpenMPDevice::halo_unpack(const shared::StepParams& p) {
   vec4* pos = buf<vec4>(Buffer::ParticlePos);
   vec4* vel = buf<vec4>(Buffer::ParticleVel);
   uint moved = 0;
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(np)) \
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(np)) \
     reduction(|                                                                   \
               : moved)
   for (std::int64_t k = 0; k < np; ++k) {
@@ -38,7 +38,7 @@ void OpenMPDevice::halo_unpack(const shared::StepParams& p) {
   const vec4* bodies = data + MOTES_HALO_PARTICLE_VEC4S * np;
   for (uint c = 0; c < MOTES_HALO_BODY_VEC4S; ++c) {
     vec4* state = buf<vec4>(kHaloBodyState[c]);
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(nb))
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(nb))
     for (std::int64_t j = 0; j < nb; ++j) {
       const uint b = index[first + np + j];
       if (b < p.body_count) state[b] = bodies[MOTES_HALO_BODY_VEC4S * j + c];

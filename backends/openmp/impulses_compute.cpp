@@ -72,7 +72,7 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     impulse_mirror_.assign(slots, kNoMirror);
     impulse_pair_.resize(slots);
     uint* mirror = impulse_mirror_.data();
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel_heavy(n))
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel_heavy(n))
     for (std::int64_t i = 0; i < n; ++i) {
       const uint c = in.count[i];
       if (in.vel[i].w == 0.0f || c > capacity) continue;
@@ -248,14 +248,14 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     if (!impulses_count_kept(p)) {
       const auto active = static_cast<std::int64_t>(impulse_active_.size());
       const uint* ids = impulse_active_.data();
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel_heavy(active))
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel_heavy(active))
       for (std::int64_t a = 0; a < active; ++a) {
         if (touches[ids[a]] == 2) particle(ids[a]);
       }
     }
   } else if (impulse_touches_.size() != std::size_t(n)) {
     // No counting pass at these sizes yet: every particle.
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n))
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n))
     for (std::int64_t i = 0; i < n; ++i) particle(i);
   } else if (impulses_sweep(p)) {
     // The sweeps of this substep from its contacts' kept frames (impulses_sweep.cpp).
@@ -265,7 +265,7 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     const auto active = static_cast<std::int64_t>(impulse_active_.size());
     const uint* ids = impulse_active_.data();
     pairs_once = impulse_mirror_.size() == slots;
-#pragma omp parallel num_threads(threads_) if (parallel_heavy(active))
+#pragma omp parallel num_threads(team_) if (parallel_heavy(active))
     {
       if (pairs_once) {
 #pragma omp for schedule(static)

@@ -191,7 +191,7 @@ void OpenMPDevice::impulse_contacts_solve(const shared::StepParams& p) {
     for (std::int64_t a = 0; a < active; ++a) add(a);
     return;
   }
-#pragma omp parallel num_threads(threads_)
+#pragma omp parallel num_threads(team_)
   {
 #pragma omp for schedule(static)
     for (std::int64_t c = 0; c < contacts; ++c) solve(c);

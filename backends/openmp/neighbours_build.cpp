@@ -42,7 +42,7 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
   uint* state = buf<uint>(Buffer::NeighbourState);
   const uint built = state[MOTES_NEIGHBOUR_BUILDS];  // the last build's count; this one's + 1
 
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n)) \
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n)) \
     reduction(+ : over) reduction(max : most)
   for (std::int64_t i = 0; i < n; ++i) {
     const vec4 pi = pos[i];

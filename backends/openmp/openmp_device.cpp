@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <string>
@@ -73,7 +74,13 @@ OpenMPDevice::OpenMPDevice(int threads, int min_parallel)
 #else
   threads_ = 1;
 #endif
+  // OpenMP's default thread count follows the machine: fewer threads while other processes keep
+  // its CPUs busy (cpu_share.h). An explicit count is kept as asked.
+  const char* adapt = std::getenv("MOTES_CPU_ADAPT");
+  share_ = CpuShare(threads_, threads <= 0 && !(adapt != nullptr && std::string(adapt) == "0"));
+  team_ = share_.team();
   info_ = describe(threads_);
+  if (share_.adapting()) info_.detail += ", fewer while other processes keep the CPUs busy";
 }
 
 std::uint64_t OpenMPDevice::required_bytes(const Sizes& sizes) const {
@@ -149,6 +156,7 @@ Status OpenMPDevice::read(Buffer b, void* dst, std::size_t bytes) {
 }
 
 void OpenMPDevice::enqueue(Kernel k, const shared::StepParams& p) {
+  team_ = share_.team();
   switch (k) {
 #define MOTES_FAMILY_CASE(E, name, reads, writes) \
   case Kernel::E:                                 \

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "contact_inputs.h"
+#include "cpu_share.h"
 #include "motes/backend/device.h"
 #include "shared/impulse.h"
 
@@ -70,12 +71,12 @@ class OpenMPDevice final : public Device {
 #undef MOTES_FAMILY_DECLARATION
 
   [[nodiscard]] bool parallel(std::int64_t items) const {
-    return threads_ > 1 && items >= min_parallel_;
+    return team_ > 1 && items >= min_parallel_;
   }
   /// For loops whose items cost about 16 times a particle's share of a light pass (an impulse
   /// particle with its contacts, ~100 ns or more): threads pay off at a 16th of the items.
   [[nodiscard]] bool parallel_heavy(std::int64_t items) const {
-    return threads_ > 1 && items * 16 >= min_parallel_;
+    return team_ > 1 && items * 16 >= min_parallel_;
   }
   /// Runs f(i) for every i in [0, n): on the team when `on`, else on this thread without entering
   /// an OpenMP region (a region that runs on one thread still costs about 0.6 us: libgomp makes
@@ -86,7 +87,7 @@ class OpenMPDevice final : public Device {
       for (std::int64_t i = 0; i < n; ++i) f(i);
       return;
     }
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp parallel for num_threads(team_) schedule(static)
     for (std::int64_t i = 0; i < n; ++i) f(i);
   }
   template <typename T>
@@ -102,7 +103,11 @@ class OpenMPDevice final : public Device {
   void record(Kernel k, std::chrono::steady_clock::time_point start);
 
   DeviceInfo info_;
-  int threads_ = 1;
+  int threads_ = 1;  // the most threads a kernel runs on
+  /// The threads the kernels run on now: threads_, or fewer while other processes keep the CPUs
+  /// busy (share_; only with OpenMP's default thread count, and not with MOTES_CPU_ADAPT=0).
+  int team_ = 1;
+  CpuShare share_{1, false};
   std::int64_t min_parallel_ = kDefaultMinParallel;
   Sizes sizes_;
   std::vector<AlignedBuffer> buffers_;

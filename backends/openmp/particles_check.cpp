@@ -18,7 +18,7 @@ void OpenMPDevice::particles_check(const shared::StepParams& p) {
   const vec4* vel = buf<vec4>(Buffer::ParticleVel);
   uint rate2 = 0;
   uint non_finite = MOTES_MOTION_NONE;
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n)) \
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n)) \
     reduction(max                                                                \
               : rate2) reduction(min                                             \
                                  : non_finite)
@@ -31,7 +31,7 @@ void OpenMPDevice::particles_check(const shared::StepParams& p) {
     }
   }
   uint fastest = MOTES_MOTION_NONE;
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n)) \
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n)) \
     reduction(min                                                                \
               : fastest)
   for (std::int64_t i = 0; i < n; ++i) {

@@ -24,7 +24,7 @@ void OpenMPDevice::particles_integrate(const shared::StepParams& p) {
   vec4* vel = buf<vec4>(Buffer::ParticleVel);
   uint moved = 0;
 
-#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel(n - first)) \
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n - first)) \
     reduction(|                                                                          \
               : moved)
   for (std::int64_t i = first; i < n; ++i) {

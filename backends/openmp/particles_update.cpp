@@ -48,7 +48,7 @@ void OpenMPDevice::particles_update(const shared::StepParams& p) {
   if (!parallel(n)) {  // without entering an OpenMP region (for_items)
     for (std::int64_t i = 0; i < n; ++i) moved |= follow(i) ? 1u : 0u;
   } else {
-#pragma omp parallel for num_threads(threads_) schedule(static) reduction(| : moved)
+#pragma omp parallel for num_threads(team_) schedule(static) reduction(| : moved)
     for (std::int64_t i = 0; i < n; ++i) moved |= follow(i) ? 1u : 0u;
   }
   if (moved != 0) buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_REBUILD] = 1;
