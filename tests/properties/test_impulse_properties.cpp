@@ -283,7 +283,9 @@ std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Cas
 /// sphere contacts 30 to 60 degrees off vertical that turns 0.013 rad/s (pile 17), fallen
 /// dominoes and floor piles that drift 0.01 to 0.02 d in 0.5 s or keep a speed of 2 to 12 mm/s
 /// without moving (chains 21, 31, 43; pile 25), dice that drift 0.015 and 0.031 d in their batch
-/// but not alone (drops 2 and 8, kept seeds that pass alone).
+/// but not alone (drops 2 and 8, kept seeds that pass alone). Each of them could stand: a static
+/// balance of its last state (MOTES_PROPERTY_DUMP, scripts/static_balance.py) needs 71% to 97% of
+/// its friction, so these are the solver's failures, not the physics's (docs/validation.md).
 struct Known {
   Kind kind;
   std::uint32_t seed;
