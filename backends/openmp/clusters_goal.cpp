@@ -30,7 +30,7 @@ void OpenMPDevice::clusters_goal(const shared::StepParams& p) {
   uint moved = 0;
 
 #pragma omp parallel for num_threads(team_) schedule(static) if (parallel(end - first)) \
-    reduction(|                                                                            \
+    reduction(|                                                                         \
               : moved)
   for (std::int64_t i = first; i < end; ++i) {
     const auto k = static_cast<std::size_t>(i - first);

@@ -27,7 +27,7 @@ void OpenMPDevice::constraints_solve(const shared::StepParams& p) {
   const bool check = (p.flags & MOTES_FLAG_SKIN_CHECK) != 0;
 
 #pragma omp parallel for num_threads(team_) schedule(static) if (parallel(end - first)) \
-    reduction(|                                                                            \
+    reduction(|                                                                         \
               : moved)
   for (std::int64_t k = first; k < end; ++k) {
     const shared::Constraint c = constraints[k];

@@ -24,9 +24,7 @@ void OpenMPDevice::halo_unpack(const shared::StepParams& p) {
   vec4* pos = buf<vec4>(Buffer::ParticlePos);
   vec4* vel = buf<vec4>(Buffer::ParticleVel);
   uint moved = 0;
-#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(np)) \
-    reduction(|                                                                   \
-              : moved)
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(np)) reduction(| : moved)
   for (std::int64_t k = 0; k < np; ++k) {
     const uint i = index[first + k];
     if (i >= p.particle_count) continue;  // not a particle: nothing written

@@ -18,10 +18,10 @@ void OpenMPDevice::particles_check(const shared::StepParams& p) {
   const vec4* vel = buf<vec4>(Buffer::ParticleVel);
   uint rate2 = 0;
   uint non_finite = MOTES_MOTION_NONE;
-#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n)) \
-    reduction(max                                                                \
-              : rate2) reduction(min                                             \
-                                 : non_finite)
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n)) reduction(max      \
+                                                                                        : rate2) \
+    reduction(min                                                                                \
+              : non_finite)
   for (std::int64_t i = 0; i < n; ++i) {
     if (shared::motion_finite(pos[i], vel[i])) {
       const uint r = shared::motion_rate2_bits(pos[i], vel[i]);
@@ -31,9 +31,8 @@ void OpenMPDevice::particles_check(const shared::StepParams& p) {
     }
   }
   uint fastest = MOTES_MOTION_NONE;
-#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n)) \
-    reduction(min                                                                \
-              : fastest)
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n)) reduction(min \
+                                                                                        : fastest)
   for (std::int64_t i = 0; i < n; ++i) {
     if (static_cast<uint>(i) < fastest && shared::motion_finite(pos[i], vel[i]) &&
         shared::motion_rate2_bits(pos[i], vel[i]) == rate2) {

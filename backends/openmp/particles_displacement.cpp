@@ -17,9 +17,8 @@ void OpenMPDevice::particles_displacement(const shared::StepParams& p) {
   const vec4* pos = buf<vec4>(Buffer::ParticlePos);
   const vec4* ref = buf<vec4>(Buffer::PartitionRefPos);
   uint largest = 0;
-#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n)) \
-    reduction(max                                                                \
-              : largest)
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n)) reduction(max \
+                                                                                        : largest)
   for (std::int64_t i = 0; i < n; ++i) {
     const uint d = shared::displacement2_bits(pos[i], ref[i]);
     largest = d > largest ? d : largest;

@@ -25,7 +25,7 @@ void OpenMPDevice::particles_integrate(const shared::StepParams& p) {
   uint moved = 0;
 
 #pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n - first)) \
-    reduction(|                                                                          \
+    reduction(|                                                                       \
               : moved)
   for (std::int64_t i = first; i < n; ++i) {
     vel[i] = shared::linked_damped(vel[i], static_cast<uint>(i), p.linked_first, p.linked_damping);
