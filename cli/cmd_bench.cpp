@@ -324,6 +324,18 @@ void print_row(const Measurement& m) {
   std::fflush(stdout);
 }
 
+/// Writes the rows to --json if asked, then ends with the error exit code if any workload failed
+/// (its reason printed already).
+void finish(const BenchOptions& o, const nlohmann::json& results, bool any_failed) {
+  if (!o.json_path.empty()) {
+    std::ofstream out(o.json_path);
+    out << results.dump(2) << "\n";
+    if (!out) fail(fmt::format("{}: cannot write JSON results", o.json_path));
+    fmt::print("results written to {}\n", o.json_path);
+  }
+  if (any_failed) throw CLI::RuntimeError(kErrorExit);
+}
+
 /// The scene files `realtime` runs: each file of --scenes, and each .json file of each folder
 /// there (sorted by name).
 std::vector<std::string> realtime_scene_files(const BenchOptions& o) {
@@ -430,13 +442,7 @@ void run_realtime(const BenchOptions& o) {
       any_failed = true;
     }
   }
-  if (!o.json_path.empty()) {
-    std::ofstream out(o.json_path);
-    out << results.dump(2) << "\n";
-    if (!out) fail(fmt::format("{}: cannot write JSON results", o.json_path));
-    fmt::print("results written to {}\n", o.json_path);
-  }
-  if (any_failed) throw CLI::RuntimeError(kErrorExit);
+  finish(o, results, any_failed);
 }
 
 void run_bench(const BenchOptions& o) {
@@ -585,13 +591,7 @@ void run_bench(const BenchOptions& o) {
       });
     }
   }
-  if (!o.json_path.empty()) {
-    std::ofstream out(o.json_path);
-    out << results.dump(2) << "\n";
-    if (!out) fail(fmt::format("{}: cannot write JSON results", o.json_path));
-    fmt::print("results written to {}\n", o.json_path);
-  }
-  if (any_failed) throw CLI::RuntimeError(kErrorExit);
+  finish(o, results, any_failed);
 }
 
 }  // namespace
