@@ -396,8 +396,10 @@ void run_realtime_scene(const std::string& path, const BenchOptions& o, nlohmann
   }
   const double med = median(seconds);
   const std::string name = std::filesystem::path(path).stem().string();
-  const char* contacts =
-      scene.settings.contact_model == motes::ContactModel::Impulses ? "impulse" : "force";
+  const motes::ContactModel model = scene.settings.contact_model;
+  const char* contacts = model == motes::ContactModel::Impulses    ? "impulse"
+                         : model == motes::ContactModel::Positions ? "position"
+                                                                   : "force";
   fmt::print("{:<18} {:<8} {:>9} {:>8.3f} {:>6} {:>9.3f} {:>9.3f} {:>9.3f}\n", name, contacts,
              particles, 1e3 * dt, frame_steps, 1e3 * med / static_cast<double>(frames),
              simulated / med, 1e3 * med / static_cast<double>(frames * frame_steps));

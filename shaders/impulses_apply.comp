@@ -34,7 +34,11 @@ void main() {
   vec4 vel = body_vel[b];
   vec4 angmom = body_angmom[b];
   vec4 angvel;
-  body_apply_impulse(com, body_quat[b], body_inv_inertia[b], vel, angmom, angvel, xyz(sum), m);
+  vec4 quat = body_quat[b];
+  body_apply_contacts(com, quat, body_inv_inertia[b], vel, angmom, angvel, xyz(sum), m,
+                      p.gravity_dt, p.flags);
+  body_pos[b] = com;
+  body_quat[b] = quat;
   body_vel[b] = vel;
   body_angmom[b] = angmom;
   body_angvel[b] = angvel;

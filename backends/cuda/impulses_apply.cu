@@ -17,8 +17,8 @@ namespace {
 
 struct ApplyBuffers {
   const uint* __restrict__ first;
-  const vec4* __restrict__ com;
-  const vec4* __restrict__ quat;
+  vec4* __restrict__ com;   // BodyPos (moved by the projection of position contacts)
+  vec4* __restrict__ quat;  // BodyQuat
   const vec4* __restrict__ inv_inertia;
   const vec4* __restrict__ impulse;
   const vec4* __restrict__ moment;
@@ -37,7 +37,7 @@ __global__ void impulses_apply_kernel(shared::StepParams p, ApplyBuffers d) {
   const std::uint64_t t = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
   if (t >= p.body_count) return;
   const auto b = static_cast<uint>(t);
-  const vec4 com = d.com[b];
+  vec4 com = d.com[b];
   vec4 sum(0.0f);
   vec3 m(0.0f);
   if (com.w != 0.0f) {
@@ -60,8 +60,11 @@ __global__ void impulses_apply_kernel(shared::StepParams p, ApplyBuffers d) {
   vec4 vel = d.vel[b];
   vec4 angmom = d.angmom[b];
   vec4 angvel;
-  shared::body_apply_impulse(com, d.quat[b], d.inv_inertia[b], vel, angmom, angvel,
-                             shared::xyz(sum), m);
+  vec4 quat = d.quat[b];
+  shared::body_apply_contacts(com, quat, d.inv_inertia[b], vel, angmom, angvel, shared::xyz(sum), m,
+                              p.gravity_dt, p.flags);
+  d.com[b] = com;
+  d.quat[b] = quat;
   d.vel[b] = vel;
   d.angmom[b] = angmom;
   d.angvel[b] = angvel;

@@ -20,8 +20,8 @@ void OpenMPDevice::impulses_apply(const shared::StepParams& p) {
   const auto bodies = static_cast<std::int64_t>(p.body_count);
   const bool count_only = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
   const uint* first = buf<uint>(Buffer::BodyFirst);
-  const vec4* com = buf<vec4>(Buffer::BodyPos);
-  const vec4* quat = buf<vec4>(Buffer::BodyQuat);
+  vec4* com = buf<vec4>(Buffer::BodyPos);  // moved by the projection of position contacts
+  vec4* quat = buf<vec4>(Buffer::BodyQuat);
   const vec4* inv_inertia = buf<vec4>(Buffer::BodyInvInertia);
   const vec4* impulse = buf<vec4>(Buffer::ParticleForce);
   const vec4* moment = buf<vec4>(Buffer::ParticleMoment);
@@ -75,8 +75,8 @@ void OpenMPDevice::impulses_apply(const shared::StepParams& p) {
         for (uint i = first[b]; i < first[b + 1]; ++i) stamp[i] = builds;
       }
     }
-    shared::body_apply_impulse(com[b], quat[b], inv_inertia[b], vel[b], angmom[b], angvel[b],
-                               shared::xyz(sum), m);
+    shared::body_apply_contacts(com[b], quat[b], inv_inertia[b], vel[b], angmom[b], angvel[b],
+                                shared::xyz(sum), m, p.gravity_dt, p.flags);
     if (push) {
       vel_push[b] = vel[b];
       angmom_push[b] = angmom[b];

@@ -46,9 +46,11 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
   const bool counting = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
   const std::size_t nr = p.rigid_particle_count;
   // Each body's frame (centre, world inverse inertia) once per substep: poses do not move
-  // between a counting pass and its sweeps.
+  // between a counting pass and its sweeps (of impulse contacts).
   const auto bodies = static_cast<std::int64_t>(p.body_count);
-  if (counting || impulse_frames_.size() != std::size_t(bodies)) {
+  // The velocity pass of position contacts follows a projection that moved the poses.
+  const bool moved = (p.flags & MOTES_FLAG_POSITION_VELOCITY) != 0u;
+  if (counting || moved || impulse_frames_.size() != std::size_t(bodies)) {
     impulse_frames_.resize(std::size_t(bodies));
     shared::ImpulseBody* frames = impulse_frames_.data();
     for_items(bodies, parallel(bodies), [&](std::int64_t b) {
@@ -264,7 +266,8 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     // contact within reach touches both), their shared contacts first.
     const auto active = static_cast<std::int64_t>(impulse_active_.size());
     const uint* ids = impulse_active_.data();
-    pairs_once = impulse_mirror_.size() == slots;
+    // Position contacts may move one side of a contact alone: no mirrored results.
+    pairs_once = impulse_mirror_.size() == slots && (p.flags & MOTES_FLAG_POSITION) == 0u;
 #pragma omp parallel num_threads(team_) if (parallel_heavy(active))
     {
       if (pairs_once) {

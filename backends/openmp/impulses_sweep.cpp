@@ -202,6 +202,8 @@ void OpenMPDevice::impulse_contacts_solve(const shared::StepParams& p) {
 
 bool OpenMPDevice::impulses_count_kept(const shared::StepParams& p) {
   impulse_contacts_ready_ = false;
+  // Position contacts keep no frames: their passes change what a frame would hold.
+  if ((p.flags & MOTES_FLAG_POSITION) != 0u) return false;
   impulse_bodies_update(p);
   if (!impulse_contacts_build(p, true)) return false;
   impulse_contacts_ready_ = true;
@@ -211,6 +213,7 @@ bool OpenMPDevice::impulses_count_kept(const shared::StepParams& p) {
 }
 
 bool OpenMPDevice::impulses_sweep(const shared::StepParams& p) {
+  if ((p.flags & MOTES_FLAG_POSITION) != 0u) return false;
   impulse_bodies_update(p);
   if (!impulse_contacts_ready_) {
     if (!impulse_contacts_build(p, false)) return false;

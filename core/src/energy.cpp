@@ -113,7 +113,7 @@ MechanicalEnergy mechanical_energy(const Snapshot& state, std::span<const BodyIn
 
 EnergyModel energy_model(const Scene& scene) {
   EnergyModel m;
-  const bool impulses = scene.settings.contact_model == ContactModel::Impulses;
+  const bool impulses = rigid_contacts_without_forces(scene.settings.contact_model);
   m.materials = static_cast<std::uint32_t>(scene.materials.size());
   m.substep = scene.settings.dt / static_cast<double>(std::max(scene.settings.substeps, 1));
   m.laws = contact_law_table(scene.materials);

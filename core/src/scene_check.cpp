@@ -81,7 +81,7 @@ void check_stability(const Scene& scene, const std::vector<BodyEntry>& entries) 
   std::map<int, std::string> partners;
   // With impulse contacts (docs/architecture.md, "Impulse contacts"), rigid bodies meet static
   // bodies, planes and each other without the force law: those pairs have no stability limit.
-  const bool impulses = scene.settings.contact_model == ContactModel::Impulses;
+  const bool impulses = rigid_contacts_without_forces(scene.settings.contact_model);
   std::map<int, std::string> rigid_partners;  // static bodies and planes
   for (const BodyEntry& e : entries) {
     const BodySpec& b = scene.bodies[e.first];

@@ -74,6 +74,23 @@ Status check_settings(const Scene& scene) {
     return Status::error(fmt::format("{}: impulse_substeps must be 1 to 64 (got {})", scene.source,
                                      settings.impulse_substeps));
   }
+  if (settings.contact_model == ContactModel::Positions) {
+    // Position contacts move rigid poses; what else a scene holds meets everything through the
+    // force law, whose springs a frame-sized step cannot resolve (issue 27 builds the rest).
+    const std::string why =
+        "contact_model \"position\" handles rigid and static bodies and planes so far (soft "
+        "bodies, cloth and ropes come with the rest of the position solver, issue 27)";
+    for (const BodySpec& b : scene.bodies) {
+      if (b.soft) {
+        return Status::error(fmt::format("{}: {}; body \"{}\" is soft", scene.source, why, b.name));
+      }
+    }
+    if (!scene.linked.empty()) {
+      return Status::error(fmt::format("{}: {}; the scene has {} \"{}\"", scene.source, why,
+                                       scene.linked[0].kind == LinkedKind::Cloth ? "cloth" : "rope",
+                                       scene.linked[0].name));
+    }
+  }
   return Status::ok();
 }
 
@@ -131,7 +148,7 @@ Result<SceneCounts> count_scene(const Scene& scene, const SceneBodies& bodies,
                                 const HaloLists* halo) {
   if (Status st = check_settings(scene); !st) return st;
   SceneCounts c;
-  c.impulses = scene.settings.contact_model == ContactModel::Impulses;
+  c.impulses = rigid_contacts_without_forces(scene.settings.contact_model);
   if (Status st = count_bodies(scene, c); !st) return st;
   if (Status st = count_linked(scene, c); !st) return st;
   c.particles = bodies.particles;
@@ -269,6 +286,9 @@ Fingerprint fingerprint(const Settings& settings, const HostLayout& layout) {
     // The impulse stage's sweeps and substeps (not hashed before they existed).
     const std::int64_t stage[2] = {settings.impulse_iterations, settings.impulse_substeps};
     h = fnv1a64(stage, sizeof stage, h);
+  } else if (settings.contact_model == ContactModel::Positions) {
+    const std::int64_t model = 2;
+    h = fnv1a64(&model, sizeof model, h);
   }
   const auto add = [&h](const auto& v) { h = fnv1a64(v.data(), v.size() * sizeof(v[0]), h); };
   add(layout.rigid.local);

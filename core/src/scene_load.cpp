@@ -72,8 +72,13 @@ void read_settings(const Node& node, Settings& s, std::int64_t& max_particles) {
       s.contact_model = ContactModel::Forces;
     } else if (model == "impulse") {
       s.contact_model = ContactModel::Impulses;
+    } else if (model == "position") {
+      s.contact_model = ContactModel::Positions;
+      // Position contacts solve once per substep: a frame of dt needs several (Macklin et al.
+      // 2019); 8 unless the file says.
+      if (!node.find("substeps")) s.substeps = kPositionSubsteps;
     } else {
-      v->fail(fmt::format("unknown contact model \"{}\" (allowed: dem, impulse)", model));
+      v->fail(fmt::format("unknown contact model \"{}\" (allowed: dem, impulse, position)", model));
     }
   }
   if (auto v = node.find("impulse_iterations")) {
@@ -210,7 +215,7 @@ void check_stiffness(const Scene& scene, const std::vector<std::string>& paths) 
       !scene.linked.empty() || std::any_of(scene.bodies.begin(), scene.bodies.end(),
                                            [](const BodySpec& b) { return b.soft; });
   const bool forces_only_where_deformable =
-      scene.settings.contact_model == ContactModel::Impulses && !deformables;
+      rigid_contacts_without_forces(scene.settings.contact_model) && !deformables;
   std::vector<bool> used(scene.materials.size(), false);
   for (const BodySpec& b : scene.bodies) {
     if (!forces_only_where_deformable || b.soft) used[static_cast<std::size_t>(b.material)] = true;

@@ -413,9 +413,10 @@ void DistributedSimulation::group_bodies() {
       }
     }
   }
-  // With impulse contacts, every rigid body: an impulse iteration passes velocities from body to
-  // body through every contact, as far as the iterations reach.
-  if (scene_.settings.contact_model == ContactModel::Impulses) {
+  // With impulse or position contacts, every rigid body: an impulse iteration (a substep's
+  // projection) passes velocities (poses) from body to body through every contact, as far as the
+  // iterations (substeps) reach.
+  if (rigid_contacts_without_forces(scene_.settings.contact_model)) {
     std::uint32_t first = UINT32_MAX;
     for (std::uint32_t b = 0; b < rigid; ++b) {
       if (scene_.bodies[b].soft) continue;

@@ -33,7 +33,9 @@ MOTES_FN void body_integrate(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
   float dt = gravity_dt.w;
   vec3 v = xyz(vel);
   vec3 l = xyz(angmom);
-  if ((flags & MOTES_FLAG_BODY_POSE) == 0u) {
+  if ((flags & MOTES_FLAG_POSITION) != 0u) {  // position contacts: predict with gravity alone
+    v = v + xyz(gravity_dt) * dt;
+  } else if ((flags & MOTES_FLAG_BODY_POSE) == 0u) {
     v = v + (xyz(force) * inv_m + xyz(gravity_dt)) * dt;
     l = l + xyz(torque) * dt;
   }

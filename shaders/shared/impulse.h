@@ -17,7 +17,9 @@
 
 #include "body_math.h"
 #include "common.h"
+#include "contact_body.h"
 #include "params.h"
+#include "position.h"
 
 MOTES_SHARED_BEGIN
 
@@ -44,112 +46,6 @@ MOTES_SHARED_BEGIN
 /// every pair this close is in the lists since their last build (two particles close at most
 /// 2 x 0.45 skin before a rebuild), so the contact set does not depend on when lists were built.
 MOTES_FN float impulse_margin(float skin) { return 0.1f * skin; }
-
-/// What a contact needs to know of one of its bodies. A plane or a static body has com.w == 0 and
-/// inv_inertia == 0, and so takes no part in the contact's effective mass.
-struct ImpulseBody {
-  vec4 com;       // xyz: centre of mass, w: inverse mass
-  vec4 inv_diag;  // world inverse inertia I^-1 = R diag(inverse moments) R^T: xx, yy, zz
-  vec4 inv_off;   // its off-diagonal terms: xy, xz, yz
-  vec4 vel;       // linear velocity now (this iteration)
-  vec4 angvel;    // angular velocity now
-  vec4 vel0;      // xyz: linear velocity at the start of the impulse stage, w: its contacts
-  vec4 angvel0;   // angular velocity at the start of the impulse stage
-};
-
-/// The part of a body as contacts see it that a substep's sweeps do not change: its centre and
-/// inverse mass, and its inverse inertia turned to the world once (a contact applies it four
-/// times). Velocities zero: impulse_body_state fills them.
-MOTES_FN ImpulseBody impulse_body_frame(vec4 com, vec4 quat, vec4 inv_inertia) {
-  ImpulseBody b;
-  b.com = com;
-  // Columns of R: the body axes in the world; I^-1 = sum over k of inv_k c_k c_k^T.
-  vec3 c0 = quat_rotate(quat, vec3(1.0f, 0.0f, 0.0f));
-  vec3 c1 = quat_rotate(quat, vec3(0.0f, 1.0f, 0.0f));
-  vec3 c2 = quat_rotate(quat, vec3(0.0f, 0.0f, 1.0f));
-  vec3 a0 = c0 * inv_inertia.x;
-  vec3 a1 = c1 * inv_inertia.y;
-  vec3 a2 = c2 * inv_inertia.z;
-  b.inv_diag =
-      vec4(a0.x * c0.x + a1.x * c1.x + a2.x * c2.x, a0.y * c0.y + a1.y * c1.y + a2.y * c2.y,
-           a0.z * c0.z + a1.z * c1.z + a2.z * c2.z, 0.0f);
-  b.inv_off = vec4(a0.x * c0.y + a1.x * c1.y + a2.x * c2.y, a0.x * c0.z + a1.x * c1.z + a2.x * c2.z,
-                   a0.y * c0.z + a1.y * c1.z + a2.y * c2.z, 0.0f);
-  b.vel = vec4(0.0f);
-  b.angvel = vec4(0.0f);
-  b.vel0 = vec4(0.0f);
-  b.angvel0 = vec4(0.0f);
-  return b;
-}
-
-/// A body's velocities now and at the substep's start into b; in the counting pass
-/// (MOTES_FLAG_IMPULSE_COUNT) the substep starts now, so its start is its present state.
-MOTES_FN void impulse_body_state(MOTES_INOUT(ImpulseBody) b, vec4 vel, vec4 angvel, vec4 vel0,
-                                 vec4 angvel0, uint flags) {
-  b.vel = vel;
-  b.angvel = angvel;
-  b.vel0 = vel0;
-  b.angvel0 = angvel0;
-  if ((flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
-    b.vel0 = vec4(xyz(vel), 1.0f);
-    b.angvel0 = angvel;
-  }
-}
-
-/// A body as the contacts of an impulse sweep see it, from its buffers' values.
-MOTES_FN ImpulseBody impulse_body_of(vec4 com, vec4 quat, vec4 inv_inertia, vec4 vel, vec4 angvel,
-                                     vec4 vel0, vec4 angvel0, uint flags) {
-  ImpulseBody b = impulse_body_frame(com, quat, inv_inertia);
-  impulse_body_state(b, vel, angvel, vel0, angvel0, flags);
-  return b;
-}
-
-/// The body's world inverse inertia applied to v: I^-1 v.
-MOTES_FN vec3 impulse_inverse_inertia(MOTES_IN(ImpulseBody) b, vec3 v) {
-  return vec3(b.inv_diag.x * v.x + b.inv_off.x * v.y + b.inv_off.y * v.z,
-              b.inv_off.x * v.x + b.inv_diag.y * v.y + b.inv_off.z * v.z,
-              b.inv_off.y * v.x + b.inv_off.z * v.y + b.inv_diag.z * v.z);
-}
-
-/// A body that takes no part: a plane.
-MOTES_FN ImpulseBody impulse_wall() {
-  ImpulseBody w;
-  w.com = vec4(0.0f);
-  w.inv_diag = vec4(0.0f);
-  w.inv_off = vec4(0.0f);
-  w.vel = vec4(0.0f);
-  w.angvel = vec4(0.0f);
-  w.vel0 = vec4(0.0f);
-  w.angvel0 = vec4(0.0f);
-  return w;
-}
-
-/// 1/m + (r x d) . I^-1 (r x d): the inverse mass a unit impulse along d at arm r meets, times
-/// the body's contact count (mass splitting). 0 for a wall or a static body.
-MOTES_FN float impulse_inverse_mass(MOTES_IN(ImpulseBody) b, vec3 r, vec3 d) {
-  if (b.com.w == 0.0f) {
-    return 0.0f;  // a wall or a static body (inverse inertia 0 too): what the terms would give
-  }
-  vec3 rd = cross(r, d);
-  float k = b.com.w + dot(rd, impulse_inverse_inertia(b, rd));
-  return max(b.vel0.w, 1.0f) * k;
-}
-
-/// The change of the velocity of a body's material point at arm r that a unit impulse along d
-/// makes, as a contact sees it (times the body's contact count: mass splitting):
-/// n (d / m + (I^-1 (r x d)) x r). Its dot product with d is impulse_inverse_mass. 0 for a wall.
-MOTES_FN vec3 impulse_response(MOTES_IN(ImpulseBody) b, vec3 r, vec3 d) {
-  if (b.com.w == 0.0f) {
-    return vec3(0.0f);
-  }
-  vec3 w = impulse_inverse_inertia(b, cross(r, d));
-  return (d * b.com.w + cross(w, r)) * max(b.vel0.w, 1.0f);
-}
-
-/// Velocity of a body's material point at arm r: v + w x r.
-MOTES_FN vec3 impulse_point_velocity(vec4 vel, vec4 angvel, vec3 r) {
-  return xyz(vel) + cross(xyz(angvel), r);
-}
 
 /// The normal velocity (separating > 0) a contact must reach in this substep, from its
 /// separation sep (< 0: overlap) and its normal velocity vn0 at the start of the substep:
@@ -184,14 +80,6 @@ MOTES_FN float impulse_target(float sep, float rsum, float vn0, float restitutio
     }
   }
   return target;
-}
-
-/// Where the impulse of two particles acts: their midpoint.
-MOTES_FN vec3 pair_contact_point(vec4 xa, vec4 xb) { return (xyz(xa) + xyz(xb)) * 0.5f; }
-
-/// Where the impulse of a particle and a plane acts: the particle's point nearest the plane.
-MOTES_FN vec3 plane_contact_point(vec4 xa, vec4 normal_offset) {
-  return xyz(xa) - xyz(normal_offset) * xa.w;
 }
 
 /// What the sweeps of one substep do not change in a contact between bodies a and b at point c
@@ -350,6 +238,30 @@ MOTES_FN vec4 particle_contact_impulse(MOTES_IN(ImpulseBody) a, vec4 xa, MOTES_I
                          gravity_dt, flags, acc);
 }
 
+/// The position contact (shared/position.h: contact_position) of particle a (centre xa, radius
+/// ra, body a) and particle b, evaluated as particle_contact_impulse is (a: the lower id), with
+/// rel = x_a - x_b. No contact (zeros, acc zeroed) when their gap is margin or more, or their
+/// centres coincide.
+MOTES_FN PositionPair particle_contact_position(MOTES_IN(ImpulseBody) a, vec4 xa,
+                                                MOTES_IN(ImpulseBody) b, vec4 xb, float margin,
+                                                ContactLaw law, vec4 gravity_dt, uint flags,
+                                                MOTES_INOUT(vec4) acc) {
+  vec3 d = xyz(xa) - xyz(xb);
+  float dist2 = dot(d, d);
+  float rsum = xa.w + xb.w;
+  float reach = rsum + margin;
+  if (dist2 >= reach * reach || dist2 == 0.0f) {
+    PositionPair none;
+    none.a = vec4(0.0f);
+    none.b = vec4(0.0f);
+    acc = vec4(0.0f);
+    return none;
+  }
+  float dist = sqrt(dist2);
+  return contact_position(a, b, pair_contact_point(xa, xb), d / dist, dist - rsum, d, law,
+                          gravity_dt, flags, acc);
+}
+
 /// Index in the contact-law table of the pair of particles i and j (materials mi, mj) as
 /// pair_impulse evaluates it: the lower id's material first, so both particles use one law.
 MOTES_FN uint pair_law_index(uint i, uint mi, uint j, uint mj, uint materials) {
@@ -362,6 +274,13 @@ MOTES_FN uint pair_law_index(uint i, uint mi, uint j, uint mj, uint materials) {
 MOTES_FN vec4 pair_impulse(MOTES_IN(ImpulseBody) own, vec4 xi, MOTES_IN(ImpulseBody) other, vec4 xj,
                            bool own_first, float margin, ContactLaw law, vec4 gravity_dt,
                            uint flags, MOTES_INOUT(vec4) acc) {
+  if ((flags & MOTES_FLAG_POSITION) != 0u) {  // the same evaluation, each side its own result
+    PositionPair r =
+        own_first
+            ? particle_contact_position(own, xi, other, xj, margin, law, gravity_dt, flags, acc)
+            : particle_contact_position(other, xj, own, xi, margin, law, gravity_dt, flags, acc);
+    return own_first ? r.a : r.b;
+  }
   if (own_first) {
     return particle_contact_impulse(own, xi, other, xj, margin, law, gravity_dt, flags, acc);
   }
@@ -381,8 +300,13 @@ MOTES_FN vec4 plane_contact_impulse(MOTES_IN(ImpulseBody) a, vec4 xa, vec4 norma
     acc = vec4(0.0f);  // zero already in the iterations: positions do not change within them
     return vec4(0.0f);
   }
-  return contact_impulse(a, impulse_wall(), plane_contact_point(xa, normal_offset), np, sep, xa.w,
-                         law, gravity_dt, flags, acc);
+  vec3 c = plane_contact_point(xa, normal_offset);
+  if ((flags & MOTES_FLAG_POSITION) != 0u) {
+    return contact_position(a, impulse_wall(), c, np, sep, plane_contact_rel(c, np), law,
+                            gravity_dt, flags, acc)
+        .a;
+  }
+  return contact_impulse(a, impulse_wall(), c, np, sep, xa.w, law, gravity_dt, flags, acc);
 }
 
 /// True when the contact of particles i and j (neighbour counts ci and cj) keeps its accumulated
@@ -435,6 +359,22 @@ MOTES_FN void body_apply_impulse(vec4 com, vec4 quat, vec4 inv_inertia, MOTES_IN
   vel = vec4(xyz(vel) + impulse * inv_m, 0.0f);
   angmom = vec4(l, 0.0f);
   angvel = vec4(body_angular_velocity(quat, inv_inertia, l), 0.0f);
+}
+
+/// What impulses_apply does with a body's summed impulse and moment under any flags: the
+/// projection of position contacts (MOTES_FLAG_POSITION without MOTES_FLAG_IMPULSE_COUNT or
+/// MOTES_FLAG_POSITION_VELOCITY) moves the pose too (shared/position.h: body_apply_position);
+/// everything else changes the velocities (body_apply_impulse).
+MOTES_FN void body_apply_contacts(MOTES_INOUT(vec4) com, MOTES_INOUT(vec4) quat, vec4 inv_inertia,
+                                  MOTES_INOUT(vec4) vel, MOTES_INOUT(vec4) angmom,
+                                  MOTES_OUT(vec4) angvel, vec3 impulse, vec3 moment,
+                                  vec4 gravity_dt, uint flags) {
+  uint pass = MOTES_FLAG_POSITION | MOTES_FLAG_IMPULSE_COUNT | MOTES_FLAG_POSITION_VELOCITY;
+  if ((flags & pass) == MOTES_FLAG_POSITION) {
+    body_apply_position(com, quat, inv_inertia, vel, angmom, angvel, impulse, moment, gravity_dt.w);
+  } else {
+    body_apply_impulse(com, quat, inv_inertia, vel, angmom, angvel, impulse, moment);
+  }
 }
 
 MOTES_SHARED_END

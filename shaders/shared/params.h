@@ -35,6 +35,14 @@ MOTES_SHARED_BEGIN
 /// impulses_apply: keep the velocities this sweep leaves (BodyVelPush, BodyAngMomPush) as those
 /// the pose moves with; bodies_integrate with MOTES_FLAG_BODY_POSE: move with them.
 #define MOTES_FLAG_IMPULSE_PUSH 256u
+/// Position contacts (shared/position.h, docs/architecture.md "Position contacts"):
+/// impulses_compute projects the overlaps of the predicted poses (with MOTES_FLAG_IMPULSE_COUNT:
+/// counts them); impulses_apply moves each body's pose by what its contacts ask and keeps the
+/// motion as velocity; bodies_integrate predicts with gravity alone (no BodyForce, BodyTorque).
+#define MOTES_FLAG_POSITION 512u
+/// With MOTES_FLAG_POSITION, impulses_compute: the velocity pass (restitution, and the normal
+/// velocity the projection left taken back) on the contacts the projection had.
+#define MOTES_FLAG_POSITION_VELOCITY 1024u
 
 /// Launch parameters of every kernel family; travels with the launch (push constants).
 struct StepParams {

@@ -6,7 +6,8 @@
 // by NMSE on all components (a quaternion; w = 0 for the vectors). `PushPose1234` runs the impulse
 // stage's pose update (MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_PUSH): BodyVelPush and
 // BodyAngMomPush written too (some zero), the pose moved with them (body_push_pose) while the
-// bodies keep their own velocities.
+// bodies keep their own velocities. `Predict1234` runs the prediction of position contacts
+// (MOTES_FLAG_POSITION: gravity alone, BodyForce and BodyTorque written but not applied).
 //
 // Tolerance: NMSE 1e-10. Per body the same shared body_integrate runs on the same floats, so
 // openmp matches bitwise (measures 0). A GPU may fuse multiply-adds and has its own sin, cos and
@@ -16,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "conformance.h"
@@ -95,6 +97,13 @@ TEST_P(BodiesIntegrate, Random31) { run_case("random", random_bodies(53, 31)); }
 TEST_P(BodiesIntegrate, Random1234) { run_case("random", random_bodies(54, 1234)); }
 TEST_P(BodiesIntegrate, Random65536) { run_case("random", random_bodies(55, 65536)); }
 TEST_P(BodiesIntegrate, PushPose1234) { run_case("push pose", random_bodies(56, 1234), true); }
+TEST_P(BodiesIntegrate, Predict1234) {
+  // Position contacts' prediction (MOTES_FLAG_POSITION): gravity alone, the random BodyForce and
+  // BodyTorque written but not applied.
+  World w = random_bodies(57, 1234);
+  w.params.flags |= MOTES_FLAG_POSITION;
+  run_case("predict", std::move(w));
+}
 
 INSTANTIATE_TEST_SUITE_P(Conformance, BodiesIntegrate, testing::ValuesIn(device_params()),
                          param_name);

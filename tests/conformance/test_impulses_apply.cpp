@@ -11,7 +11,9 @@
 // stamps must come back as written, bitwise; with it the start is (BodyVel, the summed count) and
 // BodyAngVel as they were, and the dynamic bodies' particles are stamped 9. Without
 // MOTES_FLAG_IMPULSE_PUSH the pushed velocities must come back as written; with it they are the
-// velocities the call leaves.
+// velocities the call leaves. With MOTES_FLAG_POSITION (the projection of position contacts) the
+// call moves the dynamic bodies' poses too (BodyPos, BodyQuat read back and compared); otherwise
+// they must come back as written, bitwise.
 //
 // Tolerance: NMSE 1e-7, as for the same outputs in test_impulses_compute.cpp. The sums are in
 // float in particle order on every backend and the update is the shared body_apply_impulse, so
@@ -45,6 +47,7 @@ class ImpulsesApply : public DeviceTest {
     w.params.flags |= flags;
     const bool counting = (flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
     const bool push = (flags & MOTES_FLAG_IMPULSE_PUSH) != 0u;
+    const bool moves = (flags & MOTES_FLAG_POSITION) != 0u;
     const std::size_t n = w.particles.size();
     const std::size_t nr = w.particles.rigid;
     const std::size_t b = w.bodies.size();
@@ -101,8 +104,10 @@ class ImpulsesApply : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyVelPush, given.vel_push));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::BodyAngMomPush, given.angmom_push));
     ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesApply, w.params));
-    std::vector<vec4> vel, angmom, angvel, vel0, angvel0, vel_push, angmom_push;
+    std::vector<vec4> pos, quat, vel, angmom, angvel, vel0, angvel0, vel_push, angmom_push;
     std::vector<uint> stamp;
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyPos, pos));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyQuat, quat));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyVel, vel));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngMom, angmom));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngVel, angvel));
@@ -124,7 +129,20 @@ class ImpulsesApply : public DeviceTest {
     std::size_t stamped = 0;
     for (std::size_t i = 0; i < nr; ++i) stamped += s.stamp[i] != given.stamp[i] ? 1 : 0;
 
+    std::size_t turned = 0;
+    for (std::size_t k = 0; k < b; ++k) {
+      const vec4 a = want.quat[k], o = w.bodies.quat[k];
+      turned += a.x != o.x || a.y != o.y || a.z != o.z || a.w != o.w ? 1 : 0;
+    }
+
     begin_case("impulses_apply/" + layout, b);
+    if (moves) {
+      check_close("BodyPos", pos, want.pos, kApplyTolerance);
+      check_close("BodyQuat", quat, want.quat, kApplyTolerance);
+    } else {
+      check_identical("BodyPos untouched", pos, w.bodies.pos);
+      check_identical("BodyQuat untouched", quat, w.bodies.quat);
+    }
     check_close("BodyVel", vel, want.vel, kApplyTolerance);
     check_close("BodyAngMom", angmom, want.angmom, kApplyTolerance);
     check_close("BodyAngVel", angvel, want.angvel, kApplyTolerance);
@@ -144,6 +162,7 @@ class ImpulsesApply : public DeviceTest {
       check_identical("BodyAngMomPush untouched", angmom_push, given.angmom_push);
     }
     check_that("the impulses change most bodies' velocities", b < 3 || changed >= b / 2);
+    check_that("the projection turns most bodies", !moves || b < 3 || turned >= b / 2);
     check_that("the counting pass counts contacts and stamps particles",
                !counting || nr < 31 || (counted >= b / 2 && stamped > 0));
     end_case();
@@ -171,6 +190,15 @@ TEST_P(ImpulsesApply, Push1234) {
 }
 TEST_P(ImpulsesApply, Push65536) {
   run_case("push", apply_world(90, 65536), MOTES_FLAG_IMPULSE_PUSH);
+}
+TEST_P(ImpulsesApply, Position31) {
+  run_case("position", apply_world(91, 31), MOTES_FLAG_POSITION);
+}
+TEST_P(ImpulsesApply, Position1234) {
+  run_case("position", apply_world(92, 1234), MOTES_FLAG_POSITION);
+}
+TEST_P(ImpulsesApply, Position65536) {
+  run_case("position", apply_world(93, 65536), MOTES_FLAG_POSITION);
 }
 
 INSTANTIATE_TEST_SUITE_P(Conformance, ImpulsesApply, testing::ValuesIn(device_params()),

@@ -26,7 +26,10 @@
 // velocities, BodyVelStart and BodyAngVelStart, BodyVelPush and BodyAngMomPush, every
 // ContactImpulse slot, ImpulseStamp, and the last iteration's ParticleForce and ParticleMoment of
 // the rigid particles. Each case runs with K = 16 and again with K = 2, where most particles walk
-// the grid and their contacts keep no memory.
+// the grid and their contacts keep no memory. PositionsComputeThenApply runs the same worlds
+// through a substep of position contacts (shared/position.h): the counting pass, the projection
+// (which moves the bodies: BodyPos and BodyQuat read back too) and the velocity pass, each a
+// compute and an apply.
 //
 // Tolerance: NMSE 1e-7. The terms come from the same shared functions and floats, summed in float
 // in the contract's order (list order, then particle order per body), so openmp matches bitwise
@@ -92,6 +95,9 @@ motes_ref::ImpulseState contact_memory(const World& w, const motes_ref::Neighbou
 
 class ImpulsesComputeThenApply : public DeviceTest {
  protected:
+  /// Set: a substep of position contacts (shared/position.h) instead of the impulse stage.
+  bool position_ = false;
+
   /// The counting pass and kIterations iterations on the device and the oracle, lists of
   /// capacity K; `acc` and `stamp` are the contacts' memory at the start.
   void run_capacity(const std::string& name, World w, const motes_ref::Grid& g,
@@ -104,22 +110,27 @@ class ImpulsesComputeThenApply : public DeviceTest {
     const std::vector<vec4> acc0 = s.acc;
     const std::vector<uint> stamp0 = s.stamp;
 
-    StepParams count = w.params;
-    count.flags |= MOTES_FLAG_IMPULSE_COUNT;
-    StepParams last = w.params;
-    last.flags |= MOTES_FLAG_IMPULSE_PUSH;
-    StepParams relax = w.params;
-    relax.flags |= MOTES_FLAG_IMPULSE_RELAX;
-    motes_ref::Bodies want = w.bodies;
-    motes_ref::impulses_compute(w.particles, want, nb, w.laws, w.planes, count, s);
-    motes_ref::impulses_apply(want, count, s);
-    for (int it = 0; it < kIterations; ++it) {
-      motes_ref::impulses_compute(w.particles, want, nb, w.laws, w.planes, w.params, s);
-      motes_ref::impulses_apply(want, it + 1 == kIterations ? last : w.params, s);
+    // The passes, each a compute and an apply with the same flags.
+    std::vector<StepParams> passes;
+    const auto pass = [&](uint flags) {
+      passes.push_back(w.params);
+      passes.back().flags |= flags;
+    };
+    if (position_) {  // a substep of position contacts: count, project, velocity pass
+      pass(MOTES_FLAG_POSITION | MOTES_FLAG_IMPULSE_COUNT);
+      pass(MOTES_FLAG_POSITION);
+      pass(MOTES_FLAG_POSITION | MOTES_FLAG_POSITION_VELOCITY);
+    } else {
+      pass(MOTES_FLAG_IMPULSE_COUNT);
+      for (int it = 0; it < kIterations; ++it) {
+        pass(it + 1 == kIterations ? MOTES_FLAG_IMPULSE_PUSH : 0u);
+      }
+      for (int it = 0; it < kRelaxing; ++it) pass(MOTES_FLAG_IMPULSE_RELAX);
     }
-    for (int it = 0; it < kRelaxing; ++it) {
-      motes_ref::impulses_compute(w.particles, want, nb, w.laws, w.planes, relax, s);
-      motes_ref::impulses_apply(want, relax, s);
+    motes_ref::Bodies want = w.bodies;
+    for (const StepParams& q : passes) {
+      motes_ref::impulses_compute(w.particles, want, nb, w.laws, w.planes, q, s);
+      motes_ref::impulses_apply(want, q, s);
     }
 
     ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
@@ -155,20 +166,16 @@ class ImpulsesComputeThenApply : public DeviceTest {
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourState, state));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ContactImpulse, acc0));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ImpulseStamp, stamp0));
-    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesCompute, count));
-    ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesApply, count));
-    for (int it = 0; it < kIterations; ++it) {
-      ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesCompute, w.params));
-      ASSERT_NO_FATAL_FAILURE(
-          run(motes::Kernel::ImpulsesApply, it + 1 == kIterations ? last : w.params));
-    }
-    for (int it = 0; it < kRelaxing; ++it) {
-      ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesCompute, relax));
-      ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesApply, relax));
+    for (const StepParams& q : passes) {
+      ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesCompute, q));
+      ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::ImpulsesApply, q));
     }
     ASSERT_NO_FATAL_FAILURE(finish_kernel());
-    std::vector<vec4> vel, angmom, angvel, vel0, angvel0, vel_push, angmom_push, acc, force, moment;
+    std::vector<vec4> pos, quat, vel, angmom, angvel, vel0, angvel0, vel_push, angmom_push, acc,
+        force, moment;
     std::vector<uint> stamp;
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyPos, pos));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyQuat, quat));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyVel, vel));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngMom, angmom));
     ASSERT_NO_FATAL_FAILURE(read(Buffer::BodyAngVel, angvel));
@@ -199,14 +206,18 @@ class ImpulsesComputeThenApply : public DeviceTest {
                                    ? 1
                                    : 0);
     }
-    begin_case("impulses/" + name, w.particles.size());
+    begin_case((position_ ? "positions/" : "impulses/") + name, w.particles.size());
+    check_close("BodyPos", pos, want.pos, kImpulsesTolerance);
+    check_close("BodyQuat", quat, want.quat, kImpulsesTolerance);
     check_close("BodyVel", vel, want.vel, kImpulsesTolerance);
     check_close("BodyAngMom", angmom, want.angmom, kImpulsesTolerance);
     check_close("BodyAngVel", angvel, want.angvel, kImpulsesTolerance);
     check_close("BodyVelStart", vel0, s.vel0, kImpulsesTolerance);
     check_close("BodyAngVelStart", angvel0, s.angvel0, kImpulsesTolerance);
-    check_close("BodyVelPush", vel_push, s.vel_push, kImpulsesTolerance);
-    check_close("BodyAngMomPush", angmom_push, s.angmom_push, kImpulsesTolerance);
+    if (!position_) {  // position contacts keep no pushed velocities
+      check_close("BodyVelPush", vel_push, s.vel_push, kImpulsesTolerance);
+      check_close("BodyAngMomPush", angmom_push, s.angmom_push, kImpulsesTolerance);
+    }
     check_close("ContactImpulse", acc, s.acc, kImpulsesTolerance);
     check_identical("ImpulseStamp", stamp, s.stamp);
     check_close("ParticleForce (impulses)", slice(force, 0, nr), s.impulse, kImpulsesTolerance);
@@ -247,6 +258,20 @@ TEST_P(ImpulsesComputeThenApply, FarFromOrigin) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Conformance, ImpulsesComputeThenApply, testing::ValuesIn(device_params()),
+                         param_name);
+
+/// The same worlds through a substep of position contacts.
+class PositionsComputeThenApply : public ImpulsesComputeThenApply {
+ protected:
+  PositionsComputeThenApply() { position_ = true; }
+};
+
+TEST_P(PositionsComputeThenApply, One) { run_case("random", impulse_world(71, 1)); }
+TEST_P(PositionsComputeThenApply, Random31) { run_case("random", impulse_world(72, 31)); }
+TEST_P(PositionsComputeThenApply, Random1234) { run_case("random", impulse_world(73, 1234)); }
+TEST_P(PositionsComputeThenApply, Random5000) { run_case("random", impulse_world(74, 5000)); }
+
+INSTANTIATE_TEST_SUITE_P(Conformance, PositionsComputeThenApply, testing::ValuesIn(device_params()),
                          param_name);
 
 /// impulses_compute alone, one call: the counting pass from the contacts' memory.

@@ -31,9 +31,9 @@ namespace {
 using motes_test::to_quat;
 using motes_test::to_vec3;
 
-constexpr double kDiameter = 0.05;
+constexpr double kStackDiameter = 0.05;
 constexpr int kPerSide = 4;
-constexpr double kSize = kPerSide * kDiameter;
+constexpr double kSize = kPerSide * kStackDiameter;
 constexpr int kBoxes = 5;
 constexpr double kDt = 1.1e-4;
 constexpr double kSettle = 0.5;
@@ -46,8 +46,8 @@ motes::Scene stack_scene() {
   const motes::Material mat = motes_test::material(kDensity, kStiffness, 1500.0, 1500.0, 0.5);
   motes::Scene scene = motes_test::scene_with(kDt, Eigen::Vector3d(0.0, -kGravity, 0.0), mat);
   scene.planes.push_back(motes_test::plane(Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero()));
-  auto box = motes_test::lattice(kPerSide, kPerSide, kPerSide, kDiameter);
-  const double gap = 0.01 * kDiameter;
+  auto box = motes_test::lattice(kPerSide, kPerSide, kPerSide, kStackDiameter);
+  const double gap = 0.01 * kStackDiameter;
   for (int i = 0; i < kBoxes; ++i) {
     const double y = 0.5 * kSize + gap + i * (kSize + gap);
     scene.bodies.push_back(motes_test::body(box, Eigen::Vector3d(0.0, y, 0.0)));
@@ -134,7 +134,7 @@ TEST(Stack, FiveBoxesSettleAndStayPut) {
     const double want = (i + 0.5) * kSize - sunk;
     const double got = static_cast<double>(first.last.body_pos[i].y);
     worst_height = std::max(worst_height, std::abs(got - want));
-    EXPECT_NEAR(got, want, 1e-3 * kDiameter) << "box " << i;
+    EXPECT_NEAR(got, want, 1e-3 * kStackDiameter) << "box " << i;
     const double turn =
         to_quat(first.initial.body_quat[i]).angularDistance(to_quat(first.last.body_quat[i]));
     worst_turn = std::max(worst_turn, turn);
@@ -143,7 +143,7 @@ TEST(Stack, FiveBoxesSettleAndStayPut) {
   std::printf(
       "[stack] rest heights: largest error %.2e m (%.2e of a diameter); largest turn %.1e "
       "rad\n",
-      worst_height, worst_height / kDiameter, worst_turn);
+      worst_height, worst_height / kStackDiameter, worst_turn);
 
   StackRun second;
   ASSERT_NO_FATAL_FAILURE(run_stack(false, second));

@@ -1,6 +1,7 @@
 // The oracle of impulses_apply (reference.h has the contract): each dynamic body's particles'
-// impulses and moments summed in float in particle order, then the shared body_apply_impulse, body
-// after body.
+// impulses and moments summed in float in particle order, then the shared body_apply_contacts
+// (body_apply_impulse, or body_apply_position for the projection of position contacts), body after
+// body.
 #include <cstddef>
 
 #include "reference.h"
@@ -34,9 +35,9 @@ void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s) {
         for (uint i = bodies.first[b]; i < bodies.first[b + 1]; ++i) s.stamp[i] = s.builds;
       }
     }
-    motes::shared::body_apply_impulse(bodies.pos[b], bodies.quat[b], bodies.inv_inertia[b],
-                                      bodies.vel[b], bodies.angmom[b], bodies.angvel[b], xyz(sum),
-                                      m);
+    motes::shared::body_apply_contacts(bodies.pos[b], bodies.quat[b], bodies.inv_inertia[b],
+                                       bodies.vel[b], bodies.angmom[b], bodies.angvel[b], xyz(sum),
+                                       m, p.gravity_dt, p.flags);
     if (push) {
       s.vel_push[b] = bodies.vel[b];
       s.angmom_push[b] = bodies.angmom[b];

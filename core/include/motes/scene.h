@@ -31,12 +31,23 @@ struct Material {
   double restitution = 0.0;
 };
 
-/// How rigid bodies meet each other and the planes (docs/architecture.md, "Impulse contacts").
-/// Soft bodies, cloth and ropes always meet everything through the force law.
+/// How rigid bodies meet each other and the planes (docs/architecture.md, "Impulse contacts" and
+/// "Position contacts"). Soft bodies, cloth and ropes meet everything through the force law (with
+/// position contacts a scene may not have them yet: issue 27).
 enum class ContactModel {
-  Forces,   ///< Harada's DEM: spring, dashpot and tangential force per particle contact
-  Impulses  ///< Guendelman et al. 2003: impulses with restitution and Coulomb friction
+  Forces,    ///< Harada's DEM: spring, dashpot and tangential force per particle contact
+  Impulses,  ///< Guendelman et al. 2003: impulses with restitution and Coulomb friction
+  Positions  ///< Müller et al. 2020: position constraints per substep, frame-sized steps
 };
+
+/// True when rigid bodies meet each other and the planes without the force law (impulse or
+/// position contacts): they need no stiffness and set no stability limit among themselves.
+inline bool rigid_contacts_without_forces(ContactModel model) {
+  return model != ContactModel::Forces;
+}
+
+/// Substeps of a step with position contacts when the scene does not give them.
+constexpr int kPositionSubsteps = 8;
 
 /// Global settings of a scene.
 struct Settings {
@@ -55,7 +66,8 @@ struct Settings {
   int constraint_iterations = 8;
   /// Cloth and ropes: their particles' velocities decay at this rate (1/s); 0 = none.
   double link_damping = 0.0;
-  /// Rigid-body contacts by forces (default) or by impulses ("contact_model": "impulse").
+  /// Rigid-body contacts by forces (default), by impulses ("contact_model": "impulse") or by
+  /// positions ("position": each step a frame, settings.substeps of it solved once each).
   ContactModel contact_model = ContactModel::Forces;
   /// Impulse contacts: sweeps over every contact per substep, spread over impulse_substeps (each
   /// gets ceil(impulse_iterations / impulse_substeps): the first half correct overlaps, the rest

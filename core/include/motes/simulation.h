@@ -309,6 +309,9 @@ class Simulation {
   Status upload(const Scene& scene, const HaloLists* halo);
   /// The rigid bodies' part of a substep with impulse contacts (docs/architecture.md).
   void step_impulses();
+  /// One step of position contacts (settings.substeps substeps); lists: the neighbour
+  /// update's parameters.
+  void step_positions(const shared::StepParams& lists);
   /// Cloth and ropes attached to rigid bodies: the bodies take the constraints' pull.
   void absorb_attachments();
   /// Impulse contacts: every contact's accumulated impulse to zero and its list slots void (a

@@ -26,7 +26,8 @@
 //   Static particles get 0. Exact while no particle has moved 0.45 skin since the build.
 // bodies_reduce: BodyForce and BodyTorque: sums over each body's particles in particle order.
 // bodies_integrate: semi-implicit Euler on every dynamic body (shared/body_math.h:
-//   body_integrate; with impulse contacts from BodyVelPush and BodyAngMomPush).
+//   body_integrate; with impulse contacts from BodyVelPush and BodyAngMomPush; with position
+//   contacts, MOTES_FLAG_POSITION, the prediction with gravity alone).
 // particles_update: ParticlePos and ParticleVel xyz of the rigid particles [0, Nr) from their
 //   body's pose; asks for a rebuild (NeighbourState) when one has moved too far from its
 //   NeighbourRefPos. With MOTES_FLAG_ABSORB, first ParticleForce =
@@ -54,11 +55,16 @@
 //   used). A sweep (no MOTES_FLAG_IMPULSE_COUNT) after its substep's counting pass, positions and
 //   lists unchanged since, may visit only the particles that pass found within reach of a
 //   contact (the others' impulses are 0, as the step needs); a backend that keeps that must forget
-//   it at allocate and at a write of positions or lists.
+//   it at allocate and at a write of positions or lists. With MOTES_FLAG_POSITION the contacts are
+//   position contacts (shared/position.h: contact_position; ContactImpulse slots zeroed): the
+//   counting pass, the projection, or (MOTES_FLAG_POSITION_VELOCITY) the velocity pass, which may
+//   follow a projection that moved the poses.
 // impulses_apply: every dynamic body sums its particles' ParticleForce and ParticleMoment in
 //   particle order, then shared/impulse.h: body_apply_impulse (BodyVel, BodyAngMom, BodyAngVel).
 //   With MOTES_FLAG_IMPULSE_COUNT instead: BodyVelStart = (BodyVel xyz, the summed count),
-//   BodyAngVelStart = BodyAngVel; with MOTES_FLAG_IMPULSE_PUSH the pushed velocities.
+//   BodyAngVelStart = BodyAngVel; with MOTES_FLAG_IMPULSE_PUSH the pushed velocities. With
+//   MOTES_FLAG_POSITION alone (the projection of position contacts), shared/impulse.h:
+//   body_apply_contacts moves BodyPos and BodyQuat too (shared/position.h).
 // particles_check (not part of a step: the motion guard): MotionCheck gets the largest
 //   (|v| / d)^2 of a finite particle of [0, particle_count), the first particle with it and its
 //   |v|^2, and the first particle whose position or velocity is not finite
@@ -130,8 +136,8 @@
     (ParticleForce, ParticleMoment, BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel,          \
      BodyInvInertia, BodyFirst, BodyVelStart, BodyAngVelStart, NeighbourState, ImpulseStamp,     \
      BodyVelPush, BodyAngMomPush),                                                               \
-    (BodyVel, BodyAngMom, BodyAngVel, BodyVelStart, BodyAngVelStart, ImpulseStamp, BodyVelPush,  \
-     BodyAngMomPush))                                                                            \
+    (BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel, BodyVelStart, BodyAngVelStart,          \
+     ImpulseStamp, BodyVelPush, BodyAngMomPush))                                                 \
   X(ParticlesCheck, particles_check, (ParticlePos, ParticleVel), (MotionCheck))                  \
   X(EnergyReduce, energy_reduce,                                                                 \
     (ParticlePos, ParticleVel, BodyPos, BodyVel, BodyAngMom, BodyAngVel, EnergyPartials),        \

@@ -1,0 +1,164 @@
+// Position contacts (docs/architecture.md, "Position contacts"; docs/position-solver.md): rigid
+// bodies made of particles meet each other and the planes as position constraints, solved once
+// per substep on the poses predicted with gravity (Macklin et al. 2019, "Small steps"), as Müller
+// et al. 2020 ("Detailed rigid body simulation with extended position based dynamics") correct
+// rigid poses:
+// - projection: a contact of bodies a and b at point c with normal n (from b towards a) and
+//   overlap d > 0 is the constraint C = d; its correction p = d / (w_a + w_b) n, with the
+//   generalized inverse masses w = 1/m + (r x n) . I^-1 (r x n), moves a's centre by p / m_a and
+//   turns it by I^-1 (r_a x p) (b the opposite way). Static friction is positional: the contact
+//   keeps an anchor (where it stuck) and its drift from it along the contact plane is undone while
+//   the tangential correction stays below mu times the normal one, else it is capped there
+//   (Macklin et al. 2014, eq. 24, with one mu for both; the anchor is Müller et al. 2020's
+//   contact-point difference kept across substeps): a sticking contact goes back to where it
+//   stuck, so a resting pile cannot creep; a sliding one loses mu g per unit time of its speed.
+// - velocities: each body keeps the motion its pose made as velocity (v += p / (m h), and the
+//   same for the angular momentum), as PBD's v = (x - x_start) / h does;
+// - velocity pass (Müller et al. 2020, section 3.5): each contact the projection had sets its
+//   normal velocity to -e vn0 (vn0 its normal velocity before the projection) when it closed
+//   faster than MOTES_POSITION_BOUNCE_SUBSTEPS substeps of gravity, else to 0, so that the
+//   speed a correction gave a body is taken back rather than kept.
+// Departure from Müller 2020: Jacobi with mass splitting instead of Gauss-Seidel, as the impulse
+// contacts do (shared/impulse.h): every contact of a body with n contacts sees it with n times its
+// inverse mass and inertia, all contacts are solved from the same poses, each body sums its
+// particles' corrections in particle order: no atomics, the same integers on every backend.
+// One Jacobi projection per substep moves a body between two contacts only part of the way, so a
+// column of bodies behaves as a chain of soft springs: 2 to 5 boxes stand, 10 sag and sway
+// (docs/position-solver.md has the measurements and what would fix it).
+// A correction travels as an impulse, J = p / h, through the buffers the impulse contacts use, so
+// that impulses_compute and impulses_apply run both models.
+#ifndef MOTES_SHARED_POSITION_H
+#define MOTES_SHARED_POSITION_H
+
+#include "body_math.h"
+#include "common.h"
+#include "contact_body.h"
+#include "params.h"
+#include "quaternion.h"
+
+MOTES_SHARED_BEGIN
+
+/// A contact closing faster than this many substeps' worth of gravity bounces (Müller et al.
+/// 2020 use 2); resting contacts close at |g| h every substep and do not.
+#define MOTES_POSITION_BOUNCE_SUBSTEPS 2.0f
+
+/// What a position contact does to each of its two bodies (xyz: the impulse, w: 1 for a contact
+/// that overlaps, else 0).
+struct PositionPair {
+  vec4 a;
+  vec4 b;
+};
+
+/// The position contact of bodies a and b at point c, normal n (unit, from b towards a),
+/// separation sep (< 0: overlap): the impulse on each body and whether it counts (PositionPair).
+/// acc, the contact's memory (its slot, as the lower particle id sees it): xyz its friction
+/// anchor, where rel (a's particle relative to b) was when the contact stuck (never 0 for a real
+/// anchor: 0 is none), w unused (0).
+/// - with MOTES_FLAG_IMPULSE_COUNT: only the count (the bodies' contact counts, which scale the
+///   inverse masses: mass splitting, are known after it); the anchor kept while the contact
+///   overlaps;
+/// - with MOTES_FLAG_POSITION_VELOCITY: the velocity pass, from the velocities now (vel, angvel)
+///   and those before the projection (vel0, angvel0);
+/// - else the projection: (d n / (w_a + w_b) - the friction correction) / h on a, its negation
+///   on b. Static friction takes rel back to its anchor along the contact plane (a new contact
+///   anchors where it was at the substep's start, rel - u h): a drift of many substeps, each too
+///   small to see, is undone as a whole, so a body on a bumpy support cannot creep. Past mu times
+///   the normal correction the contact slides: the correction is capped and the anchor follows
+///   what is left.
+MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, vec3 c,
+                                       vec3 n, float sep, vec3 rel, ContactLaw law, vec4 gravity_dt,
+                                       uint flags, MOTES_INOUT(vec4) acc) {
+  PositionPair res;
+  res.a = vec4(0.0f);
+  res.b = vec4(0.0f);
+  if (!(sep < 0.0f)) {
+    acc = vec4(0.0f);
+    return res;
+  }
+  res.a = vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  res.b = vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  if ((flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
+    return res;
+  }
+  float h = gravity_dt.w;
+  vec3 ra = c - xyz(a.com);
+  vec3 rb = c - xyz(b.com);
+  float kn = impulse_inverse_mass(a, ra, n) + impulse_inverse_mass(b, rb, n);
+  if (!(kn > 0.0f)) {
+    return res;
+  }
+  vec3 u =
+      impulse_point_velocity(a.vel, a.angvel, ra) - impulse_point_velocity(b.vel, b.angvel, rb);
+  if ((flags & MOTES_FLAG_POSITION_VELOCITY) != 0u) {
+    vec3 u0 = impulse_point_velocity(a.vel0, a.angvel0, ra) -
+              impulse_point_velocity(b.vel0, b.angvel0, rb);
+    float vn0 = dot(u0, n);
+    float bounce_speed = MOTES_POSITION_BOUNCE_SUBSTEPS * length(xyz(gravity_dt)) * h;
+    // Bounce; else keep no approach and no more separation than the contact had before the
+    // projection (a body that left a bounce still overlapping keeps its speed).
+    float target = vn0 < -bounce_speed ? -law.restitution * vn0 : max(vn0, 0.0f);
+    vec3 j = n * ((target - dot(u, n)) / kn);
+    res.a = vec4(j, 1.0f);
+    res.b = vec4(-j, 1.0f);
+    return res;
+  }
+  float ln = -sep / kn;
+  vec3 p = n * ln;
+  bool anchored = acc.x != 0.0f || acc.y != 0.0f || acc.z != 0.0f;
+  vec3 anchor = anchored ? xyz(acc) : rel - u * h;
+  if (law.friction != 0.0f) {
+    vec3 drift = rel - anchor;
+    vec3 dt = drift - n * dot(drift, n);
+    float len2 = dot(dt, dt);
+    if (len2 > 0.0f) {
+      float len = sqrt(len2);
+      vec3 t = dt / len;
+      float kt = impulse_inverse_mass(a, ra, t) + impulse_inverse_mass(b, rb, t);
+      if (kt > 0.0f) {
+        float lt = len / kt;
+        if (law.friction > 0.0f && lt > law.friction * ln) {
+          lt = law.friction * ln;
+          anchor += t * (len - lt * kt);  // sliding: the anchor follows what is not undone
+        }
+        p -= t * lt;
+      }
+    }
+  }
+  acc = vec4(anchor, 0.0f);
+  res.a = vec4(p / h, 1.0f);
+  res.b = vec4(-p / h, 1.0f);
+  return res;
+}
+
+/// Where a particle touching a plane is, for the contact's friction anchor (contact_position's
+/// rel): its contact point c's part along the plane, plus the plane's unit normal np, so that it
+/// is never 0 (0 means no anchor).
+MOTES_FN vec3 plane_contact_rel(vec3 c, vec3 np) { return c - np * dot(np, c) + np; }
+
+/// A body's pose and velocities after its position contacts (impulses_apply with
+/// MOTES_FLAG_POSITION): impulse = sum of J = p / h over its contacts, moment = sum of
+/// (c - x_com) x J. The centre moves by h impulse / m, the orientation turns by
+/// h I^-1(q) moment, and the body keeps that motion as velocity (v += impulse / m,
+/// L += moment, w = I^-1(q') L). Static bodies (com.w == 0) are left untouched.
+MOTES_FN void body_apply_position(MOTES_INOUT(vec4) com, MOTES_INOUT(vec4) quat, vec4 inv_inertia,
+                                  MOTES_INOUT(vec4) vel, MOTES_INOUT(vec4) angmom,
+                                  MOTES_OUT(vec4) angvel, vec3 impulse, vec3 moment, float h) {
+  float inv_m = com.w;
+  if (inv_m == 0.0f) {
+    angvel = vec4(body_angular_velocity(quat, inv_inertia, xyz(angmom)), 0.0f);
+    return;
+  }
+  vec3 dv = impulse * inv_m;
+  com = vec4(xyz(com) + dv * h, inv_m);
+  if (moment.x != 0.0f || moment.y != 0.0f || moment.z != 0.0f) {
+    quat = quat_integrate(quat, body_angular_velocity(quat, inv_inertia, moment), h);
+  }
+  vec3 l = xyz(angmom) + moment;
+  vel = vec4(xyz(vel) + dv, 0.0f);
+  angmom = vec4(l, 0.0f);
+  angvel = vec4(body_angular_velocity(quat, inv_inertia, l), 0.0f);
+}
+
+MOTES_SHARED_END
+
+#endif  // MOTES_SHARED_POSITION_H
