@@ -79,14 +79,24 @@ bool has_device(const std::string& backend, std::string& why) {
 /// The mixed scene, or W1 at 16 x 8 x 16 spheres pressed to 0.99 d (docs/conformance.md's
 /// "settle_pressed"): 2,048 free spheres with up to six contacts each, where the order of the
 /// force sums, and so the lists' order, shows in the bits; "impulse_pile": the same with impulse
-/// contacts, whose accumulated impulses (the contacts' memory) are state too.
+/// contacts, whose accumulated impulses (the contacts' memory) are state too; "position_pile":
+/// 512 spheres with position contacts at dt = 1/60 s, whose friction anchors are.
 motes::Scene test_scene(const std::string& name) {
-  if (name == "pressed_pile" || name == "impulse_pile") {
-    motes::Scene scene = motes::settle_workload(16, 8, 16);
+  if (name == "pressed_pile" || name == "impulse_pile" || name == "position_pile") {
+    // The position pile is smaller and has 2 substeps a step: its 89 launches a frame would make
+    // it the suite's slowest test on lavapipe at 2,048 spheres and 8 substeps.
+    motes::Scene scene = name == "position_pile" ? motes::settle_workload(8, 8, 8)
+                                                 : motes::settle_workload(16, 8, 16);
     for (motes::BodySpec& b : scene.bodies) b.position *= 0.9;
     if (name == "impulse_pile") {
       scene.settings.contact_model = motes::ContactModel::Impulses;
       for (motes::Material& m : scene.materials) m.restitution = 0.3;
+    }
+    if (name == "position_pile") {
+      scene.settings.contact_model = motes::ContactModel::Positions;
+      scene.settings.dt = 1.0 / 60.0;
+      scene.settings.substeps = 2;
+      for (motes::Material& m : scene.materials) m.friction = 0.5;
     }
     return scene;
   }
@@ -153,15 +163,16 @@ void max_differences(motes::Simulation& a, motes::Simulation& b, double& dx, dou
 
 // 200 steps against 100, a checkpoint, a new Simulation that loads it and 100 more: the same bits
 // in every state buffer (and so the same state hash) on the backend that wrote it. On the mixed
-// scene (every kind of state), on the pressed pile (where the lists' order shows) and on the pile
-// with impulse contacts (whose warm start reads the contacts' memory).
+// scene (every kind of state), on the pressed pile (where the lists' order shows), on the pile
+// with impulse contacts (whose warm start reads the contacts' memory) and on the pile with
+// position contacts (whose friction reads its anchors).
 TEST_P(CheckpointResume, BitwiseAfter200StepsResumedAt100) {
   const std::string backend = GetParam();
   std::string why;
   if (!has_device(backend, why)) GTEST_SKIP() << "no " << backend << " device: " << why;
   TempDir tmp;
-  for (const std::string& scene :
-       {kMixedScene, std::string("pressed_pile"), std::string("impulse_pile")}) {
+  for (const std::string& scene : {kMixedScene, std::string("pressed_pile"),
+                                   std::string("impulse_pile"), std::string("position_pile")}) {
     SCOPED_TRACE(scene);
     const std::string path = tmp / "at100.mck";
     auto whole = make(backend, scene);
@@ -180,7 +191,8 @@ TEST_P(CheckpointResume, BitwiseAfter200StepsResumedAt100) {
     });
     if (whole->sizes().impulse != 0) {
       // Impulses: particles with a contact that pushes (an accumulated normal impulse), in any
-      // of their slots (k Nr + i).
+      // of their slots (k Nr + i); positions: with a friction anchor.
+      const bool positions = whole->settings().contact_model == motes::ContactModel::Positions;
       const motes::BufferLayout layout =
           motes::buffer_layout(Buffer::ContactImpulse, whole->sizes());
       std::vector<motes::shared::vec4> acc(layout.count);
@@ -188,7 +200,8 @@ TEST_P(CheckpointResume, BitwiseAfter200StepsResumedAt100) {
       const std::size_t nr = whole->sizes().rigid_particles;
       std::vector<bool> pushed(nr, false);
       for (std::size_t k = 0; k < acc.size(); ++k)
-        pushed[k % nr] = pushed[k % nr] || acc[k].w > 0.0f;
+        pushed[k % nr] = pushed[k % nr] || acc[k].w > 0.0f ||
+                         (positions && (acc[k].x != 0.0f || acc[k].y != 0.0f || acc[k].z != 0.0f));
       touching = std::count(pushed.begin(), pushed.end(), true);
     }
     // The pile with impulses has relaxed its pressed contacts by step 200 (the position
