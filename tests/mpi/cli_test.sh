@@ -40,12 +40,12 @@ done
 for scene in "$src"/examples/scenes/*.json; do
   name=$(basename "$scene" .json)
   each="run $scene --backend openmp --steps 400 --every 200 --format csv"
-  # Runs over ranks drop the impulse contacts' memory at list builds (docs/scale-out.md): one
-  # process the same, through the scene's impulse_memory_across_builds.
+  # Runs over ranks drop the impulse and position contacts' memory at list builds
+  # (docs/scale-out.md): one process the same, through the scene's impulse_memory_across_builds.
   alone=$scene
-  if grep -q '"contact_model": "impulse"' "$scene"; then
+  if grep -qE '"contact_model": "(impulse|position)"' "$scene"; then
     alone=$work/$name-alone.json
-    sed 's/"contact_model": "impulse",/"contact_model": "impulse", "impulse_memory_across_builds": false,/' \
+    sed -E 's/"contact_model": "(impulse|position)",/"contact_model": "\1", "impulse_memory_across_builds": false,/' \
       "$scene" > "$alone"
   fi
   # shellcheck disable=SC2086
