@@ -298,33 +298,17 @@ TEST(ImpulseContact, PyramidOfFiveRowsStandsStillForFiveSeconds) {
 }
 
 TEST(ImpulseContact, CollisionWithoutGravityKeepsMomentum) {
-  constexpr double kD = 0.02;
   motes::Scene scene = impulse_scene(1e-3, Eigen::Vector3d::Zero(), 0.5, 0.4);
-  auto a = motes_test::lattice(3, 3, 3, kD);
-  auto b = motes_test::lattice(2, 4, 3, kD);
-  scene.bodies.push_back(motes_test::body(a, Eigen::Vector3d(-0.06, 0.0, 0.0),
-                                          Eigen::Vector3d(1.0, 0.1, 0.0),
-                                          Eigen::Vector3d(0.0, 3.0, 5.0)));
-  scene.bodies.push_back(motes_test::body(
-      b, Eigen::Vector3d(0.06, 0.013, 0.004), Eigen::Vector3d(-0.5, 0.0, 0.2),
-      Eigen::Vector3d(4.0, 0.0, -2.0),
-      Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1.0, 1.0, 0.0).normalized()))));
+  motes_test::add_colliding_boxes(scene);
   auto sim = motes_test::simulate(scene);
   ASSERT_TRUE(sim) << sim.status().message();
-  const auto momentum = [](const motes::Snapshot& s) {
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    for (std::size_t k = 0; k < s.body_vel.size(); ++k) {
-      p += to_vec3(s.body_vel[k]) / static_cast<double>(s.body_pos[k].w);
-    }
-    return p;
-  };
   auto before = (*sim)->snapshot();
   ASSERT_TRUE((*sim)->step(150));
   auto after = (*sim)->snapshot();
   // They did collide: both changed velocity.
   EXPECT_GT((to_vec3(after->body_vel[0]) - to_vec3(before->body_vel[0])).norm(), 0.1);
-  const Eigen::Vector3d p0 = momentum(*before);
-  const Eigen::Vector3d p1 = momentum(*after);
+  const Eigen::Vector3d p0 = motes_test::linear_momentum(*before);
+  const Eigen::Vector3d p1 = motes_test::linear_momentum(*after);
   EXPECT_LT((p1 - p0).norm(), 1e-6 * p0.norm()) << p0.transpose() << " -> " << p1.transpose();
 }
 
