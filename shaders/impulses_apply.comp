@@ -22,8 +22,9 @@ void main() {
     }
   }
   if ((p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
-    body_vel_start[b] = vec4(xyz(body_vel[b]), sum.w);
-    body_angvel_start[b] = body_angvel[b];
+    body_vel_start[b] = impulse_start_velocity(body_vel[b], body_vel_start[b], sum.w, p.flags);
+    body_angvel_start[b] =
+        impulse_start_angular_velocity(body_angvel[b], body_angvel_start[b], p.flags);
     // The counting pass has read every slot: the body's particles' slots are now this build's.
     if (com.w != 0.0f) {
       uint builds = neighbour_state[MOTES_NEIGHBOUR_BUILDS];

@@ -48,8 +48,8 @@ __global__ void impulses_apply_kernel(shared::StepParams p, ApplyBuffers d) {
     }
   }
   if ((p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
-    d.vel0[b] = vec4(shared::xyz(d.vel[b]), sum.w);
-    d.angvel0[b] = d.angvel[b];
+    d.vel0[b] = shared::impulse_start_velocity(d.vel[b], d.vel0[b], sum.w, p.flags);
+    d.angvel0[b] = shared::impulse_start_angular_velocity(d.angvel[b], d.angvel0[b], p.flags);
     // The counting pass has read every slot: the body's particles' slots are now this build's.
     if (com.w != 0.0f) {
       const uint builds = d.state[MOTES_NEIGHBOUR_BUILDS];

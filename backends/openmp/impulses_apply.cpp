@@ -69,8 +69,8 @@ void OpenMPDevice::impulses_apply(const shared::StepParams& p) {
       }
     }
     if (count_only) {  // the stage's start, then the warm start
-      vel0[b] = vec4(shared::xyz(vel[b]), sum.w);
-      angvel0[b] = angvel[b];
+      vel0[b] = shared::impulse_start_velocity(vel[b], vel0[b], sum.w, p.flags);
+      angvel0[b] = shared::impulse_start_angular_velocity(angvel[b], angvel0[b], p.flags);
       if (com[b].w != 0.0f) {
         for (uint i = first[b]; i < first[b + 1]; ++i) stamp[i] = builds;
       }

@@ -62,6 +62,21 @@ MOTES_FN void impulse_body_state(MOTES_INOUT(ImpulseBody) b, vec4 vel, vec4 angv
   }
 }
 
+/// What a counting pass keeps of a body as the substep's start (impulses_apply with
+/// MOTES_FLAG_IMPULSE_COUNT): its velocity now (xyz) and its contact count (w). Position contacts
+/// count again before each projection sweep but keep the velocity of the first
+/// (MOTES_FLAG_POSITION_FIRST), which the velocity pass's targets start from.
+MOTES_FN vec4 impulse_start_velocity(vec4 now, vec4 kept, float count, uint flags) {
+  bool keep = (flags & MOTES_FLAG_POSITION) != 0u && (flags & MOTES_FLAG_POSITION_FIRST) == 0u;
+  return vec4(keep ? xyz(kept) : xyz(now), count);
+}
+
+/// The angular part of impulse_start_velocity.
+MOTES_FN vec4 impulse_start_angular_velocity(vec4 now, vec4 kept, uint flags) {
+  bool keep = (flags & MOTES_FLAG_POSITION) != 0u && (flags & MOTES_FLAG_POSITION_FIRST) == 0u;
+  return keep ? kept : now;
+}
+
 /// A body as the contacts of an impulse sweep see it, from its buffers' values.
 MOTES_FN ImpulseBody impulse_body_of(vec4 com, vec4 quat, vec4 inv_inertia, vec4 vel, vec4 angvel,
                                      vec4 vel0, vec4 angvel0, uint flags) {

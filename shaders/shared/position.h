@@ -15,16 +15,20 @@
 // - velocities: each body keeps the motion its pose made as velocity (v += p / (m h), and the
 //   same for the angular momentum), as PBD's v = (x - x_start) / h does;
 // - velocity pass (Müller et al. 2020, section 3.5): each contact the projection had sets its
-//   normal velocity to -e vn0 (vn0 its normal velocity before the projection) when it closed
+//   normal velocity to -e vn0 (vn0 its normal velocity at the substep's start) when it closed
 //   faster than MOTES_POSITION_BOUNCE_SUBSTEPS substeps of gravity, else to 0, so that the
-//   speed a correction gave a body is taken back rather than kept.
+//   speed a correction gave a body is taken back rather than kept; a contact the projection kept
+//   stuck loses its tangential velocity too.
 // Departure from Müller 2020: Jacobi with mass splitting instead of Gauss-Seidel, as the impulse
 // contacts do (shared/impulse.h): every contact of a body with n contacts sees it with n times its
 // inverse mass and inertia, all contacts are solved from the same poses, each body sums its
 // particles' corrections in particle order: no atomics, the same integers on every backend.
-// One Jacobi projection per substep moves a body between two contacts only part of the way, so a
-// column of bodies behaves as a chain of soft springs: 2 to 5 boxes stand, 10 sag and sway
-// (docs/position-solver.md has the measurements and what would fix it).
+// Jacobi moves a body between two contacts only part of the way, so a column of bodies would be
+// a chain of soft springs: the lower body of a resting contact counts as heavier
+// (position_stack_scale, Macklin et al. 2014's mass scaling), the projection runs three sweeps a
+// substep (core/src/simulation.cpp), a contact projected in one stays one to the substep's end,
+// and the velocity pass stops the contacts the projection kept stuck; columns of ten boxes and
+// pyramids stand (docs/position-solver.md has the measurements).
 // A correction travels as an impulse, J = p / h, through the buffers the impulse contacts use, so
 // that impulses_compute and impulses_apply run both models.
 #ifndef MOTES_SHARED_POSITION_H
@@ -42,6 +46,25 @@ MOTES_SHARED_BEGIN
 /// 2020 use 2); resting contacts close at |g| h every substep and do not.
 #define MOTES_POSITION_BOUNCE_SUBSTEPS 2.0f
 
+/// Mass scaling of resting contacts in stacks (Macklin et al. 2014, section 5.1, without the
+/// exponential, whose bits differ between backends): in a contact of bodies whose centres are dh
+/// apart along -gravity, the lower body's inverse mass and inertia count f = size / (size + |dh|)
+/// of themselves (size: the pair's particle diameter), so the upper body takes most of the
+/// correction. A box of three particles' height on another takes 4/5 of it (f = 1/4); bodies
+/// side by side (dominoes, a row of a pyramid) are scaled by about 1. Only for contacts closing
+/// slower than a bounce (restitution and collisions keep their momentum) and never without
+/// gravity. Returns f, negated when the lower body is a (b is lower: positive; 1: no scaling).
+MOTES_FN float position_stack_scale(vec3 com_a, vec3 com_b, float size, float vn0,
+                                    vec4 gravity_dt) {
+  float g = length(xyz(gravity_dt));
+  if (!(g > 0.0f) || vn0 < -MOTES_POSITION_BOUNCE_SUBSTEPS * g * gravity_dt.w) {
+    return 1.0f;
+  }
+  float dh = -dot(com_a - com_b, xyz(gravity_dt)) / g;
+  float f = size / (size + abs(dh));
+  return dh > 0.0f ? f : -f;
+}
+
 /// What a position contact does to each of its two bodies (xyz: the impulse, w: 1 for a contact
 /// that overlaps, else 0).
 struct PositionPair {
@@ -50,10 +73,14 @@ struct PositionPair {
 };
 
 /// The position contact of bodies a and b at point c, normal n (unit, from b towards a),
-/// separation sep (< 0: overlap): the impulse on each body and whether it counts (PositionPair).
+/// separation sep (< 0: overlap), particle diameter size: the impulse on each body and whether it
+/// counts (PositionPair). The lower body of a resting contact counts as heavier
+/// (position_stack_scale) in the projection and the velocity pass.
 /// acc, the contact's memory (its slot, as the lower particle id sees it): xyz its friction
 /// anchor, where rel (a's particle relative to b) was when the contact stuck (never 0 for a real
-/// anchor: 0 is none), w unused (0).
+/// anchor: 0 is none), w the sum of the substep's normal corrections so far (ln, kg m), negative
+/// once a sweep let the contact slide (0: not projected this substep; the first sweep, flagged
+/// MOTES_FLAG_POSITION_FIRST, starts it anew).
 /// - with MOTES_FLAG_IMPULSE_COUNT: only the count (the bodies' contact counts, which scale the
 ///   inverse masses: mass splitting, are known after it); the anchor kept while the contact
 ///   overlaps;
@@ -66,46 +93,72 @@ struct PositionPair {
 ///   the normal correction the contact slides: the correction is capped and the anchor follows
 ///   what is left.
 MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, vec3 c,
-                                       vec3 n, float sep, vec3 rel, ContactLaw law, vec4 gravity_dt,
-                                       uint flags, MOTES_INOUT(vec4) acc) {
+                                       vec3 n, float sep, float size, vec3 rel, ContactLaw law,
+                                       vec4 gravity_dt, uint flags, MOTES_INOUT(vec4) acc) {
   PositionPair res;
   res.a = vec4(0.0f);
   res.b = vec4(0.0f);
-  if (!(sep < 0.0f)) {
+  // A contact an earlier sweep of this substep projected (acc.w != 0) stays one until the
+  // substep ends, overlapping or not: it keeps its anchor and counts, and the velocity pass sets
+  // its normal velocity.
+  bool had = (flags & MOTES_FLAG_POSITION_FIRST) == 0u && acc.w != 0.0f;
+  bool overlaps = sep < 0.0f;
+  if (!overlaps && !had) {
     acc = vec4(0.0f);
     return res;
   }
   res.a = vec4(0.0f, 0.0f, 0.0f, 1.0f);
   res.b = vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  if ((flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
+  if ((flags & MOTES_FLAG_IMPULSE_COUNT) != 0u ||
+      (!overlaps && (flags & MOTES_FLAG_POSITION_VELOCITY) == 0u)) {
     return res;
   }
   float h = gravity_dt.w;
   vec3 ra = c - xyz(a.com);
   vec3 rb = c - xyz(b.com);
-  float kn = impulse_inverse_mass(a, ra, n) + impulse_inverse_mass(b, rb, n);
+  vec3 u0 =
+      impulse_point_velocity(a.vel0, a.angvel0, ra) - impulse_point_velocity(b.vel0, b.angvel0, rb);
+  float vn0 = dot(u0, n);
+  float f = position_stack_scale(xyz(a.com), xyz(b.com), size, vn0, gravity_dt);
+  float sa = f < 0.0f ? -f : 1.0f;
+  float sb = f > 0.0f ? f : 1.0f;
+  float kn = sa * impulse_inverse_mass(a, ra, n) + sb * impulse_inverse_mass(b, rb, n);
   if (!(kn > 0.0f)) {
     return res;
   }
   vec3 u =
       impulse_point_velocity(a.vel, a.angvel, ra) - impulse_point_velocity(b.vel, b.angvel, rb);
   if ((flags & MOTES_FLAG_POSITION_VELOCITY) != 0u) {
-    vec3 u0 = impulse_point_velocity(a.vel0, a.angvel0, ra) -
-              impulse_point_velocity(b.vel0, b.angvel0, rb);
-    float vn0 = dot(u0, n);
     float bounce_speed = MOTES_POSITION_BOUNCE_SUBSTEPS * length(xyz(gravity_dt)) * h;
     // Bounce; else keep no approach and no more separation than the contact had before the
     // projection (a body that left a bounce still overlapping keeps its speed).
-    float target = vn0 < -bounce_speed ? -law.restitution * vn0 : max(vn0, 0.0f);
+    float target = vn0 < -bounce_speed ? -law.restitution * vn0 : 0.0f;
     vec3 j = n * ((target - dot(u, n)) / kn);
-    res.a = vec4(j, 1.0f);
-    res.b = vec4(-j, 1.0f);
+    // A contact the projection kept stuck (acc.w > 0; the projection's Coulomb test passed) ends
+    // the substep without tangential speed: its return to an anchor some substeps old is not
+    // kept as speed past it. Müller et al. 2020 anchor at the substep's start, so the velocity
+    // they derive from a stuck contact has no tangential part either.
+    vec3 ut = u - n * dot(u, n);
+    float ut2 = dot(ut, ut);
+    if (acc.w > 0.0f && ut2 > 0.0f) {
+      float utl = sqrt(ut2);
+      vec3 t = ut / utl;
+      float kt = sa * impulse_inverse_mass(a, ra, t) + sb * impulse_inverse_mass(b, rb, t);
+      if (kt > 0.0f) {
+        j -= t * (utl / kt);
+      }
+    }
+    res.a = vec4(j * sa, 1.0f);
+    res.b = vec4(-j * sb, 1.0f);
     return res;
   }
   float ln = -sep / kn;
   vec3 p = n * ln;
   bool anchored = acc.x != 0.0f || acc.y != 0.0f || acc.z != 0.0f;
   vec3 anchor = anchored ? xyz(acc) : rel - u * h;
+  // The normal corrections of the substep's sweeps so far; negative once one slid.
+  float sum = (flags & MOTES_FLAG_POSITION_FIRST) != 0u ? ln : abs(acc.w) + ln;
+  bool stuck = law.friction != 0.0f && ((flags & MOTES_FLAG_POSITION_FIRST) != 0u || acc.w > 0.0f);
   if (law.friction != 0.0f) {
     vec3 drift = rel - anchor;
     vec3 dt = drift - n * dot(drift, n);
@@ -113,20 +166,26 @@ MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(Impulse
     if (len2 > 0.0f) {
       float len = sqrt(len2);
       vec3 t = dt / len;
-      float kt = impulse_inverse_mass(a, ra, t) + impulse_inverse_mass(b, rb, t);
+      float kt = sa * impulse_inverse_mass(a, ra, t) + sb * impulse_inverse_mass(b, rb, t);
       if (kt > 0.0f) {
         float lt = len / kt;
         if (law.friction > 0.0f && lt > law.friction * ln) {
           lt = law.friction * ln;
-          anchor += t * (len - lt * kt);  // sliding: the anchor follows what is not undone
+          // Sliding: the anchor follows what is not undone. Only in the substep's first sweep,
+          // where the predicted motion is: the later sweeps' normal corrections are small, and
+          // a drift they cannot undo is left for the next substep's first, not let slide.
+          if ((flags & MOTES_FLAG_POSITION_FIRST) != 0u) {
+            anchor += t * (len - lt * kt);
+            stuck = false;
+          }
         }
         p -= t * lt;
       }
     }
   }
-  acc = vec4(anchor, 0.0f);
-  res.a = vec4(p / h, 1.0f);
-  res.b = vec4(-p / h, 1.0f);
+  acc = vec4(anchor, stuck ? sum : -sum);
+  res.a = vec4(p * (sa / h), 1.0f);
+  res.b = vec4(-p * (sb / h), 1.0f);
   return res;
 }
 

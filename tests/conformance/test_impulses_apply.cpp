@@ -47,7 +47,8 @@ class ImpulsesApply : public DeviceTest {
     w.params.flags |= flags;
     const bool counting = (flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
     const bool push = (flags & MOTES_FLAG_IMPULSE_PUSH) != 0u;
-    const bool moves = (flags & MOTES_FLAG_POSITION) != 0u;
+    // A projection of position contacts moves the poses; their counting pass does not.
+    const bool moves = (flags & MOTES_FLAG_POSITION) != 0u && !counting;
     const std::size_t n = w.particles.size();
     const std::size_t nr = w.particles.rigid;
     const std::size_t b = w.bodies.size();
@@ -199,6 +200,15 @@ TEST_P(ImpulsesApply, Position1234) {
 }
 TEST_P(ImpulsesApply, Position65536) {
   run_case("position", apply_world(93, 65536), MOTES_FLAG_POSITION);
+}
+// Position contacts count before each projection sweep: the first keeps the velocities as the
+// substep's start, the later ones only the counts.
+TEST_P(ImpulsesApply, PositionFirstCount1234) {
+  run_case("position count", apply_world(94, 1234),
+           MOTES_FLAG_POSITION | MOTES_FLAG_POSITION_FIRST | MOTES_FLAG_IMPULSE_COUNT);
+}
+TEST_P(ImpulsesApply, PositionCount1234) {
+  run_case("position count", apply_world(95, 1234), MOTES_FLAG_POSITION | MOTES_FLAG_IMPULSE_COUNT);
 }
 
 INSTANTIATE_TEST_SUITE_P(Conformance, ImpulsesApply, testing::ValuesIn(device_params()),

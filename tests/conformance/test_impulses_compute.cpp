@@ -27,9 +27,9 @@
 // ContactImpulse slot, ImpulseStamp, and the last iteration's ParticleForce and ParticleMoment of
 // the rigid particles. Each case runs with K = 16 and again with K = 2, where most particles walk
 // the grid and their contacts keep no memory. PositionsComputeThenApply runs the same worlds
-// through a substep of position contacts (shared/position.h): the counting pass, the projection
-// (which moves the bodies: BodyPos and BodyQuat read back too) and the velocity pass, each a
-// compute and an apply.
+// through a substep of position contacts (shared/position.h): two sweeps of a counting pass and
+// a projection (which moves the bodies: BodyPos and BodyQuat read back too; the first flagged
+// MOTES_FLAG_POSITION_FIRST) and the velocity pass, each a compute and an apply.
 //
 // Tolerance: NMSE 1e-7. The terms come from the same shared functions and floats, summed in float
 // in the contract's order (list order, then particle order per body), so openmp matches bitwise
@@ -116,7 +116,11 @@ class ImpulsesComputeThenApply : public DeviceTest {
       passes.push_back(w.params);
       passes.back().flags |= flags;
     };
-    if (position_) {  // a substep of position contacts: count, project, velocity pass
+    if (position_) {
+      // A substep of position contacts: the first sweep's count and projection, a second's
+      // (the contacts the first projected are kept, overlapping or not), the velocity pass.
+      pass(MOTES_FLAG_POSITION | MOTES_FLAG_POSITION_FIRST | MOTES_FLAG_IMPULSE_COUNT);
+      pass(MOTES_FLAG_POSITION | MOTES_FLAG_POSITION_FIRST);
       pass(MOTES_FLAG_POSITION | MOTES_FLAG_IMPULSE_COUNT);
       pass(MOTES_FLAG_POSITION);
       pass(MOTES_FLAG_POSITION | MOTES_FLAG_POSITION_VELOCITY);

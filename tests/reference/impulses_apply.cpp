@@ -29,8 +29,9 @@ void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s) {
       }
     }
     if (counting) {
-      s.vel0[b] = vec4(xyz(bodies.vel[b]), sum.w);
-      s.angvel0[b] = bodies.angvel[b];
+      s.vel0[b] = motes::shared::impulse_start_velocity(bodies.vel[b], s.vel0[b], sum.w, p.flags);
+      s.angvel0[b] =
+          motes::shared::impulse_start_angular_velocity(bodies.angvel[b], s.angvel0[b], p.flags);
       if (bodies.pos[b].w != 0.0f) {
         for (uint i = bodies.first[b]; i < bodies.first[b + 1]; ++i) s.stamp[i] = s.builds;
       }

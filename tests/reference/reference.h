@@ -213,7 +213,9 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
                       const StepParams& p, ImpulseState& s);
 
 /// impulses_apply: each dynamic body's particles' impulses, counts and moments summed in float in
-/// particle order; the counting pass first keeps vel0 = (vel, count) and angvel0 = angvel and
+/// particle order; the counting pass first keeps vel0 = (vel, count) and angvel0 = angvel (a
+/// position contacts' counting pass after the first keeps their velocities:
+/// shared::impulse_start_velocity) and
 /// stamps the dynamic bodies' particles with builds; then
 /// shared::body_apply_impulse (static bodies: angvel from angmom only); with
 /// MOTES_FLAG_IMPULSE_PUSH, vel_push and angmom_push = what it leaves.
