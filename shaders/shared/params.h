@@ -43,8 +43,9 @@ MOTES_SHARED_BEGIN
 /// With MOTES_FLAG_POSITION, impulses_compute: the velocity pass (restitution, and the normal
 /// velocity the projection left taken back) on the contacts the projection had.
 #define MOTES_FLAG_POSITION_VELOCITY 1024u
-/// With MOTES_FLAG_POSITION, impulses_compute: the substep's first projection sweep (each contact
-/// starts its sum of normal corrections, which caps the velocity pass's friction, anew).
+/// With MOTES_FLAG_POSITION: the substep's first counting pass and projection sweep (a contact's
+/// record of being projected this substep starts anew; impulses_apply keeps the velocities as the
+/// substep's start).
 #define MOTES_FLAG_POSITION_FIRST 2048u
 
 /// Launch parameters of every kernel family; travels with the launch (push constants).

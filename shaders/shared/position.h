@@ -78,9 +78,8 @@ struct PositionPair {
 /// (position_stack_scale) in the projection and the velocity pass.
 /// acc, the contact's memory (its slot, as the lower particle id sees it): xyz its friction
 /// anchor, where rel (a's particle relative to b) was when the contact stuck (never 0 for a real
-/// anchor: 0 is none), w the sum of the substep's normal corrections so far (ln, kg m), negative
-/// once a sweep let the contact slide (0: not projected this substep; the first sweep, flagged
-/// MOTES_FLAG_POSITION_FIRST, starts it anew).
+/// anchor: 0 is none), w whether a sweep of this substep projected it: 1 while it sticks, -1 once
+/// it slid, 0 not projected (the first sweep, flagged MOTES_FLAG_POSITION_FIRST, starts anew).
 /// - with MOTES_FLAG_IMPULSE_COUNT: only the count (the bodies' contact counts, which scale the
 ///   inverse masses: mass splitting, are known after it); the anchor kept while the contact
 ///   overlaps;
@@ -156,8 +155,6 @@ MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(Impulse
   vec3 p = n * ln;
   bool anchored = acc.x != 0.0f || acc.y != 0.0f || acc.z != 0.0f;
   vec3 anchor = anchored ? xyz(acc) : rel - u * h;
-  // The normal corrections of the substep's sweeps so far; negative once one slid.
-  float sum = (flags & MOTES_FLAG_POSITION_FIRST) != 0u ? ln : abs(acc.w) + ln;
   bool stuck = law.friction != 0.0f && ((flags & MOTES_FLAG_POSITION_FIRST) != 0u || acc.w > 0.0f);
   if (law.friction != 0.0f) {
     vec3 drift = rel - anchor;
@@ -183,7 +180,7 @@ MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(Impulse
       }
     }
   }
-  acc = vec4(anchor, stuck ? sum : -sum);
+  acc = vec4(anchor, stuck ? 1.0f : -1.0f);
   res.a = vec4(p * (sa / h), 1.0f);
   res.b = vec4(-p * (sb / h), 1.0f);
   return res;
