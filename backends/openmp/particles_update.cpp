@@ -34,14 +34,21 @@ void OpenMPDevice::particles_update(const shared::StepParams& p) {
   // One particle follows its body; true when it moved far enough to ask for new lists.
   const auto follow = [&](std::int64_t i) {
     const uint b = body[i];
+    // Read into locals first: the compiler then rotates local[i] once for the position and the
+    // velocity (the same rotation, the same bits), which it may not across the stores.
+    const vec4 q = quat[b];
+    const vec4 r = local[i];
+    const vec4 v = body_vel[b];
+    const vec4 w = angvel[b];
     if (absorb) {
-      const shared::vec3 j =
-          shared::particle_absorbed_impulse(vel[i], quat[b], body_vel[b], angvel[b], local[i]);
+      const shared::vec3 j = shared::particle_absorbed_impulse(vel[i], q, v, w, r);
       impulse[i] = vec4(j, 0.0f);
-      moment[i] = vec4(shared::cross(shared::quat_rotate(quat[b], shared::xyz(local[i])), j), 0.0f);
+      moment[i] = vec4(shared::cross(shared::quat_rotate(q, shared::xyz(r)), j), 0.0f);
     }
-    pos[i] = vec4(shared::particle_position(body_pos[b], quat[b], local[i]), pos[i].w);
-    vel[i] = vec4(shared::particle_velocity(quat[b], body_vel[b], angvel[b], local[i]), vel[i].w);
+    const shared::vec3 x = shared::particle_position(body_pos[b], q, r);
+    const shared::vec3 u = shared::particle_velocity(q, v, w, r);
+    pos[i] = vec4(x, pos[i].w);
+    vel[i] = vec4(u, vel[i].w);
     return shared::neighbour_moved_too_far(pos[i], ref[i], p.neighbour_skin);
   };
   uint moved = 0;
