@@ -129,8 +129,8 @@ MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(Impulse
       impulse_point_velocity(a.vel, a.angvel, ra) - impulse_point_velocity(b.vel, b.angvel, rb);
   if ((flags & MOTES_FLAG_POSITION_VELOCITY) != 0u) {
     float bounce_speed = MOTES_POSITION_BOUNCE_SUBSTEPS * length(xyz(gravity_dt)) * h;
-    // Bounce; else keep no approach and no more separation than the contact had before the
-    // projection (a body that left a bounce still overlapping keeps its speed).
+    // Bounce; else neither approach nor separation (Müller et al. 2020's rule: a contact that
+    // is still overlapping after it bounced loses what separation speed it has left).
     float target = vn0 < -bounce_speed ? -law.restitution * vn0 : 0.0f;
     vec3 j = n * ((target - dot(u, n)) / kn);
     // A contact the projection kept stuck (acc.w > 0; the projection's Coulomb test passed) ends
