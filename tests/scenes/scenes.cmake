@@ -30,6 +30,8 @@ set(motes_scene_runs
   "mixed|vulkan|0.22|1.2|104|a die lands on the floor at 0.14 s, a die and the jelly in the hammock at 0.17 and 0.19 s"
   "position_dominoes|openmp|full|2.5|1|"
   "position_dominoes|vulkan|full|2.5|7|"
+  "position_dice|openmp|full|1.5|2|"
+  "position_dice|vulkan|full|1.5|21|"
   "pendulum|openmp|full|2.0|6|"
   "pendulum|vulkan|0.3|2.0|27|the bobs through the bottom of their first swing, fastest at 0.25 to 0.3 s"
   "rope|openmp|full|2.0|3|"
