@@ -12,7 +12,8 @@
 #   (default all but scaling, which needs several GPUs, and properties; all writes 9 files, one
 #   more than come back from the GPU machine in one call, so run scenes in a call of its own, as
 #   its time asks)
-#   properties: the seeded random impulse scenes (tests/properties) on CUDA and Vulkan,
+#   properties: the seeded random impulse scenes (tests/properties), and the same scenes with
+#     position contacts (RandomPositionScenes), on CUDA and Vulkan,
 #     MOTES_PROPERTY_SEEDS per kind and backend (default 500) in batches of MOTES_PROPERTY_BATCH
 #     (default 250), and the kept seeds, into properties.txt; LIMIT_PROPERTIES seconds each backend
 #   unit: the unit tests' CUDA cases (checkpoint resume on CUDA, the CLI on CUDA), into unit.txt

@@ -45,7 +45,13 @@ namespace {
 /// Energy may rise above the start by this fraction of the case's energy scale: what the position
 /// correction may lift (overlaps pushed out) and float rounding, not what an instability gives.
 constexpr double kEnergyMargin = 0.01;
-constexpr int kChunk = 50;  // steps between looks at the state (25 ms)
+constexpr int kChunk = 50;  // steps of kDt between looks at the state (25 ms)
+/// RandomPositionScenes: frames of 1/60 s in this many substeps. The fastest drops land at about
+/// 2.6 m/s: 0.22 of a diameter a substep at 24 (at 16, drop 15 travelled 0.253 of a diameter, at
+/// 20 drop 292 0.261, past the guard's quarter: a scene's substeps must follow its fastest
+/// motion, as its dt does).
+constexpr double kPositionFrame = 1.0 / 60.0;
+constexpr int kPositionSubsteps = 24;
 #ifdef MOTES_PROPERTY_QUICK
 constexpr bool kQuick = true;  // the sanitizer build: fewer seeds, the first 0.5 s
 #else
@@ -59,12 +65,13 @@ double vlen(const motes::shared::vec4& v) { return v3(v).norm(); }
 
 /// What one case did.
 struct Outcome {
-  double scale = 0.0;   // J
-  double rise = 0.0;    // largest energy rise above the start, fraction of the scale
-  double travel = 0.0;  // largest travel per substep, in diameters
-  double drift = 0.0;   // largest drift over the rest window, in diameters (settling cases)
-  double speed = 0.0;   // fastest non-rolling body at the end (settling cases)
-  std::string failure;  // empty: passed
+  double scale = 0.0;    // J
+  double rise = 0.0;     // largest energy rise above the start, fraction of the scale
+  double travel = 0.0;   // largest travel per substep, in diameters
+  double drift = 0.0;    // largest drift over the rest window, in diameters (settling cases)
+  double speed = 0.0;    // fastest non-rolling body at the end (settling cases)
+  std::string failure;   // empty: passed
+  std::string restless;  // a rest failure that is measured, not required (position contacts)
 };
 
 int env_int(const char* name, int fallback) {
@@ -114,13 +121,19 @@ void dump_case(const std::string& dir, const Case& c, const motes::Snapshot& s,
 
 /// Runs `cases` side by side on `backend`; one outcome per case.
 std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Case>& cases,
-                               std::string& skip) {
+                               std::string& skip, bool positions) {
   std::vector<Outcome> out(cases.size());
   std::string why;
   Batch batch = make_batch(cases, why);
   if (!why.empty()) {
     for (Outcome& o : out) o.failure = why;
     return out;
+  }
+  if (positions) {  // position contacts: a step is a frame (RandomPositionScenes)
+    batch.scene.settings.contact_model = motes::ContactModel::Positions;
+    batch.scene.settings.dt = kPositionFrame;
+    batch.scene.settings.substeps =
+        std::max(1, env_int("MOTES_PROPERTY_POSITION_SUBSTEPS", kPositionSubsteps));
   }
   // Experiments: other sweeps or substeps than the defaults every scene gets.
   if (const int v = env_int("MOTES_PROPERTY_ITERATIONS", 0); v > 0) {
@@ -170,8 +183,11 @@ std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Cas
     duration = std::min(duration, 0.5);
   }
   const auto steps = static_cast<std::uint64_t>(std::llround(duration / s.settings().dt));
+  // A look every 25 ms of simulated time (every frame of position contacts).
+  const auto chunk =
+      static_cast<std::uint64_t>(std::max(1.0, std::round(kChunk * kDt / s.settings().dt)));
   for (std::uint64_t done = 0; done < steps;) {
-    const std::uint64_t n = std::min<std::uint64_t>(kChunk, steps - done);
+    const std::uint64_t n = std::min<std::uint64_t>(chunk, steps - done);
     motes::Status st = s.step(n);
     done += n;
     motes::Result<motes::Snapshot> snap = st ? s.snapshot() : motes::Result<motes::Snapshot>(st);
@@ -270,6 +286,7 @@ std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Cas
     } else if (cases[k].settles && o.speed >= kRestSpeed) {
       o.failure = fmt::format("not at rest: a body ends at {:.3g} m/s", o.speed);
     }
+    if (positions && o.failure.rfind("not at rest", 0) == 0) o.restless = std::move(o.failure);
   }
   return out;
 }
@@ -301,8 +318,9 @@ bool known_restless(const Case& c) {
 
 /// Runs `cases` in batches of `per_batch` and reports every failure.
 void check_cases(const std::string& backend, const std::vector<Case>& cases,
-                 const std::string& label, std::size_t per_batch, bool waive_known = false) {
-  std::size_t failed = 0, known = 0;
+                 const std::string& label, std::size_t per_batch, bool waive_known = false,
+                 bool positions = false) {
+  std::size_t failed = 0, known = 0, restless = 0;
   Outcome worst;
   std::uint32_t worst_rise_seed = 0, worst_drift_seed = 0;
   for (std::size_t at = 0; at < cases.size(); at += per_batch) {
@@ -310,7 +328,7 @@ void check_cases(const std::string& backend, const std::vector<Case>& cases,
         cases.begin() + static_cast<std::ptrdiff_t>(at),
         cases.begin() + static_cast<std::ptrdiff_t>(std::min(cases.size(), at + per_batch)));
     std::string skip;
-    const std::vector<Outcome> got = run_batch(backend, part, skip);
+    const std::vector<Outcome> got = run_batch(backend, part, skip, positions);
     if (!skip.empty()) GTEST_SKIP() << "no " << backend << " device: " << skip;
     for (std::size_t k = 0; k < part.size(); ++k) {
       const Case& c = part[k];
@@ -330,6 +348,11 @@ void check_cases(const std::string& backend, const std::vector<Case>& cases,
             "{} seed {} on {} is at rest now: take it out of kKnownRestless", kind_name(c.kind),
             c.seed, backend);
         continue;
+      }
+      if (!o.restless.empty()) {
+        ++restless;
+        std::printf("%s seed %u on %s: %s (position contacts: measured, not yet required)\n",
+                    kind_name(c.kind), c.seed, backend.c_str(), o.restless.c_str());
       }
       if (o.failure.empty()) continue;
       if (waived && o.failure.rfind("not at rest", 0) == 0) {
@@ -352,10 +375,11 @@ void check_cases(const std::string& backend, const std::vector<Case>& cases,
     }
   }
   std::printf(
-      "%s on %s: %zu cases, %zu failed, %zu known not at rest; largest energy rise %.3g of the "
+      "%s on %s: %zu cases, %zu failed, %zu known not at rest%s; largest energy rise %.3g of the "
       "scale (seed %u), drift %.3g d (seed %u), travel %.3g d per substep\n",
-      label.c_str(), backend.c_str(), cases.size(), failed, known, worst.rise, worst_rise_seed,
-      worst.drift, worst_drift_seed, worst.travel);
+      label.c_str(), backend.c_str(), cases.size(), failed, known,
+      positions ? fmt::format(", {} not at rest (measured)", restless).c_str() : "", worst.rise,
+      worst_rise_seed, worst.drift, worst_drift_seed, worst.travel);
 }
 
 int default_seeds(const std::string& backend) {
@@ -368,21 +392,29 @@ using Param = std::tuple<std::string, Kind>;
 
 class RandomImpulseScenes : public ::testing::TestWithParam<Param> {};
 
-TEST_P(RandomImpulseScenes, KeepEnergyStayQuietAndComeToRest) {
-  const auto& [backend, kind] = GetParam();
-  if (const char* only = std::getenv("MOTES_PROPERTY_KIND"); only != nullptr && *only != '\0') {
-    if (only != std::string(kind_name(kind))) GTEST_SKIP() << "MOTES_PROPERTY_KIND=" << only;
-  }
+/// The cases the environment asks for (MOTES_PROPERTY_SEED, _FIRST, _SEEDS), `count` seeds from 1
+/// by default; empty when MOTES_PROPERTY_KIND names another kind.
+std::vector<Case> cases_asked(Kind kind, int count) {
   std::vector<Case> cases;
+  if (const char* only = std::getenv("MOTES_PROPERTY_KIND"); only != nullptr && *only != '\0') {
+    if (only != std::string(kind_name(kind))) return cases;
+  }
   if (const int one = env_int("MOTES_PROPERTY_SEED", -1); one >= 0) {
     cases.push_back(make_case(kind, static_cast<std::uint32_t>(one)));
   } else {
     const int first = env_int("MOTES_PROPERTY_FIRST", 1);
-    const int count = env_int("MOTES_PROPERTY_SEEDS", default_seeds(backend));
+    count = env_int("MOTES_PROPERTY_SEEDS", count);
     for (int s = first; s < first + count; ++s) {
       cases.push_back(make_case(kind, static_cast<std::uint32_t>(s)));
     }
   }
+  return cases;
+}
+
+TEST_P(RandomImpulseScenes, KeepEnergyStayQuietAndComeToRest) {
+  const auto& [backend, kind] = GetParam();
+  const std::vector<Case> cases = cases_asked(kind, default_seeds(backend));
+  if (cases.empty()) GTEST_SKIP() << "MOTES_PROPERTY_KIND names another kind";
   // The known seeds are waived only in the run they were found in: CI's, openmp with every default
   // (other seeds, batches, sweeps or durations give other bits).
   bool ci_run = backend == "openmp" && !kQuick;
@@ -401,6 +433,29 @@ std::string param_name(const ::testing::TestParamInfo<Param>& p) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, RandomImpulseScenes,
+                         ::testing::Combine(::testing::Values("openmp", "vulkan", "cuda"),
+                                            ::testing::ValuesIn(kKinds)),
+                         param_name);
+
+/// The same generated scenes with position contacts (issue 27: "the random scenes of section 14,
+/// with the energy check, run on this solver too"), at frames of 1/60 s in kPositionSubsteps
+/// substeps: energy within kEnergyMargin of its scale and no guard-level travel, required of
+/// every seed. Rest is measured and printed, not required yet: about one case in six ends with a
+/// body at 2 to 8 mm/s that hardly moves (docs/validation.md, section 15), issue 27's open item.
+/// Seeds per kind: openmp 10 (2 in the sanitizer build, its first 0.5 s), vulkan 1, cuda 8.
+class RandomPositionScenes : public ::testing::TestWithParam<Param> {};
+
+TEST_P(RandomPositionScenes, KeepEnergyAndStayQuiet) {
+  const auto& [backend, kind] = GetParam();
+  const int seeds = backend == "openmp" ? (kQuick ? 2 : 10) : default_seeds(backend);
+  const std::vector<Case> cases = cases_asked(kind, seeds);
+  if (cases.empty()) GTEST_SKIP() << "MOTES_PROPERTY_KIND names another kind";
+  check_cases(backend, cases, std::string(kind_name(kind)) + " (position contacts)",
+              static_cast<std::size_t>(std::max(1, env_int("MOTES_PROPERTY_BATCH", 20))), false,
+              true);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, RandomPositionScenes,
                          ::testing::Combine(::testing::Values("openmp", "vulkan", "cuda"),
                                             ::testing::ValuesIn(kKinds)),
                          param_name);
