@@ -54,7 +54,8 @@ void main() {
                                                          p.material_count)],
                             p.gravity_dt, p.flags, a);
       if (slotted) contact_impulse_acc[slot] = a;
-      impulse_add(sum, moment_sum, r, pair_contact_point(xi, xj), own.com);
+      impulse_add(sum, moment_sum, r, contact_acting_point(pair_contact_point(xi, xj), xi, p.flags),
+                  own.com);
     }
   } else {
     uint lo[27];
@@ -72,7 +73,8 @@ void main() {
                                                           particle_material[j],
                                                           p.material_count)],
                               p.gravity_dt, p.flags, none);
-        impulse_add(sum, moment_sum, q, pair_contact_point(xi, xj), own.com);
+        impulse_add(sum, moment_sum, q,
+                    contact_acting_point(pair_contact_point(xi, xj), xi, p.flags), own.com);
       }
     }
   }
@@ -83,7 +85,9 @@ void main() {
     vec4 r = plane_contact_impulse(own, xi, pl.normal_offset, margin,
                                    contact_laws[law_base + pl.material], p.gravity_dt, p.flags, a);
     contact_impulse_acc[slot] = a;
-    impulse_add(sum, moment_sum, r, plane_contact_point(xi, pl.normal_offset), own.com);
+    impulse_add(sum, moment_sum, r,
+                contact_acting_point(plane_contact_point(xi, pl.normal_offset), xi, p.flags),
+                own.com);
   }
   particle_force[i] = sum;
   particle_moment[i] = vec4(moment_sum, 0.0f);

@@ -74,7 +74,9 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
         in.laws[shared::pair_law_index(i, in.material[i], j, in.material[j], p.material_count)],
         p.gravity_dt, p.flags, a);
     if (slot != nullptr) *slot = a;
-    shared::impulse_add(sum, moment_sum, r, shared::pair_contact_point(xi, xj), own.com);
+    shared::impulse_add(
+        sum, moment_sum, r,
+        shared::contact_acting_point(shared::pair_contact_point(xi, xj), xi, p.flags), own.com);
   };
   const uint c = in.count[i];
   if (c <= p.neighbour_capacity) {
@@ -97,7 +99,9 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
     vec4& a = acc[(std::size_t{p.neighbour_capacity} + k) * nr + i];
     const vec4 r = shared::plane_contact_impulse(own, xi, pl.normal_offset, margin,
                                                  law_row[pl.material], p.gravity_dt, p.flags, a);
-    shared::impulse_add(sum, moment_sum, r, shared::plane_contact_point(xi, pl.normal_offset),
+    shared::impulse_add(sum, moment_sum, r,
+                        shared::contact_acting_point(
+                            shared::plane_contact_point(xi, pl.normal_offset), xi, p.flags),
                         own.com);
   }
   impulse[i] = sum;

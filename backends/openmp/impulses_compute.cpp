@@ -191,7 +191,9 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
           in.laws[shared::pair_law_index(uint(i), in.material[i], j, in.material[j], materials)],
           p.gravity_dt, p.flags, a);
       if (slot != nullptr) *slot = a;
-      shared::impulse_add(sum, moment_sum, r, shared::pair_contact_point(xi, xj), own.com);
+      shared::impulse_add(
+          sum, moment_sum, r,
+          shared::contact_acting_point(shared::pair_contact_point(xi, xj), xi, p.flags), own.com);
     };
     if (c <= capacity) {
       for (uint k = 0; k < c; ++k) {
@@ -217,7 +219,9 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
       vec4& a = acc[(std::size_t{capacity} + k) * nr + std::size_t(i)];
       const vec4 r = shared::plane_contact_impulse(own, xi, pl.normal_offset, margin,
                                                    law_row[pl.material], p.gravity_dt, p.flags, a);
-      shared::impulse_add(sum, moment_sum, r, shared::plane_contact_point(xi, pl.normal_offset),
+      shared::impulse_add(sum, moment_sum, r,
+                          shared::contact_acting_point(
+                              shared::plane_contact_point(xi, pl.normal_offset), xi, p.flags),
                           own.com);
     }
     impulse[i] = sum;

@@ -140,6 +140,14 @@ MOTES_FN vec3 plane_contact_point(vec4 xa, vec4 normal_offset) {
   return xyz(xa) - xyz(normal_offset) * xa.w;
 }
 
+/// Where a contact at point c acts on the body of particle xi: at c for impulse contacts; at xi's
+/// centre for position contacts, whose friction holds the particles' centres (shared/position.h:
+/// contact_position). Both lie on the contact normal through xi, so the normal part of the impulse
+/// turns the body alike.
+MOTES_FN vec3 contact_acting_point(vec3 c, vec4 xi, uint flags) {
+  return (flags & MOTES_FLAG_POSITION) != 0u ? xyz(xi) : c;
+}
+
 MOTES_SHARED_END
 
 #endif  // MOTES_SHARED_CONTACT_BODY_H

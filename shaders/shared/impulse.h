@@ -258,8 +258,8 @@ MOTES_FN PositionPair particle_contact_position(MOTES_IN(ImpulseBody) a, vec4 xa
     return none;
   }
   float dist = sqrt(dist2);
-  return contact_position(a, b, pair_contact_point(xa, xb), d / dist, dist - rsum, rsum, d, law,
-                          gravity_dt, flags, acc);
+  return contact_position(a, b, xyz(xa), xyz(xb), d / dist, dist - rsum, rsum, d, law, gravity_dt,
+                          flags, acc);
 }
 
 /// Index in the contact-law table of the pair of particles i and j (materials mi, mj) as
@@ -302,8 +302,8 @@ MOTES_FN vec4 plane_contact_impulse(MOTES_IN(ImpulseBody) a, vec4 xa, vec4 norma
   }
   vec3 c = plane_contact_point(xa, normal_offset);
   if ((flags & MOTES_FLAG_POSITION) != 0u) {
-    return contact_position(a, impulse_wall(), c, np, sep, 2.0f * xa.w, plane_contact_rel(c, np),
-                            law, gravity_dt, flags, acc)
+    return contact_position(a, impulse_wall(), xyz(xa), c, np, sep, 2.0f * xa.w,
+                            plane_contact_rel(c, np), law, gravity_dt, flags, acc)
         .a;
   }
   return contact_impulse(a, impulse_wall(), c, np, sep, xa.w, law, gravity_dt, flags, acc);

@@ -3,15 +3,24 @@
 // per substep on the poses predicted with gravity (Macklin et al. 2019, "Small steps"), as Müller
 // et al. 2020 ("Detailed rigid body simulation with extended position based dynamics") correct
 // rigid poses:
-// - projection: a contact of bodies a and b at point c with normal n (from b towards a) and
-//   overlap d > 0 is the constraint C = d; its correction p = d / (w_a + w_b) n, with the
-//   generalized inverse masses w = 1/m + (r x n) . I^-1 (r x n), moves a's centre by p / m_a and
-//   turns it by I^-1 (r_a x p) (b the opposite way). Static friction is positional: the contact
-//   keeps an anchor (where it stuck) and its drift from it along the contact plane is undone while
-//   the tangential correction stays below mu times the normal one, else it is capped there
-//   (Macklin et al. 2014, eq. 24, with one mu for both; the anchor is Müller et al. 2020's
-//   contact-point difference kept across substeps): a sticking contact goes back to where it
-//   stuck, so a resting pile cannot creep; a sliding one loses mu g per unit time of its speed.
+// - projection: a contact of bodies a and b with normal n (from b towards a) and overlap d > 0
+//   is the constraint C = d; its correction p = d / (w_a + w_b) n, with the generalized inverse
+//   masses w = 1/m + (r x n) . I^-1 (r x n), moves a's centre by p / m_a and turns it by
+//   I^-1 (r_a x p) (b the opposite way). Static friction is positional: the contact keeps an
+//   anchor (where it stuck) and its drift from it along the contact plane is undone while the
+//   tangential correction stays below mu times the normal one, else it is capped there (Macklin
+//   et al. 2014, eq. 24, with one mu for both; the anchor is Müller et al. 2020's difference of
+//   contact points kept across substeps): a sticking contact goes back to where it stuck, so a
+//   resting pile cannot creep; a sliding one loses mu g per unit time of its speed, in every
+//   sweep (the later ones against its sliding velocity).
+//   The points are the particles' centres, as in particle-based solvers (Macklin et al. 2014):
+//   the anchor measures their drift and the correction acts there (arm r = x_particle - x_com),
+//   so the quantity corrected is the one the correction moves. A correction measured at the
+//   centres and applied on the particles' surfaces spins a body whose inertia about that lever is
+//   small (a rod of particles about its axis) instead of moving the centres, and the spin grows
+//   with the drift it leaves (docs/position-solver.md). The normal part is the same at either
+//   point (they lie on the normal); the friction part means a body one particle thick about an
+//   axis (a single sphere, a rod) slides to a stop rather than rolling.
 // - velocities: each body keeps the motion its pose made as velocity (v += p / (m h), and the
 //   same for the angular momentum), as PBD's v = (x - x_start) / h does;
 // - velocity pass (Müller et al. 2020, section 3.5): each contact the projection had sets its
@@ -72,8 +81,34 @@ struct PositionPair {
   vec4 b;
 };
 
-/// The position contact of bodies a and b at point c, normal n (unit, from b towards a),
-/// separation sep (< 0: overlap), particle diameter size: the impulse on each body and whether it
+/// The part of v along a contact's plane (normal n): its length len and unit direction t, and
+/// the contact's inverse mass along t, kt (sa, sb: the bodies' stack scaling); all 0 when v has
+/// no such part.
+struct PositionTangent {
+  vec3 t;
+  float len;
+  float kt;
+};
+
+MOTES_FN PositionTangent position_tangent(vec3 v, vec3 n, MOTES_IN(ImpulseBody) a, vec3 ra,
+                                          float sa, MOTES_IN(ImpulseBody) b, vec3 rb, float sb) {
+  PositionTangent r;
+  r.t = vec3(0.0f);
+  r.len = 0.0f;
+  r.kt = 0.0f;
+  vec3 vt = v - n * dot(v, n);
+  float len2 = dot(vt, vt);
+  if (len2 > 0.0f) {
+    r.len = sqrt(len2);
+    r.t = vt / r.len;
+    r.kt = sa * impulse_inverse_mass(a, ra, r.t) + sb * impulse_inverse_mass(b, rb, r.t);
+  }
+  return r;
+}
+
+/// The position contact of bodies a and b through points ca of a and cb of b (their particles'
+/// centres; a plane's point for a wall), normal n (unit, from b towards a), separation sep
+/// (< 0: overlap), particle diameter size: the impulse on each body and whether it
 /// counts (PositionPair). The lower body of a resting contact counts as heavier
 /// (position_stack_scale) in the projection and the velocity pass.
 /// acc, the contact's memory (its slot, as the lower particle id sees it): xyz its friction
@@ -90,10 +125,13 @@ struct PositionPair {
 ///   anchors where it was at the substep's start, rel - u h): a drift of many substeps, each too
 ///   small to see, is undone as a whole, so a body on a bumpy support cannot creep. Past mu times
 ///   the normal correction the contact slides: the correction is capped and the anchor follows
-///   what is left.
-MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, vec3 c,
-                                       vec3 n, float sep, float size, vec3 rel, ContactLaw law,
-                                       vec4 gravity_dt, uint flags, MOTES_INOUT(vec4) acc) {
+///   what is left; in the substep's later sweeps a contact that slid meets kinetic friction
+///   (mu times each sweep's normal correction) against its sliding velocity, never past
+///   stopping, and keeps its anchor.
+MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, vec3 ca,
+                                       vec3 cb, vec3 n, float sep, float size, vec3 rel,
+                                       ContactLaw law, vec4 gravity_dt, uint flags,
+                                       MOTES_INOUT(vec4) acc) {
   PositionPair res;
   res.a = vec4(0.0f);
   res.b = vec4(0.0f);
@@ -113,8 +151,8 @@ MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(Impulse
     return res;
   }
   float h = gravity_dt.w;
-  vec3 ra = c - xyz(a.com);
-  vec3 rb = c - xyz(b.com);
+  vec3 ra = ca - xyz(a.com);
+  vec3 rb = cb - xyz(b.com);
   vec3 u0 =
       impulse_point_velocity(a.vel0, a.angvel0, ra) - impulse_point_velocity(b.vel0, b.angvel0, rb);
   float vn0 = dot(u0, n);
@@ -137,14 +175,10 @@ MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(Impulse
     // the substep without tangential speed: its return to an anchor some substeps old is not
     // kept as speed past it. Müller et al. 2020 anchor at the substep's start, so the velocity
     // they derive from a stuck contact has no tangential part either.
-    vec3 ut = u - n * dot(u, n);
-    float ut2 = dot(ut, ut);
-    if (acc.w > 0.0f && ut2 > 0.0f) {
-      float utl = sqrt(ut2);
-      vec3 t = ut / utl;
-      float kt = sa * impulse_inverse_mass(a, ra, t) + sb * impulse_inverse_mass(b, rb, t);
-      if (kt > 0.0f) {
-        j -= t * (utl / kt);
+    if (acc.w > 0.0f) {
+      PositionTangent ut = position_tangent(u, n, a, ra, sa, b, rb, sb);
+      if (ut.kt > 0.0f) {
+        j -= ut.t * (ut.len / ut.kt);
       }
     }
     res.a = vec4(j * sa, 1.0f);
@@ -155,29 +189,31 @@ MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(Impulse
   vec3 p = n * ln;
   bool anchored = acc.x != 0.0f || acc.y != 0.0f || acc.z != 0.0f;
   vec3 anchor = anchored ? xyz(acc) : rel - u * h;
-  bool stuck = law.friction != 0.0f && ((flags & MOTES_FLAG_POSITION_FIRST) != 0u || acc.w > 0.0f);
-  if (law.friction != 0.0f) {
-    vec3 drift = rel - anchor;
-    vec3 dt = drift - n * dot(drift, n);
-    float len2 = dot(dt, dt);
-    if (len2 > 0.0f) {
-      float len = sqrt(len2);
-      vec3 t = dt / len;
-      float kt = sa * impulse_inverse_mass(a, ra, t) + sb * impulse_inverse_mass(b, rb, t);
-      if (kt > 0.0f) {
-        float lt = len / kt;
-        if (law.friction > 0.0f && lt > law.friction * ln) {
-          lt = law.friction * ln;
-          // Sliding: the anchor follows what is not undone. Only in the substep's first sweep,
-          // where the predicted motion is: the later sweeps' normal corrections are small, and
-          // a drift they cannot undo is left for the next substep's first, not let slide.
-          if ((flags & MOTES_FLAG_POSITION_FIRST) != 0u) {
-            anchor += t * (len - lt * kt);
-            stuck = false;
-          }
+  bool first = (flags & MOTES_FLAG_POSITION_FIRST) != 0u;
+  bool stuck = law.friction != 0.0f && (first || acc.w > 0.0f);
+  // A contact that slid in the substep's first sweep slides on in the later ones: kinetic
+  // friction on their normal corrections, against its sliding velocity, never past stopping.
+  bool slid = !first && acc.w < 0.0f;
+  if (slid && law.friction > 0.0f) {
+    PositionTangent ut = position_tangent(u, n, a, ra, sa, b, rb, sb);
+    if (ut.kt > 0.0f) {
+      p -= ut.t * min(law.friction * ln, ut.len * h / ut.kt);
+    }
+  } else if (law.friction != 0.0f) {
+    PositionTangent dt = position_tangent(rel - anchor, n, a, ra, sa, b, rb, sb);
+    if (dt.kt > 0.0f) {
+      float lt = dt.len / dt.kt;
+      if (law.friction > 0.0f && lt > law.friction * ln) {
+        lt = law.friction * ln;
+        // Sliding: the anchor follows what is not undone. Only in the substep's first sweep,
+        // where the predicted motion is: the later sweeps' normal corrections are small, and
+        // a drift they cannot undo is left for the next substep's first, not let slide.
+        if (first) {
+          anchor += dt.t * (dt.len - lt * dt.kt);
+          stuck = false;
         }
-        p -= t * lt;
       }
+      p -= dt.t * lt;
     }
   }
   acc = vec4(anchor, stuck ? 1.0f : -1.0f);

@@ -443,8 +443,8 @@ INSTANTIATE_TEST_SUITE_P(Backends, RandomImpulseScenes,
 /// The same generated scenes with position contacts (issue 27: "the random scenes of section 14,
 /// with the energy check, run on this solver too"), at frames of 1/60 s in kPositionSubsteps
 /// substeps: energy within kEnergyMargin of its scale and no guard-level travel, required of
-/// every seed. Rest is measured and printed, not required yet: 12 to 17% of cases in openmp's
-/// batches of 20 and about 47% in the GPU's batches of 250 end with a body at a few mm/s that
+/// every seed. Rest is measured and printed, not required yet: about 12% of cases in openmp's
+/// batches of 20 and 37% in the GPU's batches of 250 end with a body at a few mm/s that
 /// hardly moves, or sliding (docs/validation.md, section 15), issue 27's open item.
 /// Seeds per kind: openmp 10 (2 in the sanitizer build, its first 0.5 s), vulkan 1, cuda 8.
 class RandomPositionScenes : public ::testing::TestWithParam<Param> {};

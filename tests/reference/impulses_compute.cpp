@@ -51,8 +51,11 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
           own, xi, impulse_body(bodies, s, particles.body[j], p.flags), particles.pos[j], i < j,
           margin, laws[law], p.gravity_dt, p.flags, a);
       if (slotted) slot = a;
-      motes::shared::impulse_add(sum, moment, r,
-                                 motes::shared::pair_contact_point(xi, particles.pos[j]), own.com);
+      motes::shared::impulse_add(
+          sum, moment, r,
+          motes::shared::contact_acting_point(
+              motes::shared::pair_contact_point(xi, particles.pos[j]), xi, p.flags),
+          own.com);
     }
     for (std::size_t k = 0; k < planes.size(); ++k) {
       const PlaneData& pl = planes[k];
@@ -61,8 +64,11 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
           own, xi, pl.normal_offset, margin,
           laws[std::size_t{particles.material[i]} * p.material_count + pl.material], p.gravity_dt,
           p.flags, a);
-      motes::shared::impulse_add(sum, moment, r,
-                                 motes::shared::plane_contact_point(xi, pl.normal_offset), own.com);
+      motes::shared::impulse_add(
+          sum, moment, r,
+          motes::shared::contact_acting_point(
+              motes::shared::plane_contact_point(xi, pl.normal_offset), xi, p.flags),
+          own.com);
     }
     s.impulse[i] = sum;
     s.moment[i] = vec4(moment, 0.0f);
