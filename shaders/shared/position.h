@@ -206,8 +206,9 @@ MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(Impulse
       if (law.friction > 0.0f && lt > law.friction * ln) {
         lt = law.friction * ln;
         // Sliding: the anchor follows what is not undone. Only in the substep's first sweep,
-        // where the predicted motion is: the later sweeps' normal corrections are small, and
-        // a drift they cannot undo is left for the next substep's first, not let slide.
+        // where the predicted motion is: a contact that stuck there keeps its anchor through
+        // the later sweeps, whose share of the normal correction may be too small to hold it,
+        // and a drift they cannot undo is left for the next substep's first, not let slide.
         if (first) {
           anchor += dt.t * (dt.len - lt * dt.kt);
           stuck = false;
