@@ -229,11 +229,19 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     return true;
   };
 
+  // Only the sweeps from kept frames keep accumulated impulses in their lanes.
+  if (counting || impulse_touches_.size() != std::size_t(n)) impulse_acc_flush();
   if (counting) {
+    // From kept contact frames where it can (impulses_sweep.cpp: which particles touch
+    // something, their contacts, the warm start), else here.
+    if (impulses_count_kept(p)) {
+      record(Kernel::ImpulsesCompute, start);
+      return;
+    }
+    // Without kept contact frames: which particles touch something (2: within their lists'
+    // capacity, evaluated below; 1: the others, evaluated here, walking the grid).
     impulse_touches_.resize(std::size_t(n));
     std::uint8_t* touches = impulse_touches_.data();
-    // Which particles touch something; those within their lists' capacity are evaluated below
-    // (2), from kept contact frames where they can be (impulses_sweep.cpp), else here.
     defer = true;
     for_items(n, parallel_heavy(n), [&](std::int64_t i) {
       touches[i] = particle(i) ? (in.count[i] <= capacity ? 2 : 1) : 0;
@@ -244,20 +252,12 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
       if (touches[i] != 0) impulse_active_.push_back(static_cast<uint>(i));
     }
     // Each body's touching particles: a run of the ascending active list (impulses_apply).
-    const uint* first = buf<uint>(Buffer::BodyFirst);
-    impulse_body_active_.resize(std::size_t(bodies) + 1);
-    for (std::int64_t b = 0; b <= bodies; ++b) {
-      impulse_body_active_[std::size_t(b)] = static_cast<uint>(
-          std::lower_bound(impulse_active_.begin(), impulse_active_.end(), first[b]) -
-          impulse_active_.begin());
-    }
-    if (!impulses_count_kept(p)) {
-      const auto active = static_cast<std::int64_t>(impulse_active_.size());
-      const uint* ids = impulse_active_.data();
+    impulse_runs_update(p);
+    const auto active = static_cast<std::int64_t>(impulse_active_.size());
+    const uint* ids = impulse_active_.data();
 #pragma omp parallel for num_threads(team_) schedule(static) if (parallel_heavy(active))
-      for (std::int64_t a = 0; a < active; ++a) {
-        if (touches[ids[a]] == 2) particle(ids[a]);
-      }
+    for (std::int64_t a = 0; a < active; ++a) {
+      if (touches[ids[a]] == 2) particle(ids[a]);
     }
   } else if (impulse_touches_.size() != std::size_t(n)) {
     // No counting pass at these sizes yet: every particle.
@@ -268,6 +268,7 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
   } else {
     // The sweeps of this substep: only the particles the counting pass found touching (a
     // contact within reach touches both), their shared contacts first.
+    impulse_acc_flush();
     const auto active = static_cast<std::int64_t>(impulse_active_.size());
     const uint* ids = impulse_active_.data();
     // Position contacts may move one side of a contact alone: no mirrored results.

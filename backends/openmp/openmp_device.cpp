@@ -134,6 +134,7 @@ Status OpenMPDevice::write(Buffer b, const void* src, std::size_t bytes) {
     return Status::error(fmt::format("openmp: writing {} bytes into {} of {} bytes", bytes,
                                      buffer_name(b), buffers_[i].size()));
   }
+  impulse_acc_flush();
   if (bytes > 0) std::memcpy(buffers_[i].data(), src, bytes);
   impulse_contacts_ready_ = false;  // what the kept contact frames were made from may have changed
   if (b == Buffer::NeighbourList || b == Buffer::NeighbourCount) impulse_mirror_.clear();
@@ -151,12 +152,16 @@ Status OpenMPDevice::read(Buffer b, void* dst, std::size_t bytes) {
     return Status::error(fmt::format("openmp: reading {} bytes from {} of {} bytes", bytes,
                                      buffer_name(b), buffers_[i].size()));
   }
+  impulse_acc_flush();
   if (bytes > 0) std::memcpy(dst, buffers_[i].data(), bytes);
   return Status::ok();
 }
 
 void OpenMPDevice::enqueue(Kernel k, const shared::StepParams& p) {
   team_ = share_.team();
+  // Between the sweeps of a substep only they and impulses_apply run; anything else sees the
+  // contacts' accumulated impulses in ContactImpulse.
+  if (k != Kernel::ImpulsesCompute && k != Kernel::ImpulsesApply) impulse_acc_flush();
   switch (k) {
 #define MOTES_FAMILY_CASE(E, name, reads, writes) \
   case Kernel::E:                                 \
@@ -176,6 +181,7 @@ void OpenMPDevice::forget_impulse_passes() {
   impulse_body_active_.clear();
   impulse_frames_.clear();
   impulse_contacts_ready_ = false;
+  impulse_acc_pending_ = false;  // written back already, or its buffer made anew (allocate)
 }
 
 Status OpenMPDevice::check_guards() {

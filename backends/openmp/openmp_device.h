@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "contact_inputs.h"
+#include "contact_lanes.h"
 #include "cpu_share.h"
 #include "motes/backend/device.h"
 #include "shared/impulse.h"
@@ -117,8 +118,10 @@ class OpenMPDevice final : public Device {
   /// pass and its sweeps, so the sweeps visit only these: the others' impulses stay 0.
   std::vector<std::uint32_t> impulse_active_;
   std::vector<std::uint8_t> impulse_touches_;
-  /// Per body (and one past the last), where its particles start in impulse_active_.
+  /// Per body (and one past the last), where its particles start in impulse_active_
+  /// (impulse_runs_update makes them from it).
   std::vector<std::uint32_t> impulse_body_active_;
+  void impulse_runs_update(const shared::StepParams& p);
   /// impulses_compute: each body's shared::impulse_body_frame, made by the counting pass.
   std::vector<shared::ImpulseBody> impulse_frames_;
   /// impulses_compute's sweeps evaluate a contact of two dynamic rigid particles once, at the
@@ -128,14 +131,11 @@ class OpenMPDevice final : public Device {
   /// and each slot's contact impulse of the sweep (w: counted).
   std::vector<std::uint32_t> impulse_mirror_;
   std::vector<shared::vec4> impulse_pair_;
-  /// impulses_sweep.cpp: a contact within reach at the last counting pass, with what the
-  /// substep's sweeps do not change; bodies a and b (b == the body count: a plane); the slots of
-  /// its accumulated impulse in ContactImpulse (kNone: none, it starts from 0 every sweep).
+  /// impulses_sweep.cpp: a contact within reach at the last counting pass (its numbers in
+  /// impulse_blocks_); bodies a and b (b == the body count: a plane); the slots of its
+  /// accumulated impulse in ContactImpulse (kNone: none, it starts from 0 every sweep).
   struct ImpulseContact {
-    shared::ContactFrame frame;
-    shared::ContactLaw law;
     std::uint32_t a, b, slot, mirror;
-    bool warm;  // the counting pass starts from the slot's accumulated impulse (the sweeps always)
   };
   /// The counting pass and the sweeps from kept contact frames (impulses_sweep.cpp): false when
   /// they cannot be kept (a touching particle beyond its list's capacity), and impulses_compute
@@ -145,15 +145,22 @@ class OpenMPDevice final : public Device {
   bool impulse_contacts_build(const shared::StepParams& p, bool counting);
   void impulse_bodies_update(const shared::StepParams& p);
   void impulse_contacts_solve(const shared::StepParams& p);
-  /// The substep's contacts (built by its first sweep, dropped by a counting pass or a write),
-  /// each sweep's results, and per active particle its contacts in order (index * 2 + 1: the
-  /// higher id's side of a pair), from impulse_entry_first_[a]; each body as the sweep sees it
-  /// (impulse_body_state), then a plane; a slot's contact while the list is built.
+  /// The substep's contacts (built by the counting pass or else its first sweep, dropped when
+  /// the particles move or a buffer is written), and per active particle its contacts in order
+  /// (index * 2 + 1: the higher id's side of a pair), from impulse_entry_first_[a]; each body as
+  /// the pass sees it (impulse_body_state), then a plane; a slot's contact while the list is
+  /// built. The contacts' numbers in lanes (contact_lanes.h), kContactLanes to a block: their
+  /// frames from the build, their responses from the first sweep; their accumulated impulses
+  /// live there through the substep's passes (pending) and go back to ContactImpulse
+  /// (impulse_acc_flush) before anything else runs or reads the buffers.
   std::vector<ImpulseContact> impulse_contacts_;
-  std::vector<shared::vec4> impulse_results_;
   std::vector<std::uint32_t> impulse_entries_, impulse_entry_first_, impulse_slot_contact_;
   std::vector<shared::ImpulseBody> impulse_bodies_;
+  std::vector<float> impulse_velocities_[6];  // the bodies' velocities now, a component each
+  std::vector<ContactBlock> impulse_blocks_;
   bool impulse_contacts_ready_ = false, impulse_responses_ready_ = false;
+  bool impulse_acc_pending_ = false;
+  void impulse_acc_flush();
   /// Drops what the last counting pass found (after allocate, or a write of positions or lists):
   /// the next sweep without a counting pass visits every particle.
   void forget_impulse_passes();

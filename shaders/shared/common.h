@@ -88,6 +88,14 @@ MOTES_FN float min(float a, float b) { return a < b ? a : b; }
 MOTES_FN float clamp(float x, float lo, float hi) { return min(max(x, lo), hi); }
 MOTES_FN float length(vec3 a) { return sqrt(dot(a, a)); }
 MOTES_FN vec3 xyz(vec4 v) { return vec3(v.x, v.y, v.z); }
+/// c ? a : b, component by component: a choice without a branch, so that a loop over contacts
+/// stays one straight line a compiler can put in vector lanes (GLSL's ?: on vectors).
+MOTES_FN vec3 choose(bool c, vec3 a, vec3 b) {
+  return vec3(c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z);
+}
+MOTES_FN vec4 choose(bool c, vec4 a, vec4 b) {
+  return vec4(c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z, c ? a.w : b.w);
+}
 
 #ifdef __CUDACC__
 MOTES_FN float mul_rn(float a, float b) {
@@ -112,6 +120,8 @@ MOTES_SHARED_END
 #define MOTES_SHARED_BEGIN
 #define MOTES_SHARED_END
 vec3 xyz(vec4 v) { return vec3(v.x, v.y, v.z); }
+vec3 choose(bool c, vec3 a, vec3 b) { return c ? a : b; }
+vec4 choose(bool c, vec4 a, vec4 b) { return c ? a : b; }
 float mul_rn(float a, float b) {
   precise float r = a * b;
   return r;

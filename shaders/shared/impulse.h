@@ -60,26 +60,19 @@ MOTES_FN float impulse_margin(float skin) { return 0.1f * skin; }
 /// backends' roundings of sep would otherwise part their trajectories), else 0.
 MOTES_FN float impulse_target(float sep, float rsum, float vn0, float restitution, vec4 gravity_dt,
                               uint flags, MOTES_OUT(float) soft) {
+  // Every case computed, the one that holds chosen: the openmp backend makes frames in vector
+  // lanes (contact_lanes.cpp), and nested branches here would keep it from doing so.
   float dt = gravity_dt.w;
-  soft = 0.0f;
-  float target = -sep / dt;
-  if ((flags & MOTES_FLAG_IMPULSE_RELAX) == 0u) soft = 1.0f;
-  if (sep <= 0.0f) {
-    target = 0.0f;
-    if ((flags & MOTES_FLAG_IMPULSE_RELAX) == 0u) {
-      float overlap = max(-sep - MOTES_IMPULSE_SLOP * rsum, 0.0f);
-      target = min(MOTES_IMPULSE_BIAS * overlap, MOTES_IMPULSE_PUSH_MAX * rsum) / dt;
-    }
-  }
+  bool relax = (flags & MOTES_FLAG_IMPULSE_RELAX) != 0u;
+  float overlap = max(-sep - MOTES_IMPULSE_SLOP * rsum, 0.0f);
+  float push = relax ? 0.0f : min(MOTES_IMPULSE_BIAS * overlap, MOTES_IMPULSE_PUSH_MAX * rsum) / dt;
+  float target = sep <= 0.0f ? push : -sep / dt;
   float bounce_speed = MOTES_IMPULSE_BOUNCE_SUBSTEPS * length(xyz(gravity_dt)) * dt;
-  if (restitution > 0.0f && vn0 < -bounce_speed && vn0 * dt < -sep) {
-    float bounce = -restitution * vn0;
-    if (bounce > target) {
-      target = bounce;
-      soft = 0.0f;
-    }
-  }
-  return target;
+  float bounce = -restitution * vn0;
+  bool closing = restitution > 0.0f && vn0 < -bounce_speed && vn0 * dt < -sep;
+  bool bounces = closing && bounce > target;
+  soft = relax || bounces ? 0.0f : 1.0f;
+  return bounces ? bounce : target;
 }
 
 /// What the sweeps of one substep do not change in a contact between bodies a and b at point c
@@ -127,7 +120,10 @@ MOTES_FN void contact_frame_response(MOTES_INOUT(ContactFrame) f, MOTES_IN(Impul
 }
 
 /// contact_impulse from the contact's frame f (its response filled unless counting), with the
-/// bodies' velocities now in a and b.
+/// bodies' velocities now in a and b. Its branches are plain blocks of arithmetic and its
+/// early outs choices (shared/common.h, choose), so that the openmp backend's loop over a block of
+/// contacts runs in vector lanes (contact_lanes.cpp: both sides computed, the one taken chosen,
+/// the same bits), while a GPU may still skip a block its threads do not take.
 MOTES_FN vec4 contact_solve(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b,
                             MOTES_IN(ContactFrame) f, ContactLaw law, uint flags,
                             MOTES_INOUT(vec4) acc) {
@@ -137,25 +133,23 @@ MOTES_FN vec4 contact_solve(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b,
   float sep = f.ra.w;
   float vn0 = f.n.w;
   bool relaxing = (flags & MOTES_FLAG_IMPULSE_RELAX) != 0u;
+  bool counting = (flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
   float target = relaxing ? f.target.z : f.target.x;
   float soft = relaxing ? f.target.w : f.target.y;
   float counts = 1.0f;
   vec3 old_total = xyz(acc);
   float jn = acc.w;
   vec3 jt = old_total - n * dot(old_total, n);
-  if ((flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) {
-    if (sep > 0.0f && target <= vn0) {
-      jn = 0.0f;
-    }
+  // A contact without a response (both sides static) is left as it is.
+  bool solved = counting || f.response.w > 0.0f;
+  if (counting) {
+    jn = sep > 0.0f && target <= vn0 ? 0.0f : jn;
   } else {
     vec3 u =
         impulse_point_velocity(a.vel, a.angvel, ra) - impulse_point_velocity(b.vel, b.angvel, rb);
     float vn = dot(u, n);
     vec3 response = xyz(f.response);
     float kn = f.response.w;
-    if (!(kn > 0.0f)) {
-      return vec4(0.0f, 0.0f, 0.0f, counts);
-    }
     float scale = soft > 0.0f ? MOTES_IMPULSE_MASS_SCALE : 1.0f;
     float leak = soft > 0.0f ? MOTES_IMPULSE_LEAK : 0.0f;
     float jn_new = max(jn + scale * (target - vn) / kn - leak * jn, 0.0f);
@@ -171,20 +165,18 @@ MOTES_FN vec4 contact_solve(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b,
       jt -= t * (vt_len / kt);
     }
   }
-  if (law.friction == 0.0f || jn == 0.0f) {
-    jt = vec3(0.0f);
-  } else if (law.friction > 0.0f) {
-    float cap = law.friction * jn;
-    float jt2 = dot(jt, jt);
-    if (jt2 > cap * cap) {
-      jt = jt * (cap / sqrt(jt2));
-    }
+  float cap = law.friction * jn;
+  float jt2 = dot(jt, jt);
+  if (law.friction > 0.0f && jt2 > cap * cap) {  // a branch a GPU may skip; lanes take both
+    jt = jt * (cap / sqrt(jt2));
   }
+  jt = choose(law.friction == 0.0f, vec3(0.0f), jt);
+  jt = choose(jn == 0.0f, vec3(0.0f), jt);
   vec3 total = n * jn + jt;
-  acc = vec4(total, jn);
   // The counting pass applies the whole warm start: nothing of this substep is applied yet.
-  vec3 applied = (flags & MOTES_FLAG_IMPULSE_COUNT) != 0u ? vec3(0.0f) : old_total;
-  return vec4(total - applied, counts);
+  vec3 applied = counting ? vec3(0.0f) : old_total;
+  acc = choose(solved, vec4(total, jn), acc);
+  return choose(solved, vec4(total - applied, counts), vec4(0.0f, 0.0f, 0.0f, counts));
 }
 
 /// The impulse on body a of a contact between bodies a and b at point c, normal n (unit, from b
