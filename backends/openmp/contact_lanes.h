@@ -3,10 +3,11 @@
 // velocities, its accumulated impulse and result) is an array with one lane per contact, so that
 // making the frames, their responses and every pass's solve are loops of the shared functions
 // (shared::contact_frame, contact_frame_response, contact_solve) over the lanes that the compiler
-// puts in vector registers: they have no branches on a contact's values, and the flags are
-// constants here. The arithmetic is the shared functions', lane by lane: the same bits as
-// evaluating the contacts one at a time. docs/architecture.md, "Impulse contacts", says what the
-// passes do; docs/benchmarks.md what the lanes gained.
+// puts in vector registers: their branches are plain blocks of arithmetic it computes on both
+// sides and chooses between, and the flags are constants here. The arithmetic is the shared
+// functions', lane by lane: the same bits as evaluating the contacts one at a time.
+// docs/architecture.md, "Impulse contacts", says what the passes do; docs/benchmarks.md what the
+// lanes gained.
 #ifndef MOTES_OPENMP_CONTACT_LANES_H
 #define MOTES_OPENMP_CONTACT_LANES_H
 
@@ -73,13 +74,16 @@ inline void contact_lane_start_velocities(ContactBlock& k, int l, int s,
   vel[5][l] = w.z;
 }
 
-/// Lane l takes a contact of bodies a and b at point c (normal n from b towards a, separation
-/// sep, r_a + r_b = rsum), the contact law's e and mu, and its accumulated impulse: what
+/// Lane l takes a contact of bodies a and b (their indices ia and ib, whose velocities
+/// contact_block_velocities reads) at point c (normal n from b towards a, separation sep,
+/// r_a + r_b = rsum), the contact law's e and mu, and its accumulated impulse: what
 /// contact_block_frame makes its frame from.
-inline void contact_lane_start(ContactBlock& k, int l, const shared::vec3& c, const shared::vec3& n,
-                               float sep, float rsum, const shared::ImpulseBody& a,
-                               const shared::ImpulseBody& b, const shared::ContactLaw& law,
-                               const shared::vec4& acc) {
+inline void contact_lane_start(ContactBlock& k, int l, std::uint32_t ia, std::uint32_t ib,
+                               const shared::vec3& c, const shared::vec3& n, float sep, float rsum,
+                               const shared::ImpulseBody& a, const shared::ImpulseBody& b,
+                               const shared::ContactLaw& law, const shared::vec4& acc) {
+  k.bodies[0][l] = std::int32_t(ia);
+  k.bodies[1][l] = std::int32_t(ib);
   contact_lane_put(k.frame + 8, l, shared::vec4(n, 0.0f));
   k.frame[3][l] = sep;
   k.frame[7][l] = rsum;
@@ -93,22 +97,15 @@ inline void contact_lane_start(ContactBlock& k, int l, const shared::vec3& c, co
   contact_lane_put(k.acc, l, acc);
 }
 
-/// Lane l's bodies, whose velocities contact_block_velocities reads.
-inline void contact_lane_indices(ContactBlock& k, int l, std::uint32_t a, std::uint32_t b) {
-  k.bodies[0][l] = std::int32_t(a);
-  k.bodies[1][l] = std::int32_t(b);
-}
-
 /// Lane l takes no contact (a block's lanes past the last contact): zeros, no response, nothing
 /// solved there.
 inline void contact_lane_clear(ContactBlock& k, int l) {
-  contact_lane_start(k, l, shared::vec3(0.0f), shared::vec3(0.0f), 0.0f, 0.0f,
+  contact_lane_start(k, l, 0u, 0u, shared::vec3(0.0f), shared::vec3(0.0f), 0.0f, 0.0f,
                      shared::impulse_wall(), shared::impulse_wall(), shared::ContactLaw{},
                      shared::vec4(0.0f));
   for (auto& side : k.body) {
     for (auto& f : side) f[l] = 0.0f;
   }
-  contact_lane_indices(k, l, 0u, 0u);
 }
 
 /// Lane l takes what its bodies a and b hold through the substep's sweeps (once the counting

@@ -120,10 +120,9 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
       // the sweeps always start from the slot.
       const bool warm =
           !counting || shared::impulse_slots_valid(stamp[i], stamp[j], in.vel[j].w, builds);
-      contact_lane_indices(lane(index), int(index % kContactLanes), ct.a, ct.b);
       contact_lane_start(
-          lane(index), int(index % kContactLanes), shared::pair_contact_point(xa, xb), d / dist,
-          dist - rsum, rsum, bodies[ct.a], bodies[ct.b],
+          lane(index), int(index % kContactLanes), ct.a, ct.b, shared::pair_contact_point(xa, xb),
+          d / dist, dist - rsum, rsum, bodies[ct.a], bodies[ct.b],
           in.laws[shared::pair_law_index(i, in.material[i], j, in.material[j], materials)],
           ct.slot != kNone && warm ? acc[ct.slot] : vec4(0.0f));
       impulse_entries_.push_back(index * 2u + (own_first ? 0u : 1u));
@@ -143,8 +142,7 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
       ct.b = wall;
       ct.slot = uint(slot);
       ct.mirror = kNone;
-      contact_lane_indices(lane(index), int(index % kContactLanes), ct.a, ct.b);
-      contact_lane_start(lane(index), int(index % kContactLanes),
+      contact_lane_start(lane(index), int(index % kContactLanes), ct.a, ct.b,
                          shared::plane_contact_point(xi, no), shared::xyz(no), sep, xi.w,
                          bodies[ct.a], bodies[wall], in.laws[own_law + in.planes[k].material],
                          acc[slot]);
