@@ -3,7 +3,8 @@
 // particles in its neighbour list, in list order, then the planes, and writes only its own force:
 // no atomics, a fixed summation order. A particle with more neighbours than its list holds walks
 // the grid of the last build from the cell of its position then: the same pairs in the same order.
-// As backends/openmp/contacts_compute.cpp.
+// With MOTES_FLAG_POSITION the terms are the shifts of position contacts and their number
+// (shared/particle_shift.h). As backends/openmp/contacts_compute.cpp.
 #extension GL_GOOGLE_include_directive : require
 #include "kernel_common.glsl"
 #include "shared/contact_force.h"
@@ -23,17 +24,22 @@ void main() {
   vec3 xi = xyz(pi);
   vec3 ui = xyz(vi);
   uint law_base = particle_material[i] * p.material_count;
-  vec3 f = vec3(0.0f);
+  vec4 f = vec4(0.0f);
   bool by_impulse = impulse_particle(p.flags, i, p.rigid_particle_count);
   uint c = neighbour_count[i];
+  // Position contacts: both particles' contacts within reach (mass splitting); read only then.
+  bool shifts = (p.flags & MOTES_FLAG_POSITION) != 0u;
+  float ni = shifts ? particle_shift_count(c, p.plane_count) : 0.0f;
   if (c <= p.neighbour_capacity) {
     for (uint k = 0u; k < c; ++k) {
       uint j = neighbour_list[k * p.particle_count + i];
       if (by_impulse && j < p.rigid_particle_count) continue;
       vec4 pj = particle_pos[j];
       vec4 vj = particle_vel[j];
-      f += particle_contact_force(xi, ui, pi.w, vi.w, xyz(pj), xyz(vj), pj.w, vj.w,
-                                  contact_laws[law_base + particle_material[j]], p.flags);
+      float nj = shifts ? particle_shift_count(neighbour_count[j], p.plane_count) : 0.0f;
+      f += particle_contact_term(xi, ui, pi.w, vi.w, ni, xyz(pj), xyz(vj), pj.w, vj.w, nj,
+                                 contact_laws[law_base + particle_material[j]], p.flags,
+                                 p.gravity_dt.w);
     }
   } else {
     uint body_i = particle_body[i];
@@ -47,15 +53,17 @@ void main() {
         if (by_impulse && j < p.rigid_particle_count) continue;
         vec4 pj = particle_pos[j];
         vec4 vj = particle_vel[j];
-        f += particle_contact_force(xi, ui, pi.w, vi.w, xyz(pj), xyz(vj), pj.w, vj.w,
-                                    contact_laws[law_base + particle_material[j]], p.flags);
+        float nj = shifts ? particle_shift_count(neighbour_count[j], p.plane_count) : 0.0f;
+        f += particle_contact_term(xi, ui, pi.w, vi.w, ni, xyz(pj), xyz(vj), pj.w, vj.w, nj,
+                                   contact_laws[law_base + particle_material[j]], p.flags,
+                                   p.gravity_dt.w);
       }
     }
   }
   for (uint k = 0u; k < (by_impulse ? 0u : p.plane_count); ++k) {
     PlaneData pl = planes[k];
-    f += plane_contact_force(xi, ui, pi.w, vi.w, pl.normal_offset,
-                             contact_laws[law_base + pl.material], p.flags);
+    f += plane_contact_term(xi, ui, pi.w, vi.w, ni, pl.normal_offset,
+                            contact_laws[law_base + pl.material], p.flags, p.gravity_dt.w);
   }
-  particle_force[i] = vec4(f, 0.0f);
+  particle_force[i] = f;
 }

@@ -1,10 +1,12 @@
-// particles_integrate: semi-implicit Euler on the free spheres [Nr, N) (shared/body_math.h), one
+// particles_integrate: semi-implicit Euler on the free spheres [Nr, N) (shared/body_math.h), or
+// with MOTES_FLAG_PARTICLE_SHIFT the mean of their contacts' shifts (shared/particle_shift.h), one
 // thread per particle, and a neighbour-list rebuild asked for when one has moved too far since
 // the last build (one store per block at most).
 #include "cuda_device.h"
 #include "shared/body_math.h"
 #include "shared/links.h"
 #include "shared/neighbours.h"
+#include "shared/particle_shift.h"
 
 namespace motes::cuda {
 
@@ -21,8 +23,13 @@ __global__ void particles_integrate_kernel(shared::StepParams p, vec4* __restric
   bool moved = false;
   if (i < p.particle_count) {
     vec4 x = pos[i];
-    vec4 v = shared::linked_damped(vel[i], static_cast<uint>(i), p.linked_first, p.linked_damping);
-    shared::particle_integrate(x, v, force[i], p.gravity_dt);
+    vec4 v = vel[i];
+    if ((p.flags & MOTES_FLAG_PARTICLE_SHIFT) != 0u) {
+      shared::particle_shift_apply(x, v, force[i], p.gravity_dt.w);
+    } else {
+      v = shared::linked_damped(v, static_cast<uint>(i), p.linked_first, p.linked_damping);
+      shared::particle_integrate(x, v, force[i], p.gravity_dt, p.flags);
+    }
     pos[i] = x;
     vel[i] = v;
     moved = shared::neighbour_moved_too_far(x, ref[i], p.neighbour_skin);

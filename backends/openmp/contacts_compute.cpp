@@ -2,6 +2,7 @@
 // in list order (the canonical order of the last build), then the planes. A particle with more
 // neighbours than the list holds walks the grid of the last build from the cell of its position
 // then: the same pairs in the same order. No atomics: each particle writes only its own force.
+// With MOTES_FLAG_POSITION: the shifts of position contacts and their number (contacts_shift.cpp).
 #include <chrono>
 #include <cstdint>
 
@@ -18,6 +19,11 @@ using shared::vec4;
 
 void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
+  if ((p.flags & MOTES_FLAG_POSITION) != 0u) {  // position contacts: contacts_shift.cpp
+    contacts_shift(p);
+    record(Kernel::ContactsCompute, start);
+    return;
+  }
   const auto n = static_cast<std::int64_t>(p.particle_count);
   const std::size_t stride = p.particle_count;
   const uint capacity = p.neighbour_capacity;

@@ -122,6 +122,8 @@ class OpenMPDevice final : public Device {
   /// (impulse_runs_update makes them from it).
   std::vector<std::uint32_t> impulse_body_active_;
   void impulse_runs_update(const shared::StepParams& p);
+  /// contacts_compute with MOTES_FLAG_POSITION (contacts_shift.cpp).
+  void contacts_shift(const shared::StepParams& p);
   /// impulses_compute: each body's shared::impulse_body_frame, made by the counting pass.
   std::vector<shared::ImpulseBody> impulse_frames_;
   /// impulses_compute's sweeps evaluate a contact of two dynamic rigid particles once, at the

@@ -210,6 +210,9 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
   // float energies stay precise wherever the scene is.
   energy_model_ = motes::energy_model(scene);
   rigid_scene_body_.assign(sizes_.bodies, 0u);
+  position_bodies_ = std::any_of(bodies_.begin(), bodies_.end(), [](const BodyInfo& b) {
+    return b.kind == BodyKind::Dynamic && b.has_body_state();
+  });
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     if (bodies_[b].has_body_state())
       rigid_scene_body_[device_index_[b]] = static_cast<std::uint32_t>(b);
@@ -251,22 +254,28 @@ Status Simulation::step(std::uint64_t count) {
         d.enqueue(Kernel::ClustersFit, params_);
         d.enqueue(Kernel::ClustersGoal, params_);
       }
-      for (int it = 0; it < settings_.constraint_iterations && colour_first_.size() > 1; ++it) {
-        for (std::size_t c = 0; c + 1 < colour_first_.size(); ++c) {
-          shared::StepParams colour = params_;
-          // Only the last sweep's positions are the ones the next contacts see.
-          if (it + 1 == settings_.constraint_iterations) colour.flags |= MOTES_FLAG_SKIN_CHECK;
-          colour.constraint_first = colour_first_[c];
-          colour.constraint_count = colour_first_[c + 1] - colour_first_[c];
-          d.enqueue(Kernel::ConstraintsSolve, colour);
-        }
-      }
+      relax_constraints();
       if (sizes_.absorb != 0) absorb_attachments();
     }
     ++steps_;
     time_ = static_cast<double>(steps_) * settings_.dt;
   }
   return d.synchronize();
+}
+
+void Simulation::relax_constraints() {
+  // settings.constraint_iterations sweeps over the colours of the cloth and rope constraints, one
+  // launch per colour (docs/architecture.md, "Cloth and ropes").
+  for (int it = 0; it < settings_.constraint_iterations && colour_first_.size() > 1; ++it) {
+    for (std::size_t c = 0; c + 1 < colour_first_.size(); ++c) {
+      shared::StepParams colour = params_;
+      // Only the last sweep's positions are the ones the next contacts see.
+      if (it + 1 == settings_.constraint_iterations) colour.flags |= MOTES_FLAG_SKIN_CHECK;
+      colour.constraint_first = colour_first_[c];
+      colour.constraint_count = colour_first_[c + 1] - colour_first_[c];
+      device_->enqueue(Kernel::ConstraintsSolve, colour);
+    }
+  }
 }
 
 void Simulation::absorb_attachments() {
@@ -341,14 +350,24 @@ constexpr int kPositionVelocitySweeps = 2;
 /// 0.02 to 0.04 d from 1 s to 4 s with 2 sweeps, under 0.01 d with 3 (docs/position-solver.md).
 constexpr int kPositionProjectionSweeps = 3;
 
+/// Jacobi sweeps of the position contacts of free spheres, soft-body, cloth and rope particles per
+/// substep (shared/particle_shift.h), after the shape matching and the constraints, so that the
+/// substep ends with the contacts met as far as the sweeps get (docs/position-solver.md).
+constexpr int kParticleShiftSweeps = 3;
+
 void Simulation::step_positions(const shared::StepParams& lists) {
   // Position contacts (docs/architecture.md, "Position contacts"; shared/position.h): each
   // substep predicts the poses with gravity, finds the contacts of the predicted particles (the
   // lists rebuilt first where a particle moved too far), counts each body's contacts, projects
   // them (kPositionProjectionSweeps Jacobi sweeps: the poses move, the motion becomes velocity),
   // then the velocity pass (kPositionVelocitySweeps Jacobi sweeps); the particles follow the poses
-  // at the end of the step.
+  // at the end of the step. Free spheres, soft bodies, cloth and ropes (with static bodies and
+  // planes; docs/architecture.md "Position contacts of particles") are predicted with gravity
+  // alongside, pulled to their shapes and constraints, and then moved out of their contacts
+  // (kParticleShiftSweeps Jacobi sweeps, shared/particle_shift.h).
   Device& d = *device_;
+  const bool bodies = position_bodies_;
+  const bool free = sizes_.particles > sizes_.rigid_particles;
   shared::StepParams project = params_;
   project.flags |= MOTES_FLAG_POSITION;
   shared::StepParams count = project;
@@ -359,23 +378,38 @@ void Simulation::step_positions(const shared::StepParams& lists) {
   first_count.flags |= MOTES_FLAG_POSITION_FIRST;
   shared::StepParams velocity = project;
   velocity.flags |= MOTES_FLAG_POSITION_VELOCITY;
+  shared::StepParams shift = project;
+  shift.flags |= MOTES_FLAG_PARTICLE_SHIFT;
   for (int s = 0; s < settings_.substeps; ++s) {
-    d.enqueue(Kernel::BodiesIntegrate, project);
-    d.enqueue(Kernel::ParticlesUpdate, params_);
+    if (bodies) {
+      d.enqueue(Kernel::BodiesIntegrate, project);
+      d.enqueue(Kernel::ParticlesUpdate, params_);
+    }
+    if (free) d.enqueue(Kernel::ParticlesIntegrate, project);
     d.enqueue(Kernel::NeighboursUpdate, lists);
-    for (int it = 0; it < kPositionProjectionSweeps; ++it) {
+    for (int it = 0; it < kPositionProjectionSweeps && bodies; ++it) {
       if (it > 0) d.enqueue(Kernel::ParticlesUpdate, params_);
       d.enqueue(Kernel::ImpulsesCompute, it == 0 ? first_count : count);
       d.enqueue(Kernel::ImpulsesApply, it == 0 ? first_count : count);
       d.enqueue(Kernel::ImpulsesCompute, it == 0 ? first : project);
       d.enqueue(Kernel::ImpulsesApply, it == 0 ? first : project);
     }
-    for (int it = 0; it < kPositionVelocitySweeps; ++it) {
+    for (int it = 0; it < kPositionVelocitySweeps && bodies; ++it) {
       d.enqueue(Kernel::ImpulsesCompute, velocity);
       d.enqueue(Kernel::ImpulsesApply, velocity);
     }
+    if (!free) continue;
+    if (params_.cluster_count > 0) {
+      d.enqueue(Kernel::ClustersFit, params_);
+      d.enqueue(Kernel::ClustersGoal, params_);
+    }
+    relax_constraints();
+    for (int it = 0; it < kParticleShiftSweeps; ++it) {
+      d.enqueue(Kernel::ContactsCompute, project);
+      d.enqueue(Kernel::ParticlesIntegrate, shift);
+    }
   }
-  d.enqueue(Kernel::ParticlesUpdate, params_);
+  if (bodies) d.enqueue(Kernel::ParticlesUpdate, params_);
 }
 
 Status Simulation::clear_contact_history() {

@@ -81,14 +81,16 @@ MOTES_FN void body_push_pose(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
 /// One semi-implicit Euler step of a free particle (a one-particle body that does not spin), the
 /// linear half of body_integrate with the same arithmetic: v += dt (F/m + g); x += dt v.
 /// Static particles (vel.w, the inverse mass, == 0) are left untouched.
+/// With MOTES_FLAG_POSITION the force is not used (position contacts: gravity predicts).
 MOTES_FN void particle_integrate(MOTES_INOUT(vec4) pos, MOTES_INOUT(vec4) vel, vec4 force,
-                                 vec4 gravity_dt) {
+                                 vec4 gravity_dt, uint flags) {
   float inv_m = vel.w;
   if (inv_m == 0.0f) {
     return;
   }
   float dt = gravity_dt.w;
-  vec3 v = xyz(vel) + (xyz(force) * inv_m + xyz(gravity_dt)) * dt;
+  vec3 f = (flags & MOTES_FLAG_POSITION) != 0u ? vec3(0.0f) : xyz(force);
+  vec3 v = xyz(vel) + (f * inv_m + xyz(gravity_dt)) * dt;
   vec3 x = xyz(pos) + v * dt;
   pos = vec4(x, pos.w);
   vel = vec4(v, inv_m);

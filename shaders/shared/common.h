@@ -72,6 +72,10 @@ MOTES_FN vec3& operator-=(vec3& a, vec3 b) {
 }
 MOTES_FN vec4 operator+(vec4 a, vec4 b) { return vec4(a.x + b.x, a.y + b.y, a.z + b.z, a.w + b.w); }
 MOTES_FN vec4 operator*(vec4 a, float s) { return vec4(a.x * s, a.y * s, a.z * s, a.w * s); }
+MOTES_FN vec4& operator+=(vec4& a, vec4 b) {
+  a = a + b;
+  return a;
+}
 
 MOTES_FN float dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 MOTES_FN float dot(vec4 a, vec4 b) { return a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w; }

@@ -47,6 +47,10 @@ MOTES_SHARED_BEGIN
 /// record of being projected this substep starts anew; impulses_apply keeps the velocities as the
 /// substep's start).
 #define MOTES_FLAG_POSITION_FIRST 2048u
+/// particles_integrate: move each particle by the mean of the shifts contacts_compute summed with
+/// MOTES_FLAG_POSITION (shared/particle_shift.h) and its velocity by that / dt; nothing else.
+/// Without it, MOTES_FLAG_POSITION makes particles_integrate predict (gravity, no force).
+#define MOTES_FLAG_PARTICLE_SHIFT 4096u
 
 /// Launch parameters of every kernel family; travels with the launch (push constants).
 struct StepParams {

@@ -3,10 +3,11 @@
 // random direction, as between two rebuilds. Written: ParticlePos/Vel (now), ParticleBody,
 // ParticleMaterial, the lists (NeighbourList, NeighbourCount, NeighbourRefPos = X0), the grid of
 // X0 (GridOrder, GridCellStart, SortedBody: the walk of particles with more neighbours than K),
-// ContactLaws and Planes; every other buffer is poisoned; ParticleForce (by particle id, w = 0)
-// is read back. Each case runs twice: with K = 16, and with K = 2 so that most particles walk
-// the grid instead; the two forces must be equal, value for value (the same pairs in the same
-// order), and both close to the oracle's.
+// ContactLaws and Planes; every other buffer is poisoned; ParticleForce (by particle id, w = 0;
+// with MOTES_FLAG_POSITION the shifts of position contacts, w their number) is read back. Each case
+// runs twice: with K = 16, and with K = 2 so that most particles walk the grid instead; the two
+// forces must be equal, value for value (the same pairs in the same order), and both close to the
+// oracle's.
 //
 // Tolerance: NMSE 1e-7 (the default). Each term comes from the same shared function and the same
 // floats; the device sums the terms in float in the canonical order, the oracle in double in id
@@ -84,7 +85,8 @@ class ContactsCompute : public DeviceTest {
     for (std::size_t i = 0; i < now.size(); ++i) {
       if (now.vel[i].w != 0.0f) now.pos[i] = moved[i];
     }
-    const std::vector<vec4> want = motes_ref::contacts_compute(now, w.laws, w.planes, w.params);
+    const std::vector<vec4> want =
+        motes_ref::contacts_compute(now, w.laws, w.planes, w.params, nb.count);
     const std::size_t n = w.particles.size();
     // The layout must really make contacts, or the case proves little.
     std::size_t pushed = 0;
@@ -139,6 +141,14 @@ TEST_P(ContactsCompute, Linked1234) {
 TEST_P(ContactsCompute, MeshLinked1234) {
   // Cloths from meshes: no force between the pairs their LinkExclusions lists hold.
   run_case("mesh_linked", with_mesh_linked(random_world(29, 1234, 0, kTestSkin), 29));
+}
+TEST_P(ContactsCompute, Positions1234) {
+  // Position contacts: each particle's shifts and their number (shared/particle_shift.h).
+  run_case("positions", random_world(26, 1234, MOTES_FLAG_POSITION, kTestSkin));
+}
+TEST_P(ContactsCompute, LinkedPositions1234) {
+  run_case("linked_positions",
+           with_linked(random_world(27, 1234, MOTES_FLAG_POSITION, kTestSkin), 27));
 }
 TEST_P(ContactsCompute, Random20000) {
   run_case("random_clamped", random_world(25, 20000, MOTES_FLAG_CLAMP_ATTRACTION, kTestSkin));

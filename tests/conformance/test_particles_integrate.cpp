@@ -28,9 +28,18 @@ class ParticlesIntegrate : public DeviceTest {
  protected:
   /// `far`: one free particle's ref sits 0.6 skin from where it ends (a rebuild is due), the
   /// others 0.3 skin.
-  void run_case(const std::string& layout, World w, bool far) {
+  /// `flags`: MOTES_FLAG_POSITION (predict: the force not used) or with MOTES_FLAG_PARTICLE_SHIFT
+  /// (each particle moved by the mean of the shifts in ParticleForce: their number 0 to 3 in w).
+  void run_case(const std::string& layout, World w, bool far, uint flags = 0u) {
     w.params.neighbour_skin = kTestSkin;
-    const std::vector<vec4> force = random_forces(w.sizes.particles + 5u, w.particles.size(), 2.0f);
+    w.params.flags |= flags;
+    std::vector<vec4> force = random_forces(w.sizes.particles + 5u, w.particles.size(), 2.0f);
+    if ((flags & MOTES_FLAG_PARTICLE_SHIFT) != 0u) {
+      for (std::size_t i = 0; i < force.size(); ++i) {
+        force[i] = vec4(force[i].x * 1e-4f, force[i].y * 1e-4f, force[i].z * 1e-4f,
+                        static_cast<float>(i % 4));
+      }
+    }
     motes_ref::Particles want = w.particles;
     motes_ref::particles_integrate(want, force, w.params);
     Rng rng(static_cast<std::uint32_t>(w.sizes.particles) + 77u);
@@ -92,6 +101,15 @@ TEST_P(ParticlesIntegrate, Random1234Moved) {
 TEST_P(ParticlesIntegrate, Linked1234) {
   // The free particles are cloth and rope particles: damped before they are integrated.
   run_case("linked", with_linked(random_world(166, 1234), 166), true);
+}
+TEST_P(ParticlesIntegrate, Predict1234) {
+  // Position contacts: gravity alone predicts, the force is not used.
+  run_case("predict", with_linked(random_world(167, 1234), 167), true, MOTES_FLAG_POSITION);
+}
+TEST_P(ParticlesIntegrate, Shift1234) {
+  // Position contacts: the mean of each particle's shifts; no damping, no gravity.
+  run_case("shift", with_linked(random_world(168, 1234), 168), true,
+           MOTES_FLAG_POSITION | MOTES_FLAG_PARTICLE_SHIFT);
 }
 TEST_P(ParticlesIntegrate, Random65536) { run_case("random", random_world(165, 65536), true); }
 

@@ -11,7 +11,13 @@ using motes::shared::vec3;
 using motes::shared::xyz;
 
 std::vector<vec4> contacts_compute(const Particles& particles, const std::vector<ContactLaw>& laws,
-                                   const std::vector<PlaneData>& planes, const StepParams& p) {
+                                   const std::vector<PlaneData>& planes, const StepParams& p,
+                                   const std::vector<uint>& listed) {
+  const auto within_reach = [&](std::size_t i) {
+    return (p.flags & MOTES_FLAG_POSITION) != 0u
+               ? motes::shared::particle_shift_count(listed.at(i), p.plane_count)
+               : 0.0f;
+  };
   const std::size_t n = particles.size();
   const std::size_t m = p.material_count;
   std::vector<vec4> force(n, vec4(0.0f));
@@ -19,25 +25,29 @@ std::vector<vec4> contacts_compute(const Particles& particles, const std::vector
     const vec4 xi = particles.pos[i];
     const vec4 vi = particles.vel[i];
     if (vi.w == 0.0f) continue;  // static particles get no force
-    double sum[3] = {0.0, 0.0, 0.0};
-    auto add = [&](vec3 f) {
+    double sum[4] = {0.0, 0.0, 0.0, 0.0};
+    auto add = [&](vec4 f) {
       sum[0] += static_cast<double>(f.x);
       sum[1] += static_cast<double>(f.y);
       sum[2] += static_cast<double>(f.z);
+      sum[3] += static_cast<double>(f.w);
     };
+    const float h = p.gravity_dt.w;
+    const float ni = within_reach(i);
     for (std::size_t j = 0; j < n; ++j) {
       const vec4 xj = particles.pos[j];
-      // Apart along x by the radii's sum or more: particle_contact_force returns 0 (its float
+      // Apart along x by the radii's sum or more: particle_contact_term returns 0 (its float
       // dx * dx alone reaches rsum * rsum), which adds nothing.
       const float dx = xj.x - xi.x;
       if (dx >= xi.w + xj.w || -dx >= xi.w + xj.w) continue;
       const vec4 vj = particles.vel[j];
       const ContactLaw law = laws[particles.material[i] * m + particles.material[j]];
-      const vec3 f = motes::shared::particle_contact_force(xyz(xi), xyz(vi), xi.w, vi.w, xyz(xj),
-                                                           xyz(vj), xj.w, vj.w, law, p.flags);
+      const vec4 f =
+          motes::shared::particle_contact_term(xyz(xi), xyz(vi), xi.w, vi.w, ni, xyz(xj), xyz(vj),
+                                               xj.w, vj.w, within_reach(j), law, p.flags, h);
       // A zero term adds nothing (the sum starts at +0 and so is never -0): the exclusions, a set
       // lookup, are asked only of pairs that touch.
-      if (f.x == 0.0f && f.y == 0.0f && f.z == 0.0f) continue;
+      if (f.x == 0.0f && f.y == 0.0f && f.z == 0.0f && f.w == 0.0f) continue;
       if (motes::shared::contact_excluded(particles.body[j], particles.body[i]) ||
           particles.never_touch.count({uint(i), uint(j)}) != 0) {
         continue;  // j == i, or j never touches i
@@ -46,11 +56,11 @@ std::vector<vec4> contacts_compute(const Particles& particles, const std::vector
     }
     for (std::size_t k = 0; k < p.plane_count; ++k) {
       const ContactLaw law = laws[particles.material[i] * m + planes[k].material];
-      add(motes::shared::plane_contact_force(xyz(xi), xyz(vi), xi.w, vi.w, planes[k].normal_offset,
-                                             law, p.flags));
+      add(motes::shared::plane_contact_term(xyz(xi), xyz(vi), xi.w, vi.w, ni,
+                                            planes[k].normal_offset, law, p.flags, h));
     }
     force[i] = vec4(static_cast<float>(sum[0]), static_cast<float>(sum[1]),
-                    static_cast<float>(sum[2]), 0.0f);
+                    static_cast<float>(sum[2]), static_cast<float>(sum[3]));
   }
   return force;
 }

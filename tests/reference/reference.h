@@ -106,9 +106,13 @@ bool neighbours_update(const Particles& particles, const std::vector<uint>& stat
 /// laws[material_i * M + material_j], plus shared::plane_contact_force of each plane with law
 /// laws[material_i * M + plane.material]. Static particles (vel.w == 0) get 0. Indexed by
 /// particle id; w = 0. Terms are summed in double, in id order, then rounded once to float: this
-/// is the most accurate sum of the float terms, not the device's canonical order.
+/// is the most accurate sum of the float terms, not the device's canonical order. With
+/// MOTES_FLAG_POSITION the terms are shared::particle_contact_term's and plane_contact_term's
+/// shifts (h = p.gravity_dt.w; each particle's contacts within reach from `listed`, the lists'
+/// counts, and the planes) and w is their number (shared/particle_shift.h).
 std::vector<vec4> contacts_compute(const Particles& particles, const std::vector<ContactLaw>& laws,
-                                   const std::vector<PlaneData>& planes, const StepParams& p);
+                                   const std::vector<PlaneData>& planes, const StepParams& p,
+                                   const std::vector<uint>& listed = {});
 
 /// bodies_reduce: force and torque (shared::particle_torque about the body's centre) of each
 /// dynamic body, summed in float over its particles in particle order; static bodies get 0.
@@ -158,7 +162,9 @@ EnergyBlocks energy_reduce(const Particles& particles, const Bodies& bodies, con
 
 /// particles_integrate: shared::particle_integrate on the free particles [particles.rigid, N)
 /// with `force`, the velocities of the linked ones [p.linked_first, N) first times 1 -
-/// p.linked_damping; returns whether one has moved too far from `ref` (empty ref: false).
+/// p.linked_damping (with MOTES_FLAG_POSITION the force is not used); with
+/// MOTES_FLAG_PARTICLE_SHIFT instead shared::particle_shift_apply with `force` (the shifts' sum and
+/// number); returns whether one has moved too far from `ref` (empty ref: false).
 bool particles_integrate(Particles& particles, const std::vector<vec4>& force, const StepParams& p,
                          const std::vector<vec4>& ref = {});
 

@@ -312,6 +312,8 @@ class Simulation {
   /// One step of position contacts (settings.substeps substeps); lists: the neighbour
   /// update's parameters.
   void step_positions(const shared::StepParams& lists);
+  /// Cloth and rope constraints: settings.constraint_iterations sweeps over their colours.
+  void relax_constraints();
   /// Cloth and ropes attached to rigid bodies: the bodies take the constraints' pull.
   void absorb_attachments();
   /// Impulse contacts: every contact's accumulated impulse to zero and its list slots void (a
@@ -340,6 +342,8 @@ class Simulation {
   std::vector<shared::vec4> rigid_inv_inertia_;
   /// Constraints of colour c are Constraints [colour_first_[c], colour_first_[c + 1]).
   std::vector<std::uint32_t> colour_first_;
+  /// Position contacts: the scene has dynamic rigid bodies (their passes run).
+  bool position_bodies_ = false;
   /// (scene body, orientation) of the free spheres that are not at the identity orientation; a
   /// free sphere never turns.
   std::vector<std::pair<std::uint32_t, shared::vec4>> sphere_turns_;

@@ -1,0 +1,180 @@
+// Cloth and ropes with position contacts ("contact_model": "position"; shared/particle_shift.h),
+// at frame-sized steps (dt = 1/60 s), on the OpenMP device, against answers that do not come from
+// motes:
+// - a 25 x 25 cloth draped over a static sphere of particles never enters it: no cloth particle's
+//   centre comes within the sphere's radius (its surface particles reach radius + d/2), and it
+//   comes to rest on it (the highest cloth particle slower than 1 cm/s at the end);
+// - a cloth dropped flat on the floor never goes through it (every centre at least 0.9 of its
+//   radius above) and ends at rest;
+// - a cloth falling onto a rope held at its ends (no gravity but the cloth's speed): the linear
+//   momentum of everything that can move is kept; constraint averaging (a particle moves by the
+//   mean of its contacts' shifts) is not exact, so the bound is what it measured with a margin.
+// - dynamic rigid bodies with cloth, and soft bodies, are refused with a message naming them.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "motes/cloth.h"
+#include "physics/physics_scenes.h"
+
+namespace {
+
+using motes_test::to_vec3;
+
+constexpr double kFrame = 1.0 / 60.0;
+constexpr double kSpacing = 0.01;
+
+motes::Scene cloth_scene(const Eigen::Vector3d& gravity, int substeps) {
+  motes::Material mat = motes_test::material(1000.0, 0.0, 0.0, 0.0, 0.5);
+  motes::Scene scene = motes_test::scene_with(kFrame, gravity, mat);
+  scene.settings.contact_model = motes::ContactModel::Positions;
+  scene.settings.substeps = substeps;
+  scene.settings.constraint_iterations = 2;
+  scene.settings.link_damping = 1.0;
+  return scene;
+}
+
+motes::LinkedSpec square_cloth(int side, const Eigen::Vector3d& corner) {
+  motes::ClothOptions o;
+  o.corner = corner;
+  o.edge_u = Eigen::Vector3d(kSpacing * (side - 1), 0.0, 0.0);
+  o.edge_v = Eigen::Vector3d(0.0, 0.0, kSpacing * (side - 1));
+  o.nu = side;
+  o.nv = side;
+  o.diameter = kSpacing;
+  o.bend = true;
+  o.bend_stiffness = 0.1;
+  motes::LinkedSpec c = motes::make_cloth(o).value();
+  c.name = "cloth";
+  return c;
+}
+
+TEST(PositionCloth, DrapedOverASphereStaysOutsideAndComesToRest) {
+  constexpr double kRadius = 0.05;
+  motes::Scene scene = cloth_scene(Eigen::Vector3d(0.0, -9.81, 0.0), 20);
+  auto ball =
+      std::make_shared<motes::ParticleSet>(motes::sphere_particles(kRadius, kSpacing).value());
+  motes::BodySpec sphere = motes_test::body(ball, Eigen::Vector3d::Zero());
+  sphere.kind = motes::BodyKind::Static;
+  scene.bodies.push_back(sphere);
+  scene.linked.push_back(square_cloth(25, Eigen::Vector3d(-0.12, 0.08, -0.12)));
+  auto created = motes_test::simulate(scene);
+  ASSERT_TRUE(created) << created.message();
+  motes::Simulation& sim = *created.value();
+  const std::uint32_t first = sim.bodies()[1].first_particle;
+  double closest = 1.0;
+  double top_speed = 0.0;
+  for (int frame = 0; frame < 120; ++frame) {  // 2 s
+    ASSERT_TRUE(sim.step(1));
+    const auto s = sim.snapshot();
+    ASSERT_TRUE(s);
+    std::size_t top = first;
+    for (std::size_t i = first; i < s->particle_pos.size(); ++i) {
+      closest = std::min(closest, to_vec3(s->particle_pos[i]).norm());
+      if (s->particle_pos[i].y > s->particle_pos[top].y) top = i;
+    }
+    top_speed = to_vec3(s->particle_vel[top]).norm();
+  }
+  std::printf(
+      "[position cloth] over a sphere of radius %.3f m: closest cloth particle centre %.4f m "
+      "from its centre; the highest cloth particle ends at %.2g m/s\n",
+      kRadius, closest, top_speed);
+  EXPECT_GT(closest, kRadius);
+  EXPECT_LT(top_speed, 0.01);
+}
+
+TEST(PositionCloth, DroppedOnTheFloorStaysAboveIt) {
+  motes::Scene scene = cloth_scene(Eigen::Vector3d(0.0, -9.81, 0.0), 20);
+  scene.planes.push_back(
+      motes::PlaneSpec{"floor", Eigen::Vector3d(0.0, 1.0, 0.0), Eigen::Vector3d::Zero(), 0});
+  scene.linked.push_back(square_cloth(15, Eigen::Vector3d(-0.07, 0.3, -0.07)));
+  auto created = motes_test::simulate(scene);
+  ASSERT_TRUE(created) << created.message();
+  motes::Simulation& sim = *created.value();
+  double lowest = 1.0;
+  double fastest = 0.0;
+  for (int frame = 0; frame < 90; ++frame) {  // 1.5 s
+    ASSERT_TRUE(sim.step(1));
+    const auto s = sim.snapshot();
+    ASSERT_TRUE(s);
+    fastest = 0.0;
+    for (std::size_t i = 0; i < s->particle_pos.size(); ++i) {
+      lowest = std::min(lowest, static_cast<double>(s->particle_pos[i].y));
+      fastest = std::max(fastest, to_vec3(s->particle_vel[i]).norm());
+    }
+  }
+  std::printf(
+      "[position cloth] dropped on the floor from 0.3 m: lowest centre %.5f m (radius %.3f); "
+      "the fastest particle ends at %.2g m/s\n",
+      lowest, 0.5 * kSpacing, fastest);
+  EXPECT_GT(lowest, 0.9 * 0.5 * kSpacing);
+  EXPECT_LT(fastest, 0.01);
+}
+
+TEST(PositionCloth, CollisionWithARopeWithoutGravityKeepsMomentum) {
+  motes::Scene scene = cloth_scene(Eigen::Vector3d::Zero(), 10);
+  scene.settings.link_damping = 0.0;
+  motes::LinkedSpec cloth = square_cloth(11, Eigen::Vector3d(-0.05, 0.05, -0.05));
+  cloth.velocity = Eigen::Vector3d(0.1, -1.0, 0.2);
+  scene.linked.push_back(cloth);
+  motes::LinkedSpec rope;
+  rope.name = "rope";
+  rope.kind = motes::LinkedKind::Rope;
+  rope.diameter = kSpacing;
+  for (int k = 0; k <= 14; ++k) {
+    rope.points.push_back(Eigen::Vector3d(-0.07 + kSpacing * k, 0.0, 0.003));
+    rope.lattice.push_back({static_cast<std::uint32_t>(k), 0u});
+    if (k > 0) {
+      rope.links.push_back({static_cast<std::uint32_t>(k - 1), static_cast<std::uint32_t>(k), 1.0});
+    }
+  }
+  scene.linked.push_back(rope);
+  auto created = motes_test::simulate(scene);
+  ASSERT_TRUE(created) << created.message();
+  motes::Simulation& sim = *created.value();
+  const auto momentum = [](const motes::Snapshot& s) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (const motes::shared::vec4& v : s.particle_vel) {
+      p += to_vec3(v) / static_cast<double>(v.w);
+    }
+    return p;
+  };
+  auto before = sim.snapshot();
+  ASSERT_TRUE(before);
+  const Eigen::Vector3d p0 = momentum(*before);
+  ASSERT_TRUE(sim.step(9));  // 0.15 s: the cloth meets the rope and carries it along
+  auto after = sim.snapshot();
+  ASSERT_TRUE(after);
+  const Eigen::Vector3d p1 = momentum(*after);
+  const std::uint32_t rope_first = sim.bodies()[1].first_particle;
+  double rope_speed = 0.0;
+  for (std::size_t i = rope_first; i < after->particle_vel.size(); ++i) {
+    rope_speed = std::max(rope_speed, to_vec3(after->particle_vel[i]).norm());
+  }
+  const double drift = (p1 - p0).norm() / p0.norm();
+  std::printf(
+      "[position cloth] free collision with a rope: momentum (%.6g, %.6g, %.6g) -> (%.6g, %.6g, "
+      "%.6g), %.2e relative; the rope's fastest particle at %.3f m/s after\n",
+      p0.x(), p0.y(), p0.z(), p1.x(), p1.y(), p1.z(), drift, rope_speed);
+  EXPECT_GT(rope_speed, 0.1) << "the cloth must have hit the rope";
+  EXPECT_LT(drift, 1e-6);
+}
+
+TEST(PositionCloth, RefusesClothWithDynamicRigidBodies) {
+  motes::Scene scene = cloth_scene(Eigen::Vector3d(0.0, -9.81, 0.0), 10);
+  motes::BodySpec box =
+      motes_test::body(motes_test::lattice(3, 3, 3, kSpacing), Eigen::Vector3d(0.0, 0.1, 0.0));
+  box.name = "crate";
+  scene.bodies.push_back(box);
+  scene.linked.push_back(square_cloth(5, Eigen::Vector3d(0.0, 0.3, 0.0)));
+  auto sim = motes_test::simulate(scene);
+  ASSERT_FALSE(sim);
+  EXPECT_NE(sim.status().message().find("dynamic rigid body \"crate\" and cloth \"cloth\""),
+            std::string::npos)
+      << sim.status().message();
+}
+
+}  // namespace
