@@ -114,6 +114,9 @@ MechanicalEnergy mechanical_energy(const Snapshot& state, std::span<const BodyIn
 EnergyModel energy_model(const Scene& scene) {
   EnergyModel m;
   const bool impulses = rigid_contacts_without_forces(scene.settings.contact_model);
+  // Position contacts have no force law anywhere: no spring stores energy (shared/position.h,
+  // shared/particle_shift.h).
+  const bool positions = scene.settings.contact_model == ContactModel::Positions;
   m.materials = static_cast<std::uint32_t>(scene.materials.size());
   m.substep = scene.settings.dt / static_cast<double>(std::max(scene.settings.substeps, 1));
   m.laws = contact_law_table(scene.materials);
@@ -147,7 +150,7 @@ EnergyModel energy_model(const Scene& scene) {
     for (std::size_t k = 0; k < b.shape->points.size(); ++k) {
       m.contact_word.push_back(static_cast<std::uint32_t>(bi));
       m.material.push_back(material);
-      m.by_impulse.push_back(impulses && !b.soft ? 1u : 0u);
+      m.by_impulse.push_back((impulses && !b.soft) || positions ? 1u : 0u);
     }
     m.largest_diameter = std::max(m.largest_diameter, b.shape->diameter);
     if (b.kind != BodyKind::Dynamic || material >= scene.materials.size()) continue;
@@ -184,7 +187,7 @@ EnergyModel energy_model(const Scene& scene) {
           mesh ? shared::linked_mesh_body(object, k)
                : shared::linked_body(object, l.lattice[k][0] & 1023u, l.lattice[k][1] & 1023u));
       m.material.push_back(static_cast<std::uint32_t>(std::max(l.material, 0)));
-      m.by_impulse.push_back(0u);
+      m.by_impulse.push_back(positions ? 1u : 0u);
       if (any_mesh)
         m.exclusion_start.push_back(static_cast<std::uint32_t>(m.exclusion_list.size()));
       if (mesh) {

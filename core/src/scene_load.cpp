@@ -208,6 +208,8 @@ CameraSpec read_camera(const Node& node) {
 /// Every material a body, cloth, rope or plane uses needs a stiffness (from itself or
 /// settings.contact).
 void check_stiffness(const Scene& scene, const std::vector<std::string>& paths) {
+  // Position contacts have no force law anywhere: no stiffness is needed.
+  if (scene.settings.contact_model == ContactModel::Positions) return;
   // With impulse contacts, rigid bodies and planes meet each other without the force law: only
   // soft bodies, cloth and ropes need a stiffness, and whatever they touch (they meet everything
   // through forces).

@@ -55,7 +55,8 @@ struct EnergyModel {
   /// Per scene particle: the word shared::contact_excluded compares (its scene body; a cloth's or
   /// rope's particle: shared::linked_body or shared::linked_mesh_body of its object), its
   /// material, and whether it is a rigid body's in a scene with impulse contacts (its contacts
-  /// with other such particles and with the planes are impulses: no spring stores energy).
+  /// with other such particles and with the planes are impulses: no spring stores energy), or any
+  /// particle's in a scene of position contacts (no force law at all).
   std::vector<std::uint32_t> contact_word;
   std::vector<std::uint32_t> material;
   std::vector<std::uint8_t> by_impulse;
