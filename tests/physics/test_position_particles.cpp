@@ -15,12 +15,15 @@
 //   3 s);
 // - two soft cubes thrown at each other without gravity, one spinning: linear momentum kept to
 //   1e-6 relative (mass splitting in the shifts, the shape pull's own momentum corrections);
+// - a chain of 20 links hanging between two pins comes to the exact discrete catenary's sag within
+//   1e-2 relative at the default 8 substeps of 8 link sweeps, 1e-3 at 40 substeps (issue 27);
 // - dynamic rigid bodies with cloth are refused with a message naming both.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 #include <vector>
 
 #include "motes/cloth.h"
@@ -33,7 +36,7 @@ using motes_test::to_vec3;
 constexpr double kFrame = 1.0 / 60.0;
 constexpr double kSpacing = 0.01;
 
-motes::Scene cloth_scene(const Eigen::Vector3d& gravity, int substeps) {
+motes::Scene particle_scene(const Eigen::Vector3d& gravity, int substeps) {
   motes::Material mat = motes_test::material(1000.0, 0.0, 0.0, 0.0, 0.5);
   motes::Scene scene = motes_test::scene_with(kFrame, gravity, mat);
   scene.settings.contact_model = motes::ContactModel::Positions;
@@ -43,7 +46,7 @@ motes::Scene cloth_scene(const Eigen::Vector3d& gravity, int substeps) {
   return scene;
 }
 
-motes::LinkedSpec square_cloth(int side, const Eigen::Vector3d& corner) {
+motes::LinkedSpec flat_cloth(int side, const Eigen::Vector3d& corner) {
   motes::ClothOptions o;
   o.corner = corner;
   o.edge_u = Eigen::Vector3d(kSpacing * (side - 1), 0.0, 0.0);
@@ -60,13 +63,13 @@ motes::LinkedSpec square_cloth(int side, const Eigen::Vector3d& corner) {
 
 TEST(PositionCloth, DrapedOverASphereStaysOutsideAndComesToRest) {
   constexpr double kRadius = 0.05;
-  motes::Scene scene = cloth_scene(Eigen::Vector3d(0.0, -9.81, 0.0), 20);
+  motes::Scene scene = particle_scene(Eigen::Vector3d(0.0, -9.81, 0.0), 20);
   auto ball =
       std::make_shared<motes::ParticleSet>(motes::sphere_particles(kRadius, kSpacing).value());
   motes::BodySpec sphere = motes_test::body(ball, Eigen::Vector3d::Zero());
   sphere.kind = motes::BodyKind::Static;
   scene.bodies.push_back(sphere);
-  scene.linked.push_back(square_cloth(25, Eigen::Vector3d(-0.12, 0.08, -0.12)));
+  scene.linked.push_back(flat_cloth(25, Eigen::Vector3d(-0.12, 0.08, -0.12)));
   auto created = motes_test::simulate(scene);
   ASSERT_TRUE(created) << created.message();
   motes::Simulation& sim = *created.value();
@@ -93,10 +96,10 @@ TEST(PositionCloth, DrapedOverASphereStaysOutsideAndComesToRest) {
 }
 
 TEST(PositionCloth, DroppedOnTheFloorStaysAboveIt) {
-  motes::Scene scene = cloth_scene(Eigen::Vector3d(0.0, -9.81, 0.0), 20);
+  motes::Scene scene = particle_scene(Eigen::Vector3d(0.0, -9.81, 0.0), 20);
   scene.planes.push_back(
       motes::PlaneSpec{"floor", Eigen::Vector3d(0.0, 1.0, 0.0), Eigen::Vector3d::Zero(), 0});
-  scene.linked.push_back(square_cloth(15, Eigen::Vector3d(-0.07, 0.3, -0.07)));
+  scene.linked.push_back(flat_cloth(15, Eigen::Vector3d(-0.07, 0.3, -0.07)));
   auto created = motes_test::simulate(scene);
   ASSERT_TRUE(created) << created.message();
   motes::Simulation& sim = *created.value();
@@ -121,9 +124,9 @@ TEST(PositionCloth, DroppedOnTheFloorStaysAboveIt) {
 }
 
 TEST(PositionCloth, CollisionWithARopeWithoutGravityKeepsMomentum) {
-  motes::Scene scene = cloth_scene(Eigen::Vector3d::Zero(), 10);
+  motes::Scene scene = particle_scene(Eigen::Vector3d::Zero(), 10);
   scene.settings.link_damping = 0.0;
-  motes::LinkedSpec cloth = square_cloth(11, Eigen::Vector3d(-0.05, 0.05, -0.05));
+  motes::LinkedSpec cloth = flat_cloth(11, Eigen::Vector3d(-0.05, 0.05, -0.05));
   cloth.velocity = Eigen::Vector3d(0.1, -1.0, 0.2);
   scene.linked.push_back(cloth);
   motes::LinkedSpec rope;
@@ -169,8 +172,8 @@ TEST(PositionCloth, CollisionWithARopeWithoutGravityKeepsMomentum) {
   EXPECT_LT(drift, 1e-6);
 }
 
-motes::BodySpec soft_cube(const Eigen::Vector3d& at, const Eigen::Vector3d& velocity,
-                          const Eigen::Vector3d& spin) {
+motes::BodySpec position_soft_cube(const Eigen::Vector3d& at, const Eigen::Vector3d& velocity,
+                                   const Eigen::Vector3d& spin) {
   motes::BodySpec b = motes_test::body(motes_test::lattice(5, 5, 5, kSpacing), at, velocity, spin);
   b.soft = motes::SoftSpec{};
   b.soft->frequency = 30.0;
@@ -179,11 +182,11 @@ motes::BodySpec soft_cube(const Eigen::Vector3d& at, const Eigen::Vector3d& velo
 }
 
 TEST(PositionSoft, CubeDroppedOnTheFloorComesToRestAboveIt) {
-  motes::Scene scene = cloth_scene(Eigen::Vector3d(0.0, -9.81, 0.0), 20);
+  motes::Scene scene = particle_scene(Eigen::Vector3d(0.0, -9.81, 0.0), 20);
   scene.planes.push_back(
       motes::PlaneSpec{"floor", Eigen::Vector3d(0.0, 1.0, 0.0), Eigen::Vector3d::Zero(), 0});
-  motes::BodySpec cube =
-      soft_cube(Eigen::Vector3d(0.0, 0.1, 0.0), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  motes::BodySpec cube = position_soft_cube(Eigen::Vector3d(0.0, 0.1, 0.0), Eigen::Vector3d::Zero(),
+                                            Eigen::Vector3d::Zero());
   cube.rotation =
       Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Eigen::Vector3d(1.0, 0.0, 0.5).normalized()));
   scene.bodies.push_back(cube);
@@ -211,11 +214,13 @@ TEST(PositionSoft, CubeDroppedOnTheFloorComesToRestAboveIt) {
 }
 
 TEST(PositionSoft, CollisionWithoutGravityKeepsMomentum) {
-  motes::Scene scene = cloth_scene(Eigen::Vector3d::Zero(), 10);
-  scene.bodies.push_back(soft_cube(Eigen::Vector3d(-0.04, 0.0, 0.0), Eigen::Vector3d(1.0, 0.1, 0.0),
-                                   Eigen::Vector3d(0.0, 0.0, 20.0)));
-  scene.bodies.push_back(soft_cube(Eigen::Vector3d(0.04, 0.01, 0.005),
-                                   Eigen::Vector3d(-0.5, 0.0, 0.2), Eigen::Vector3d::Zero()));
+  motes::Scene scene = particle_scene(Eigen::Vector3d::Zero(), 10);
+  scene.bodies.push_back(position_soft_cube(Eigen::Vector3d(-0.04, 0.0, 0.0),
+                                            Eigen::Vector3d(1.0, 0.1, 0.0),
+                                            Eigen::Vector3d(0.0, 0.0, 20.0)));
+  scene.bodies.push_back(position_soft_cube(Eigen::Vector3d(0.04, 0.01, 0.005),
+                                            Eigen::Vector3d(-0.5, 0.0, 0.2),
+                                            Eigen::Vector3d::Zero()));
   auto created = motes_test::simulate(scene);
   ASSERT_TRUE(created) << created.message();
   motes::Simulation& sim = *created.value();
@@ -243,13 +248,91 @@ TEST(PositionSoft, CollisionWithoutGravityKeepsMomentum) {
   EXPECT_LT(drift, 1e-6);
 }
 
+/// A chain of n links of length L hanging in a V between two pins `span` apart at height y.
+motes::LinkedSpec hanging_chain(int n, double link, double span, double y) {
+  const double angle = std::acos(span / (n * link));
+  motes::LinkedSpec s;
+  s.name = "chain";
+  s.kind = motes::LinkedKind::Rope;
+  s.diameter = 0.5 * link;  // neighbours two links apart never touch
+  Eigen::Vector3d x(0.0, y, 0.0);
+  for (int k = 0; k <= n; ++k) {
+    s.points.push_back(x);
+    s.lattice.push_back({static_cast<std::uint32_t>(k), 0u});
+    const double down = k < n / 2 ? -1.0 : 1.0;
+    x += Eigen::Vector3d(link * std::cos(angle), down * link * std::sin(angle), 0.0);
+  }
+  for (int k = 0; k < n; ++k) {
+    s.links.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k + 1), 1.0});
+  }
+  s.pinned = {0u, static_cast<std::uint32_t>(n)};
+  return s;
+}
+
+/// Sag of the exact discrete catenary: n links of length L, n - 1 equal interior masses, pins
+/// `span` apart at one height (n even: the lowest point is node n / 2).
+double exact_catenary_sag(int n, double link, double span) {
+  const auto span_for = [&](double h) {  // h = H / (m g)
+    double s = 0.0;
+    for (int k = 1; k <= n; ++k) s += link * std::cos(std::atan((n + 1 - 2 * k) / (2.0 * h)));
+    return s;
+  };
+  double lo = 1e-9, hi = 1e9;
+  for (int it = 0; it < 200; ++it) {
+    const double mid = std::sqrt(lo * hi);
+    (span_for(mid) < span ? lo : hi) = mid;
+  }
+  const double h = std::sqrt(lo * hi);
+  double sag = 0.0;
+  for (int k = 1; k <= n / 2; ++k) sag += link * std::sin(std::atan((n + 1 - 2 * k) / (2.0 * h)));
+  return sag;
+}
+
+/// The sag of the V chain hanging at rest (6 s) with position contacts at `substeps` a frame.
+double position_chain_sag(int substeps, int iterations, double* stretch) {
+  constexpr int kLinks = 20;
+  constexpr double kLink = 0.02, kSpan = 0.3, kY = 1.0;
+  motes::Scene scene = particle_scene(Eigen::Vector3d(0.0, -9.81, 0.0), substeps);
+  scene.settings.constraint_iterations = iterations;
+  scene.settings.link_damping = 4.0;
+  scene.linked.push_back(hanging_chain(kLinks, kLink, kSpan, kY));
+  auto created = motes_test::simulate(scene);
+  if (!created || !created.value()->step(360)) return -1.0;
+  const auto s = created.value()->snapshot();
+  if (!s) return -1.0;
+  double lowest = kY;
+  *stretch = 0.0;
+  for (std::size_t k = 0; k < s->particle_pos.size(); ++k) {
+    lowest = std::min(lowest, static_cast<double>(s->particle_pos[k].y));
+    if (k > 0) {
+      const double len = (to_vec3(s->particle_pos[k]) - to_vec3(s->particle_pos[k - 1])).norm();
+      *stretch = std::max(*stretch, std::abs(len - kLink) / kLink);
+    }
+  }
+  return kY - lowest;
+}
+
+TEST(PositionRope, HangingChainIsTheDiscreteCatenary) {
+  const double want = exact_catenary_sag(20, 0.02, 0.3);
+  for (const auto& [substeps, iterations, bound] :
+       {std::tuple{motes::kPositionSubsteps, 8, 1e-2}, std::tuple{40, 8, 1e-3}}) {
+    double stretch = 0.0;
+    const double got = position_chain_sag(substeps, iterations, &stretch);
+    std::printf(
+        "[position rope] 20 links, %d substeps of %d sweeps: sag %.6f m, exact %.6f m (%.2e "
+        "rel); largest stretch %.2e\n",
+        substeps, iterations, got, want, std::abs(got - want) / want, stretch);
+    EXPECT_NEAR(got, want, bound * want) << substeps << " substeps";
+  }
+}
+
 TEST(PositionCloth, RefusesClothWithDynamicRigidBodies) {
-  motes::Scene scene = cloth_scene(Eigen::Vector3d(0.0, -9.81, 0.0), 10);
+  motes::Scene scene = particle_scene(Eigen::Vector3d(0.0, -9.81, 0.0), 10);
   motes::BodySpec box =
       motes_test::body(motes_test::lattice(3, 3, 3, kSpacing), Eigen::Vector3d(0.0, 0.1, 0.0));
   box.name = "crate";
   scene.bodies.push_back(box);
-  scene.linked.push_back(square_cloth(5, Eigen::Vector3d(0.0, 0.3, 0.0)));
+  scene.linked.push_back(flat_cloth(5, Eigen::Vector3d(0.0, 0.3, 0.0)));
   auto sim = motes_test::simulate(scene);
   ASSERT_FALSE(sim);
   EXPECT_NE(sim.status().message().find("dynamic rigid body \"crate\" and cloth \"cloth\""),
