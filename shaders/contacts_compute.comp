@@ -12,6 +12,24 @@
 #include "grid_walk.glsl"
 #include "link_exclusions.glsl"
 
+// Position contacts (MOTES_FLAG_POSITION): the shift particle i asks of itself for its contact
+// with particle j (shared/particle_shift.h), or for a rigid body's particle the reaction of its
+// contact with another kind's particle; both particles' contacts within reach for mass splitting.
+vec4 shift_term(uint i, uint j, vec3 xi, vec3 ui, float wi, float ri, float ni, vec4 pj, vec4 vj) {
+  float nj = particle_shift_count(neighbour_count[j], p.plane_count);
+  if (i < p.rigid_particle_count) {
+    return rigid_contact_reaction(
+        xi, ui, ri, ni, xyz(pj), xyz(vj), pj.w, vj.w, nj,
+        contact_laws[particle_material[j] * p.material_count + particle_material[i]],
+        p.gravity_dt.w);
+  }
+  return particle_contact_shift(
+      xi, ui, ri, wi, ni, xyz(pj), xyz(vj), pj.w,
+      shift_partner_inverse_mass(j, p.rigid_particle_count, vj.w), nj,
+      contact_laws[particle_material[i] * p.material_count + particle_material[j]],
+      p.gravity_dt.w);
+}
+
 void main() {
   uint i = thread_index();
   if (i >= p.particle_count) return;
@@ -36,10 +54,10 @@ void main() {
       if (by_impulse && j < p.rigid_particle_count) continue;
       vec4 pj = particle_pos[j];
       vec4 vj = particle_vel[j];
-      float nj = shifts ? particle_shift_count(neighbour_count[j], p.plane_count) : 0.0f;
-      f += particle_contact_term(xi, ui, pi.w, vi.w, ni, xyz(pj), xyz(vj), pj.w, vj.w, nj,
-                                 contact_laws[law_base + particle_material[j]], p.flags,
-                                 p.gravity_dt.w);
+      f += shifts ? shift_term(i, j, xi, ui, vi.w, pi.w, ni, pj, vj)
+                  : particle_contact_term(xi, ui, pi.w, vi.w, 0.0f, xyz(pj), xyz(vj), pj.w, vj.w,
+                                          0.0f, contact_laws[law_base + particle_material[j]],
+                                          p.flags, p.gravity_dt.w);
     }
   } else {
     uint body_i = particle_body[i];
@@ -53,10 +71,11 @@ void main() {
         if (by_impulse && j < p.rigid_particle_count) continue;
         vec4 pj = particle_pos[j];
         vec4 vj = particle_vel[j];
-        float nj = shifts ? particle_shift_count(neighbour_count[j], p.plane_count) : 0.0f;
-        f += particle_contact_term(xi, ui, pi.w, vi.w, ni, xyz(pj), xyz(vj), pj.w, vj.w, nj,
-                                   contact_laws[law_base + particle_material[j]], p.flags,
-                                   p.gravity_dt.w);
+        f += shifts ? shift_term(i, j, xi, ui, vi.w, pi.w, ni, pj, vj)
+                    : particle_contact_term(xi, ui, pi.w, vi.w, 0.0f, xyz(pj), xyz(vj), pj.w,
+                                            vj.w, 0.0f,
+                                            contact_laws[law_base + particle_material[j]], p.flags,
+                                            p.gravity_dt.w);
       }
     }
   }

@@ -2,7 +2,7 @@
 // particles_update: the rigid particles' [0, Nr) positions and velocities follow their body's
 // pose; a neighbour-list rebuild is asked for when one has moved too far since the last build
 // (one store per workgroup at most). With MOTES_FLAG_ABSORB each first hands what the constraints
-// did to it to its body (shared/body_math.h: particle_absorbed_impulse, and its moment).
+// did to it to its body (shared/body_math.h: particle_handed_impulse, and its moment).
 #extension GL_GOOGLE_include_directive : require
 #include "kernel_common.glsl"
 #include "shared/body_math.h"
@@ -19,7 +19,8 @@ void main() {
     vec4 local = particle_local[i];
     vec4 q = body_quat[b];
     if ((p.flags & MOTES_FLAG_ABSORB) != 0u) {
-      vec3 j = particle_absorbed_impulse(particle_vel[i], q, body_vel[b], body_angvel[b], local);
+      vec3 j = particle_handed_impulse(particle_vel[i], q, body_vel[b], body_angvel[b], local,
+                                       particle_force[i], p.flags);
       particle_force[i] = vec4(j, 0.0f);
       particle_moment[i] = vec4(cross(quat_rotate(q, xyz(local)), j), 0.0f);
     }

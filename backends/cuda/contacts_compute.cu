@@ -48,10 +48,19 @@ __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
     const vec4 pj = in.pos[j];
     const vec4 vj = in.vel[j];
     if constexpr (kShifts) {
-      f += shared::particle_contact_shift(xi, ui, pi.w, vi.w, ni, shared::xyz(pj), shared::xyz(vj),
-                                          pj.w, vj.w,
-                                          shared::particle_shift_count(in.count[j], p.plane_count),
-                                          law_row[in.material[j]], p.gravity_dt.w);
+      // A rigid body's particle gathers the reactions of its contacts with other kinds'.
+      const float nj = shared::particle_shift_count(in.count[j], p.plane_count);
+      if (i < p.rigid_particle_count) {
+        f += shared::rigid_contact_reaction(
+            xi, ui, pi.w, ni, shared::xyz(pj), shared::xyz(vj), pj.w, vj.w, nj,
+            in.laws[std::size_t{in.material[j]} * p.material_count + in.material[i]],
+            p.gravity_dt.w);
+      } else {
+        f += shared::particle_contact_shift(
+            xi, ui, pi.w, vi.w, ni, shared::xyz(pj), shared::xyz(vj), pj.w,
+            shared::shift_partner_inverse_mass(j, p.rigid_particle_count, vj.w), nj,
+            law_row[in.material[j]], p.gravity_dt.w);
+      }
     } else {
       f += shared::particle_contact_force(xi, ui, pi.w, vi.w, shared::xyz(pj), shared::xyz(vj),
                                           pj.w, vj.w, law_row[in.material[j]], p.flags);

@@ -1,7 +1,7 @@
 // particles_update: the rigid particles' [0, Nr) positions and velocities follow their body's
 // pose; a neighbour-list rebuild is asked for when one has moved too far since the last build.
 // With MOTES_FLAG_ABSORB each first hands what the constraints did to it to its body
-// (shared/body_math.h: particle_absorbed_impulse, and its moment). As
+// (shared/body_math.h: particle_handed_impulse, and its moment). As
 // backends/openmp/particles_update.cpp and shaders/particles_update.comp.
 #include "body_passes.cuh"
 #include "cuda_device.h"
@@ -10,8 +10,8 @@ namespace motes::cuda {
 
 namespace {
 
-__global__ void particles_update_kernel(shared::uint n, float skin, BodyBuffers d,
-                                        shared::vec4* __restrict__ impulse,
+__global__ void particles_update_kernel(shared::uint n, float skin, shared::uint flags,
+                                        BodyBuffers d, shared::vec4* __restrict__ impulse,
                                         shared::vec4* __restrict__ moment) {
   const std::uint64_t i = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
   bool moved = false;
@@ -20,8 +20,8 @@ __global__ void particles_update_kernel(shared::uint n, float skin, BodyBuffers 
     const shared::uint b = d.particle_body[k];
     if (impulse != nullptr) {  // MOTES_FLAG_ABSORB
       const shared::vec4 q = d.quat[b];
-      const shared::vec3 j =
-          shared::particle_absorbed_impulse(d.vel[k], q, d.body_vel[b], d.angvel[b], d.local[k]);
+      const shared::vec3 j = shared::particle_handed_impulse(
+          d.vel[k], q, d.body_vel[b], d.angvel[b], d.local[k], impulse[k], flags);
       impulse[k] = shared::vec4(j, 0.0f);
       moment[k] =
           shared::vec4(shared::cross(shared::quat_rotate(q, shared::xyz(d.local[k])), j), 0.0f);
@@ -37,7 +37,7 @@ void CudaDevice::launch_particles_update(const shared::StepParams& p) {
   if (p.rigid_particle_count == 0) return;
   const bool absorb = (p.flags & MOTES_FLAG_ABSORB) != 0u;
   particles_update_kernel<<<blocks_for(p.rigid_particle_count), kBlock, 0, stream_>>>(
-      p.rigid_particle_count, p.neighbour_skin, body_buffers(),
+      p.rigid_particle_count, p.neighbour_skin, p.flags, body_buffers(),
       absorb ? buf<shared::vec4>(Buffer::ParticleForce) : nullptr,
       absorb ? buf<shared::vec4>(Buffer::ParticleMoment) : nullptr);
 }

@@ -1,6 +1,8 @@
 // contacts_compute with MOTES_FLAG_POSITION (shared/particle_shift.h): every dynamic particle sums
 // the shifts its position contacts ask of it, with their number in w, in the order contacts_compute
-// sums forces (list order, or the grid walk beyond the list's capacity, then the planes). A loop of
+// sums forces (list order, or the grid walk beyond the list's capacity, then the planes); a rigid
+// body's particle sums the reactions of its contacts with other kinds' particles instead (its
+// contacts with rigid particles and planes are impulses_compute's). A loop of
 // its own beside the force law's, which keeps its code (one loop for both made the force law's
 // falling spheres slower).
 #include <cstdint>
@@ -41,13 +43,23 @@ void OpenMPDevice::contacts_shift(const shared::StepParams& p) {
     // Both particles' contacts within reach: mass splitting.
     const float ni = shared::particle_shift_count(in.count[i], p.plane_count);
     vec4 s(0.0f);
+    // A rigid body's particle gathers the reactions of its contacts with other kinds' particles.
+    const bool rigid = uint(i) < p.rigid_particle_count;
     auto add_contact = [&](uint j) {
       if (by_impulse && j < p.rigid_particle_count) return;
       const vec4 pj = in.pos[j];
       const vec4 vj = in.vel[j];
-      s += shared::particle_contact_shift(
-          xi, ui, pi.w, vi.w, ni, shared::xyz(pj), shared::xyz(vj), pj.w, vj.w,
-          shared::particle_shift_count(in.count[j], p.plane_count), law_row[in.material[j]], h);
+      const float nj = shared::particle_shift_count(in.count[j], p.plane_count);
+      if (rigid) {
+        s += shared::rigid_contact_reaction(
+            xi, ui, pi.w, ni, shared::xyz(pj), shared::xyz(vj), pj.w, vj.w, nj,
+            in.laws[std::size_t{in.material[j]} * materials + in.material[i]], h);
+      } else {
+        s += shared::particle_contact_shift(
+            xi, ui, pi.w, vi.w, ni, shared::xyz(pj), shared::xyz(vj), pj.w,
+            shared::shift_partner_inverse_mass(j, p.rigid_particle_count, vj.w), nj,
+            law_row[in.material[j]], h);
+      }
     };
     const uint c = in.count[i];
     if (c <= capacity) {

@@ -1,7 +1,8 @@
 // particles_update: the rigid particles' positions and velocities follow their body's pose; a
 // neighbour-list rebuild is asked for when one has moved too far since the last build. With
 // MOTES_FLAG_ABSORB each first hands what the constraints did to it to its body (an impulse and its
-// moment, shared/body_math.h: particle_absorbed_impulse).
+// moment, shared/body_math.h: particle_absorbed_impulse); with MOTES_FLAG_PARTICLE_SHIFT too, the
+// reaction of its position contacts that contacts_compute left in ParticleForce.
 #include <chrono>
 #include <cstdint>
 
@@ -41,7 +42,8 @@ void OpenMPDevice::particles_update(const shared::StepParams& p) {
     const vec4 v = body_vel[b];
     const vec4 w = angvel[b];
     if (absorb) {
-      const shared::vec3 j = shared::particle_absorbed_impulse(vel[i], q, v, w, r);
+      const shared::vec3 j =
+          shared::particle_handed_impulse(vel[i], q, v, w, r, impulse[i], p.flags);
       impulse[i] = vec4(j, 0.0f);
       moment[i] = vec4(shared::cross(shared::quat_rotate(q, shared::xyz(r)), j), 0.0f);
     }

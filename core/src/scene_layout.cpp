@@ -74,29 +74,6 @@ Status check_settings(const Scene& scene) {
     return Status::error(fmt::format("{}: impulse_substeps must be 1 to 64 (got {})", scene.source,
                                      settings.impulse_substeps));
   }
-  if (settings.contact_model == ContactModel::Positions) {
-    // Position contacts: rigid bodies with each other, static bodies and planes; soft bodies,
-    // cloth and ropes with each other, static bodies and planes. The two together need the
-    // bodies' share of the particles' shifts (issue 27 builds it next: docs/position-solver.md).
-    const auto soft = std::find_if(scene.bodies.begin(), scene.bodies.end(),
-                                   [](const BodySpec& b) { return b.soft; });
-    const auto rigid =
-        std::find_if(scene.bodies.begin(), scene.bodies.end(),
-                     [](const BodySpec& b) { return !b.soft && b.kind == BodyKind::Dynamic; });
-    if (rigid != scene.bodies.end() && (soft != scene.bodies.end() || !scene.linked.empty())) {
-      const std::string other =
-          soft != scene.bodies.end()
-              ? fmt::format("soft body \"{}\"", soft->name)
-              : fmt::format("{} \"{}\"",
-                            scene.linked[0].kind == LinkedKind::Cloth ? "cloth" : "rope",
-                            scene.linked[0].name);
-      return Status::error(fmt::format(
-          "{}: contact_model \"position\" does not yet couple dynamic rigid bodies with soft "
-          "bodies, cloth or ropes (issue 27); the scene has dynamic rigid body \"{}\" and {} "
-          "(make the rigid bodies static, or use the force law)",
-          scene.source, rigid->name, other));
-    }
-  }
   return Status::ok();
 }
 

@@ -361,10 +361,11 @@ void Simulation::step_positions(const shared::StepParams& lists) {
   // lists rebuilt first where a particle moved too far), counts each body's contacts, projects
   // them (kPositionProjectionSweeps Jacobi sweeps: the poses move, the motion becomes velocity),
   // then the velocity pass (kPositionVelocitySweeps Jacobi sweeps); the particles follow the poses
-  // at the end of the step. Free spheres, soft bodies, cloth and ropes (with static bodies and
-  // planes; docs/architecture.md "Position contacts of particles") are predicted with gravity
-  // alongside, pulled to their shapes and constraints, and then moved out of their contacts
-  // (kParticleShiftSweeps Jacobi sweeps, shared/particle_shift.h).
+  // at the end of the step. Soft bodies, cloth and ropes (docs/architecture.md "Position contacts
+  // of particles") are predicted with gravity alongside, pulled to their shapes and constraints
+  // (attachments hand their pull to the bodies), and then moved out of their contacts
+  // (kParticleShiftSweeps Jacobi sweeps, shared/particle_shift.h), the rigid bodies taking the
+  // reactions of their contacts with them at each sweep.
   Device& d = *device_;
   const bool bodies = position_bodies_;
   const bool free = sizes_.particles > sizes_.rigid_particles;
@@ -380,6 +381,14 @@ void Simulation::step_positions(const shared::StepParams& lists) {
   velocity.flags |= MOTES_FLAG_POSITION_VELOCITY;
   shared::StepParams shift = project;
   shift.flags |= MOTES_FLAG_PARTICLE_SHIFT;
+  // The rigid bodies take the reactions of their particles' contacts with the other kinds at the
+  // same sweep, as a motion of their pose (particles_update hands each particle's to its body with
+  // its moment, impulses_apply moves the body and keeps it as velocity), and their particles
+  // follow.
+  shared::StepParams react = shift;
+  react.flags |= MOTES_FLAG_ABSORB;
+  shared::StepParams react_apply = project;
+  react_apply.flags |= MOTES_FLAG_ABSORB;
   for (int s = 0; s < settings_.substeps; ++s) {
     if (bodies) {
       d.enqueue(Kernel::BodiesIntegrate, project);
@@ -404,9 +413,15 @@ void Simulation::step_positions(const shared::StepParams& lists) {
       d.enqueue(Kernel::ClustersGoal, params_);
     }
     relax_constraints();
+    if (sizes_.absorb != 0) absorb_attachments();
     for (int it = 0; it < kParticleShiftSweeps; ++it) {
       d.enqueue(Kernel::ContactsCompute, project);
       d.enqueue(Kernel::ParticlesIntegrate, shift);
+      if (bodies) {
+        d.enqueue(Kernel::ParticlesUpdate, react);
+        d.enqueue(Kernel::ImpulsesApply, react_apply);
+        d.enqueue(Kernel::ParticlesUpdate, params_);
+      }
     }
   }
   if (bodies) d.enqueue(Kernel::ParticlesUpdate, params_);

@@ -125,6 +125,18 @@ MOTES_FN vec3 particle_absorbed_impulse(vec4 vel, vec4 quat, vec4 body_vel, vec4
   return (xyz(vel) - particle_velocity(quat, body_vel, angvel, local)) / vel.w;
 }
 
+/// particles_update with MOTES_FLAG_ABSORB: the impulse a rigid particle hands its body: what the
+/// constraints did to it (particle_absorbed_impulse), or with MOTES_FLAG_PARTICLE_SHIFT the
+/// reaction of its position contacts with other kinds' particles that contacts_compute summed
+/// into ParticleForce (shared/particle_shift.h: rigid_contact_reaction).
+MOTES_FN vec3 particle_handed_impulse(vec4 vel, vec4 quat, vec4 body_vel, vec4 angvel, vec4 local,
+                                      vec4 force, uint flags) {
+  if ((flags & MOTES_FLAG_PARTICLE_SHIFT) != 0u) {
+    return xyz(force);
+  }
+  return particle_absorbed_impulse(vel, quat, body_vel, angvel, local);
+}
+
 MOTES_SHARED_END
 
 #endif  // MOTES_SHARED_BODY_MATH_H

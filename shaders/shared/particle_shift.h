@@ -63,6 +63,26 @@ MOTES_FN vec4 plane_contact_shift(vec3 xi, vec3 vi, float ri, float ni, vec4 nor
   return vec4(contact_shift(-np, overlap, vi * h, 1.0f / ni, law.friction), 1.0f);
 }
 
+/// A rigid body's particle in a position contact with a free, soft, cloth or rope particle j:
+/// the rigid particles do not move in the shift sweeps (their partners take the whole correction,
+/// particle_contact_shift with the rigid side's inverse mass 0), and the body takes the reaction,
+/// minus the momentum j gains: -shift / (w_j h), with the shift exactly as j computes it (law_j:
+/// j's row of the pair laws), and 1 in w when they overlap. A pinned j (w_j = 0) gives none.
+MOTES_FN vec4 rigid_contact_reaction(vec3 xi, vec3 vi, float ri, float ni, vec3 xj, vec3 vj,
+                                     float rj, float wj, float nj, ContactLaw law_j, float h) {
+  if (wj == 0.0f) {
+    return vec4(0.0f);
+  }
+  vec4 s = particle_contact_shift(xj, vj, rj, wj, nj, xi, vi, ri, 0.0f, ni, law_j, h);
+  return vec4(xyz(s) * (-1.0f / (wj * h)), s.w);
+}
+
+/// The inverse mass a partner j takes in particle_contact_shift: a rigid body's particle
+/// (j < rigid_count) does not move in the shift sweeps (rigid_contact_reaction), so 0.
+MOTES_FN float shift_partner_inverse_mass(uint j, uint rigid_count, float wj) {
+  return j < rigid_count ? 0.0f : wj;
+}
+
 /// A particle's contacts within reach for the shares above: its list's count and the planes.
 MOTES_FN float particle_shift_count(uint listed, uint planes) { return float(listed + planes); }
 

@@ -36,13 +36,21 @@ constexpr double kParticlesUpdateTolerance = 1.0e-10;
 class ParticlesUpdate : public DeviceTest {
  protected:
   /// `far`: one rigid particle's ref sits 0.6 skin away (a rebuild is due), the others 0.3.
-  void run_case(const std::string& layout, World w, bool far, bool absorb = false) {
+  /// `reactions`: with MOTES_FLAG_PARTICLE_SHIFT too, the impulses are the reactions of position
+  /// contacts given in ParticleForce (random here), their moments computed.
+  void run_case(const std::string& layout, World w, bool far, bool absorb = false,
+                bool reactions = false) {
     w.params.neighbour_skin = kTestSkin;
     std::vector<vec4> impulse_want, moment_want;
+    std::vector<vec4> force_in;
     if (absorb) {
       w.params.flags |= MOTES_FLAG_ABSORB;
       w.sizes.absorb = 1;
-      motes_ref::absorbed_impulses(w.bodies, w.particles, impulse_want, moment_want);
+      if (reactions) {
+        w.params.flags |= MOTES_FLAG_POSITION | MOTES_FLAG_PARTICLE_SHIFT;
+        force_in = random_forces(w.sizes.particles + 11u, w.particles.size(), 0.01f);
+      }
+      motes_ref::absorbed_impulses(w.bodies, w.particles, impulse_want, moment_want, force_in);
     }
     motes_ref::Particles want = w.particles;
     motes_ref::particles_update(w.bodies, want, w.params);
@@ -58,10 +66,18 @@ class ParticlesUpdate : public DeviceTest {
     const std::vector<uint> state_in = {0u, 7u, 3u, 5u};
 
     ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));
-    ASSERT_NO_FATAL_FAILURE(
-        poison_all_but({Buffer::ParticleBody, Buffer::ParticleLocal, Buffer::ParticlePos,
-                        Buffer::ParticleVel, Buffer::BodyPos, Buffer::BodyQuat, Buffer::BodyVel,
-                        Buffer::BodyAngVel, Buffer::NeighbourRefPos, Buffer::NeighbourState}));
+    if (reactions) {  // ParticleForce is read: the reactions
+      ASSERT_NO_FATAL_FAILURE(poison_all_but(
+          {Buffer::ParticleBody, Buffer::ParticleLocal, Buffer::ParticlePos, Buffer::ParticleVel,
+           Buffer::BodyPos, Buffer::BodyQuat, Buffer::BodyVel, Buffer::BodyAngVel,
+           Buffer::NeighbourRefPos, Buffer::NeighbourState, Buffer::ParticleForce}));
+      ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleForce, force_in));
+    } else {
+      ASSERT_NO_FATAL_FAILURE(
+          poison_all_but({Buffer::ParticleBody, Buffer::ParticleLocal, Buffer::ParticlePos,
+                          Buffer::ParticleVel, Buffer::BodyPos, Buffer::BodyQuat, Buffer::BodyVel,
+                          Buffer::BodyAngVel, Buffer::NeighbourRefPos, Buffer::NeighbourState}));
+    }
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleBody, w.particles.body));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleLocal, w.particles.local));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
@@ -122,6 +138,10 @@ TEST_P(ParticlesUpdate, Random1234Absorb) {
 }
 TEST_P(ParticlesUpdate, Random31AbsorbMoved) {
   run_case("absorb", random_world(67, 31), true, true);
+}
+TEST_P(ParticlesUpdate, Random1234Reactions) {
+  // Position contacts: each rigid particle hands its body the reaction in ParticleForce.
+  run_case("reactions", random_world(68, 1234), false, true, true);
 }
 
 INSTANTIATE_TEST_SUITE_P(Conformance, ParticlesUpdate, testing::ValuesIn(device_params()),

@@ -12,8 +12,8 @@
 //   particle moves 1% of a diameter (issue 27), no box drops a diameter.
 // - momentum: two spinning boxes collide without gravity; the total linear momentum is the same
 //   before and after to 1e-6 relative.
-// - a soft body with a dynamic rigid body in a scene of position contacts is refused with a message
-//   naming both (soft bodies, cloth and ropes: test_position_particles.cpp).
+// Soft bodies, cloth and ropes with position contacts, and with rigid bodies:
+// test_position_particles.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -379,23 +379,6 @@ TEST(PositionContact, CollisionWithoutGravityKeepsMomentum) {
   const Eigen::Vector3d p0 = motes_test::linear_momentum(*before);
   const Eigen::Vector3d p1 = motes_test::linear_momentum(*after);
   EXPECT_LT((p1 - p0).norm(), 1e-6 * p0.norm()) << p0.transpose() << " -> " << p1.transpose();
-}
-
-TEST(PositionContact, RefusesSoftBodiesWithDynamicRigidBodies) {
-  motes::Scene scene = position_scene(Eigen::Vector3d(0.0, -kG, 0.0), 0.0, 0.5);
-  auto box = motes_test::lattice(3, 3, 3, 0.01);
-  motes::BodySpec rigid = motes_test::body(box, Eigen::Vector3d(0.2, 0.1, 0.0));
-  rigid.name = "crate";
-  scene.bodies.push_back(rigid);
-  motes::BodySpec soft = motes_test::body(box, Eigen::Vector3d(0.0, 0.1, 0.0));
-  soft.name = "jelly";
-  soft.soft = motes::SoftSpec{};
-  scene.bodies.push_back(soft);
-  auto sim = motes_test::simulate(scene);
-  ASSERT_FALSE(sim);
-  EXPECT_NE(sim.status().message().find("dynamic rigid body \"crate\" and soft body \"jelly\""),
-            std::string::npos)
-      << sim.status().message();
 }
 
 }  // namespace

@@ -34,7 +34,13 @@ std::vector<vec4> contacts_compute(const Particles& particles, const std::vector
     };
     const float h = p.gravity_dt.w;
     const float ni = within_reach(i);
+    const bool positions = (p.flags & MOTES_FLAG_POSITION) != 0u;
+    const auto rigid = static_cast<uint>(particles.rigid);
+    // A rigid body's particle in a scene of rigid contacts without forces: its contacts with
+    // rigid particles and planes are impulses_compute's.
+    const bool by_impulse = motes::shared::impulse_particle(p.flags, uint(i), rigid);
     for (std::size_t j = 0; j < n; ++j) {
+      if (by_impulse && j < rigid) continue;
       const vec4 xj = particles.pos[j];
       // Apart along x by the radii's sum or more: particle_contact_term returns 0 (its float
       // dx * dx alone reaches rsum * rsum), which adds nothing.
@@ -42,9 +48,20 @@ std::vector<vec4> contacts_compute(const Particles& particles, const std::vector
       if (dx >= xi.w + xj.w || -dx >= xi.w + xj.w) continue;
       const vec4 vj = particles.vel[j];
       const ContactLaw law = laws[particles.material[i] * m + particles.material[j]];
+      // Position contacts: a rigid body's particle takes the reaction of its partner's shift, and
+      // a rigid partner does not move in the shift (shared/particle_shift.h).
       const vec4 f =
-          motes::shared::particle_contact_term(xyz(xi), xyz(vi), xi.w, vi.w, ni, xyz(xj), xyz(vj),
-                                               xj.w, vj.w, within_reach(j), law, p.flags, h);
+          !positions ? motes::shared::particle_contact_term(xyz(xi), xyz(vi), xi.w, vi.w, ni,
+                                                            xyz(xj), xyz(vj), xj.w, vj.w,
+                                                            within_reach(j), law, p.flags, h)
+          : i < rigid
+              ? motes::shared::rigid_contact_reaction(
+                    xyz(xi), xyz(vi), xi.w, ni, xyz(xj), xyz(vj), xj.w, vj.w, within_reach(j),
+                    laws[particles.material[j] * m + particles.material[i]], h)
+              : motes::shared::particle_contact_shift(
+                    xyz(xi), xyz(vi), xi.w, vi.w, ni, xyz(xj), xyz(vj), xj.w,
+                    motes::shared::shift_partner_inverse_mass(uint(j), rigid, vj.w),
+                    within_reach(j), law, h);
       // A zero term adds nothing (the sum starts at +0 and so is never -0): the exclusions, a set
       // lookup, are asked only of pairs that touch.
       if (f.x == 0.0f && f.y == 0.0f && f.z == 0.0f && f.w == 0.0f) continue;
@@ -54,7 +71,7 @@ std::vector<vec4> contacts_compute(const Particles& particles, const std::vector
       }
       add(f);
     }
-    for (std::size_t k = 0; k < p.plane_count; ++k) {
+    for (std::size_t k = 0; k < (by_impulse ? 0u : p.plane_count); ++k) {
       const ContactLaw law = laws[particles.material[i] * m + planes[k].material];
       add(motes::shared::plane_contact_term(xyz(xi), xyz(vi), xi.w, vi.w, ni,
                                             planes[k].normal_offset, law, p.flags, h));

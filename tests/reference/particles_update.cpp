@@ -32,13 +32,15 @@ bool particles_update(const Bodies& bodies, Particles& particles, const StepPara
 }
 
 void absorbed_impulses(const Bodies& bodies, const Particles& particles, std::vector<vec4>& impulse,
-                       std::vector<vec4>& moment) {
+                       std::vector<vec4>& moment, const std::vector<vec4>& reactions) {
   impulse.assign(particles.rigid, vec4(0.0f));
   moment.assign(particles.rigid, vec4(0.0f));
   for (std::size_t i = 0; i < particles.rigid; ++i) {
     const uint b = particles.body[i];
-    const vec3 j = motes::shared::particle_absorbed_impulse(
-        particles.vel[i], bodies.quat[b], bodies.vel[b], bodies.angvel[b], particles.local[i]);
+    const vec3 j = !reactions.empty() ? xyz(reactions[i])
+                                      : motes::shared::particle_absorbed_impulse(
+                                            particles.vel[i], bodies.quat[b], bodies.vel[b],
+                                            bodies.angvel[b], particles.local[i]);
     impulse[i] = vec4(j, 0.0f);
     const vec3 r = motes::shared::quat_rotate(bodies.quat[b], xyz(particles.local[i]));
     moment[i] = vec4(motes::shared::cross(r, j), 0.0f);

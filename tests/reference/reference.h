@@ -109,7 +109,10 @@ bool neighbours_update(const Particles& particles, const std::vector<uint>& stat
 /// is the most accurate sum of the float terms, not the device's canonical order. With
 /// MOTES_FLAG_POSITION the terms are shared::particle_contact_term's and plane_contact_term's
 /// shifts (h = p.gravity_dt.w; each particle's contacts within reach from `listed`, the lists'
-/// counts, and the planes) and w is their number (shared/particle_shift.h).
+/// counts, and the planes) and w is their number (shared/particle_shift.h): a rigid body's
+/// particle takes rigid_contact_reaction of its contacts with other kinds' particles, whose
+/// shifts take a rigid partner's inverse mass as 0. With MOTES_FLAG_IMPULSE a rigid body's particle
+/// skips rigid partners and the planes (impulse_particle).
 std::vector<vec4> contacts_compute(const Particles& particles, const std::vector<ContactLaw>& laws,
                                    const std::vector<PlaneData>& planes, const StepParams& p,
                                    const std::vector<uint>& listed = {});
@@ -134,10 +137,11 @@ bool particles_update(const Bodies& bodies, Particles& particles, const StepPara
                       const std::vector<vec4>& ref = {});
 
 /// particles_update's first part with MOTES_FLAG_ABSORB: for each rigid particle [0, Nr),
-/// shared::particle_absorbed_impulse of its velocity as it is (impulse, w = 0) and its moment
+/// shared::particle_absorbed_impulse of its velocity as it is (impulse, w = 0), or with
+/// `reactions` (MOTES_FLAG_PARTICLE_SHIFT: ParticleForce as given) their xyz, and its moment
 /// (R local) x impulse about the body's centre (moment, w = 0).
 void absorbed_impulses(const Bodies& bodies, const Particles& particles, std::vector<vec4>& impulse,
-                       std::vector<vec4>& moment);
+                       std::vector<vec4>& moment, const std::vector<vec4>& reactions = {});
 
 /// particles_check: the four MotionCheck words (shared/motion_check.h) over every particle, by
 /// the definitions: the largest rate bits of a finite particle, the first finite particle with

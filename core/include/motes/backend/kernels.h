@@ -111,8 +111,8 @@
      BodyVelPush, BodyAngMomPush),                                                               \
     (BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel))                                        \
   X(ParticlesUpdate, particles_update,                                                           \
-    (ParticlePos, ParticleVel, ParticleLocal, ParticleBody, BodyPos, BodyQuat, BodyVel,          \
-     BodyAngVel, NeighbourRefPos, NeighbourState),                                               \
+    (ParticlePos, ParticleVel, ParticleForce, ParticleLocal, ParticleBody, BodyPos, BodyQuat,    \
+     BodyVel, BodyAngVel, NeighbourRefPos, NeighbourState),                                      \
     (ParticlePos, ParticleVel, ParticleForce, ParticleMoment, NeighbourState))                   \
   X(ParticlesIntegrate, particles_integrate,                                                     \
     (ParticlePos, ParticleVel, ParticleForce, NeighbourRefPos, NeighbourState),                  \
