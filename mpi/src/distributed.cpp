@@ -424,6 +424,14 @@ void DistributedSimulation::group_bodies() {
       unite(first, b);
     }
   }
+  // With position contacts, everything: a step is a frame of many substeps, each of several Jacobi
+  // sweeps, and a particle's shift passes positions on to soft bodies, cloth, ropes and the rigid
+  // bodies they touch as far as the sweeps reach, beyond any halo a step's copies could have (a
+  // cloth split over two ranks differed from one process in its first frame): such a scene runs
+  // on one rank.
+  if (scene_.settings.contact_model == ContactModel::Positions) {
+    for (std::uint32_t b = 1; b < parent.size(); ++b) unite(0, b);
+  }
   // Bodies alone stay kAlone (most bodies of a large scene: no list each).
   std::vector<std::uint32_t> size(parent.size(), 0);
   for (std::uint32_t b = 0; b < parent.size(); ++b) ++size[find(b)];

@@ -49,9 +49,12 @@ for scene in "$src"/examples/scenes/*.json; do
   each="run $scene --backend openmp --steps $steps --every $every --format csv"
   # Runs over ranks drop the impulse and position contacts' memory at list builds
   # (docs/scale-out.md): one process the same, through the scene's impulse_memory_across_builds.
+  # (In a folder beside a link to the assets, for the scenes' relative mesh paths.)
   alone=$scene
   if grep -qE '"contact_model": "(impulse|position)"' "$scene"; then
-    alone=$work/$name-alone.json
+    mkdir -p "$work/scenes"
+    ln -sfn "$src/examples/assets" "$work/assets"
+    alone=$work/scenes/$name-alone.json
     sed -E 's/"contact_model": "(impulse|position)"/"contact_model": "\1", "impulse_memory_across_builds": false/' \
       "$scene" > "$alone"
   fi
