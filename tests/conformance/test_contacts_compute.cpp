@@ -144,11 +144,13 @@ TEST_P(ContactsCompute, MeshLinked1234) {
 }
 TEST_P(ContactsCompute, Positions1234) {
   // Position contacts: each particle's shifts and their number (shared/particle_shift.h).
-  run_case("positions", random_world(26, 1234, MOTES_FLAG_POSITION | MOTES_FLAG_IMPULSE, kTestSkin));
+  run_case("positions",
+           random_world(26, 1234, MOTES_FLAG_POSITION | MOTES_FLAG_IMPULSE, kTestSkin));
 }
 TEST_P(ContactsCompute, LinkedPositions1234) {
-  run_case("linked_positions",
-           with_linked(random_world(27, 1234, MOTES_FLAG_POSITION | MOTES_FLAG_IMPULSE, kTestSkin), 27));
+  run_case(
+      "linked_positions",
+      with_linked(random_world(27, 1234, MOTES_FLAG_POSITION | MOTES_FLAG_IMPULSE, kTestSkin), 27));
 }
 TEST_P(ContactsCompute, Random20000) {
   run_case("random_clamped", random_world(25, 20000, MOTES_FLAG_CLAMP_ATTRACTION, kTestSkin));
