@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -138,6 +139,57 @@ inline Eigen::Vector3d linear_momentum(const motes::Snapshot& s) {
   for (std::size_t b = 0; b < s.body_pos.size(); ++b) {
     const double inv_m = static_cast<double>(s.body_pos[b].w);
     if (inv_m != 0.0) p += to_vec3(s.body_vel[b]) / inv_m;
+  }
+  return p;
+}
+
+/// A chain of n links of length L hanging in a V between two pins `span` apart at height y.
+inline motes::LinkedSpec v_chain(int n, double link, double span, double y, double diameter) {
+  const double angle = std::acos(span / (n * link));
+  motes::LinkedSpec s;
+  s.name = "chain";
+  s.kind = motes::LinkedKind::Rope;
+  s.diameter = diameter;
+  Eigen::Vector3d x(0.0, y, 0.0);
+  for (int k = 0; k <= n; ++k) {
+    s.points.push_back(x);
+    s.lattice.push_back({static_cast<std::uint32_t>(k), 0u});
+    const double down = k < n / 2 ? -1.0 : 1.0;
+    x += Eigen::Vector3d(link * std::cos(angle), down * link * std::sin(angle), 0.0);
+  }
+  for (int k = 0; k < n; ++k) {
+    s.links.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k + 1), 1.0});
+  }
+  s.pinned = {0u, static_cast<std::uint32_t>(n)};
+  return s;
+}
+
+/// Sag of the exact discrete catenary: n links of length L, n - 1 equal interior masses, pins
+/// `span` apart at one height (n even: the lowest point is node n / 2).
+inline double catenary_sag(int n, double link, double span) {
+  const auto span_for = [&](double h) {  // h = H / (m g)
+    double s = 0.0;
+    for (int k = 1; k <= n; ++k) s += link * std::cos(std::atan((n + 1 - 2 * k) / (2.0 * h)));
+    return s;
+  };
+  double lo = 1e-9, hi = 1e9;
+  for (int it = 0; it < 200; ++it) {
+    const double mid = std::sqrt(lo * hi);
+    (span_for(mid) < span ? lo : hi) = mid;
+  }
+  const double h = std::sqrt(lo * hi);
+  double sag = 0.0;
+  for (int k = 1; k <= n / 2; ++k) sag += link * std::sin(std::atan((n + 1 - 2 * k) / (2.0 * h)));
+  return sag;
+}
+
+/// Total linear momentum of the particles [first, N) that can move (soft bodies, cloth, ropes):
+/// sum of m v; with linear_momentum, the momentum of a scene's every moving part.
+inline Eigen::Vector3d particle_momentum(const motes::Snapshot& s, std::size_t first) {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  for (std::size_t i = first; i < s.particle_vel.size(); ++i) {
+    const double inv_m = static_cast<double>(s.particle_vel[i].w);
+    if (inv_m != 0.0) p += to_vec3(s.particle_vel[i]) / inv_m;
   }
   return p;
 }

