@@ -55,9 +55,10 @@ void main() {
       vec4 pj = particle_pos[j];
       vec4 vj = particle_vel[j];
       f += shifts ? shift_term(i, j, xi, ui, vi.w, pi.w, ni, pj, vj)
-                  : particle_contact_term(xi, ui, pi.w, vi.w, 0.0f, xyz(pj), xyz(vj), pj.w, vj.w,
-                                          0.0f, contact_laws[law_base + particle_material[j]],
-                                          p.flags, p.gravity_dt.w);
+                  : vec4(particle_contact_force(xi, ui, pi.w, vi.w, xyz(pj), xyz(vj), pj.w, vj.w,
+                                                contact_laws[law_base + particle_material[j]],
+                                                p.flags),
+                         0.0f);
     }
   } else {
     uint body_i = particle_body[i];
@@ -72,10 +73,10 @@ void main() {
         vec4 pj = particle_pos[j];
         vec4 vj = particle_vel[j];
         f += shifts ? shift_term(i, j, xi, ui, vi.w, pi.w, ni, pj, vj)
-                    : particle_contact_term(xi, ui, pi.w, vi.w, 0.0f, xyz(pj), xyz(vj), pj.w,
-                                            vj.w, 0.0f,
-                                            contact_laws[law_base + particle_material[j]], p.flags,
-                                            p.gravity_dt.w);
+                    : vec4(particle_contact_force(xi, ui, pi.w, vi.w, xyz(pj), xyz(vj), pj.w, vj.w,
+                                                contact_laws[law_base + particle_material[j]],
+                                                p.flags),
+                         0.0f);
       }
     }
   }

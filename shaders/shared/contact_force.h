@@ -67,20 +67,11 @@ MOTES_FN vec3 plane_contact_force(vec3 xi, vec3 vi, float ri, float inv_mi, vec4
   return contact_law_force(-np, overlap, -vi, 1.0f / inv_mi, law, flags);
 }
 
-/// contacts_compute's term for particle i's contact with particle j: the force (w = 0), or with
-/// MOTES_FLAG_POSITION the shift it asks and 1 when they overlap (shared/particle_shift.h; h: the
-/// substep; ni, nj: the particles' contacts within reach, particle_shift_count). Summed in the same
-/// order either way.
-MOTES_FN vec4 particle_contact_term(vec3 xi, vec3 vi, float ri, float inv_mi, float ni, vec3 xj,
-                                    vec3 vj, float rj, float inv_mj, float nj, ContactLaw law,
-                                    uint flags, float h) {
-  if ((flags & MOTES_FLAG_POSITION) != 0u) {
-    return particle_contact_shift(xi, vi, ri, inv_mi, ni, xj, vj, rj, inv_mj, nj, law, h);
-  }
-  return vec4(particle_contact_force(xi, vi, ri, inv_mi, xj, vj, rj, inv_mj, law, flags), 0.0f);
-}
-
-/// The same for a static plane.
+/// contacts_compute's term for particle i's contact with a static plane: the force (w = 0), or
+/// with MOTES_FLAG_POSITION the shift it asks and 1 when they overlap (shared/particle_shift.h; h:
+/// the substep; ni: i's contacts within reach, particle_shift_count). A particle's contact with
+/// another particle takes particle_contact_force, or particle_contact_shift with the partner's
+/// inverse mass from shift_partner_inverse_mass, or rigid_contact_reaction (the backends choose).
 MOTES_FN vec4 plane_contact_term(vec3 xi, vec3 vi, float ri, float inv_mi, float ni,
                                  vec4 normal_offset, ContactLaw law, uint flags, float h) {
   if ((flags & MOTES_FLAG_POSITION) != 0u) {

@@ -42,7 +42,7 @@ std::vector<vec4> contacts_compute(const Particles& particles, const std::vector
     for (std::size_t j = 0; j < n; ++j) {
       if (by_impulse && j < rigid) continue;
       const vec4 xj = particles.pos[j];
-      // Apart along x by the radii's sum or more: particle_contact_term returns 0 (its float
+      // Apart along x by the radii's sum or more: the term is 0 (its float
       // dx * dx alone reaches rsum * rsum), which adds nothing.
       const float dx = xj.x - xi.x;
       if (dx >= xi.w + xj.w || -dx >= xi.w + xj.w) continue;
@@ -51,9 +51,10 @@ std::vector<vec4> contacts_compute(const Particles& particles, const std::vector
       // Position contacts: a rigid body's particle takes the reaction of its partner's shift, and
       // a rigid partner does not move in the shift (shared/particle_shift.h).
       const vec4 f =
-          !positions ? motes::shared::particle_contact_term(xyz(xi), xyz(vi), xi.w, vi.w, ni,
-                                                            xyz(xj), xyz(vj), xj.w, vj.w,
-                                                            within_reach(j), law, p.flags, h)
+          !positions
+              ? vec4(motes::shared::particle_contact_force(xyz(xi), xyz(vi), xi.w, vi.w, xyz(xj),
+                                                           xyz(vj), xj.w, vj.w, law, p.flags),
+                     0.0f)
           : i < rigid
               ? motes::shared::rigid_contact_reaction(
                     xyz(xi), xyz(vi), xi.w, ni, xyz(xj), xyz(vj), xj.w, vj.w, within_reach(j),

@@ -107,7 +107,7 @@ bool neighbours_update(const Particles& particles, const std::vector<uint>& stat
 /// laws[material_i * M + plane.material]. Static particles (vel.w == 0) get 0. Indexed by
 /// particle id; w = 0. Terms are summed in double, in id order, then rounded once to float: this
 /// is the most accurate sum of the float terms, not the device's canonical order. With
-/// MOTES_FLAG_POSITION the terms are shared::particle_contact_term's and plane_contact_term's
+/// MOTES_FLAG_POSITION the terms are shared::particle_contact_shift's and plane_contact_term's
 /// shifts (h = p.gravity_dt.w; each particle's contacts within reach from `listed`, the lists'
 /// counts, and the planes) and w is their number (shared/particle_shift.h): a rigid body's
 /// particle takes rigid_contact_reaction of its contacts with other kinds' particles, whose
