@@ -5,8 +5,9 @@
 // same order), then the planes, and writes only its own impulse, count and moment
 // (shared/impulse.h). Each pair is evaluated lower id first, so the two particles of a contact get
 // bitwise opposite impulses; each keeps the contact's accumulated impulse in its own slot of
-// ContactImpulse (valid while ImpulseStamp matches the lists' build). As
-// backends/openmp/impulses_compute.cpp.
+// ContactImpulse (valid while ImpulseStamp matches the lists' build; a correcting sweep of split
+// impulses, MOTES_FLAG_IMPULSE_SPLIT, in ContactImpulseSplit, which the last relaxing sweep,
+// MOTES_FLAG_IMPULSE_PUSH, fills too). As backends/openmp/impulses_compute.cpp.
 #extension GL_GOOGLE_include_directive : require
 #include "kernel_common.glsl"
 #include "shared/grid_hash.h"
@@ -16,6 +17,23 @@
 ImpulseBody impulse_body(uint b) {
   return impulse_body_of(body_pos[b], body_quat[b], body_inv_inertia[b], body_vel[b],
                          body_angvel[b], body_vel_start[b], body_angvel_start[b], p.flags);
+}
+
+/// The accumulated impulse of a slot as this pass keeps them (ContactImpulseSplit for a correcting
+/// sweep of split impulses).
+vec4 acc_read(uint slot) {
+  return (p.flags & MOTES_FLAG_IMPULSE_SPLIT) != 0u ? contact_impulse_split[slot]
+                                                    : contact_impulse_acc[slot];
+}
+
+/// Writes it there (and, for the last relaxing sweep, to ContactImpulseSplit too).
+void acc_write(uint slot, vec4 a) {
+  if ((p.flags & MOTES_FLAG_IMPULSE_SPLIT) != 0u) {
+    contact_impulse_split[slot] = a;
+    return;
+  }
+  contact_impulse_acc[slot] = a;
+  if ((p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u) contact_impulse_split[slot] = a;
 }
 
 void main() {
@@ -46,14 +64,14 @@ void main() {
       uint slot = k * nr + i;
       bool valid = !counting ||
                    impulse_slots_valid(own_stamp, impulse_stamp[j], particle_vel[j].w, builds);
-      vec4 a = slotted && valid ? contact_impulse_acc[slot] : vec4(0.0f);
+      vec4 a = slotted && valid ? acc_read(slot) : vec4(0.0f);
       vec4 xj = particle_pos[j];
       vec4 r = pair_impulse(own, xi, impulse_body(particle_body[j]), xj, i < j, margin,
                             contact_laws[pair_law_index(i, particle_material[i], j,
                                                          particle_material[j],
                                                          p.material_count)],
                             p.gravity_dt, p.flags, a);
-      if (slotted) contact_impulse_acc[slot] = a;
+      if (slotted) acc_write(slot, a);
       impulse_add(sum, moment_sum, r, contact_acting_point(pair_contact_point(xi, xj), xi, p.flags),
                   own.com);
     }
@@ -81,10 +99,10 @@ void main() {
   for (uint k = 0u; k < p.plane_count; ++k) {
     PlaneData pl = planes[k];
     uint slot = (p.neighbour_capacity + k) * nr + i;
-    vec4 a = contact_impulse_acc[slot];
+    vec4 a = acc_read(slot);
     vec4 r = plane_contact_impulse(own, xi, pl.normal_offset, margin,
                                    contact_laws[law_base + pl.material], p.gravity_dt, p.flags, a);
-    contact_impulse_acc[slot] = a;
+    acc_write(slot, a);
     impulse_add(sum, moment_sum, r,
                 contact_acting_point(plane_contact_point(xi, pl.normal_offset), xi, p.flags),
                 own.com);

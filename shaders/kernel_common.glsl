@@ -53,6 +53,9 @@ layout(std430, binding = B_PARTICLE_MOMENT) buffer ParticleMomentBuf { vec4 part
 layout(std430, binding = B_BODY_VEL_START) buffer BodyVelStartBuf { vec4 body_vel_start[]; };
 layout(std430, binding = B_BODY_ANGVEL_START) buffer BodyAngVelStartBuf { vec4 body_angvel_start[]; };
 layout(std430, binding = B_CONTACT_IMPULSE) buffer ContactImpulseBuf { vec4 contact_impulse_acc[]; };
+layout(std430, binding = B_CONTACT_IMPULSE_SPLIT) buffer ContactImpulseSplitBuf {
+  vec4 contact_impulse_split[];
+};
 layout(std430, binding = B_IMPULSE_STAMP) buffer ImpulseStampBuf { uint impulse_stamp[]; };
 layout(std430, binding = B_MOTION_CHECK) buffer MotionCheckBuf { uint motion_check[]; };
 layout(std430, binding = B_LINK_EXCLUSIONS) readonly buffer LinkExclusionsBuf { uint link_exclusions[]; };

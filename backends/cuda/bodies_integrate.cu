@@ -1,5 +1,7 @@
 // bodies_integrate: one semi-implicit Euler step of every body (shared/body_math.h); with
-// MOTES_FLAG_IMPULSE_PUSH the pose moves with BodyVelPush and BodyAngMomPush (body_push_pose).
+// MOTES_FLAG_IMPULSE_PUSH the pose moves with BodyVelPush and BodyAngMomPush (body_push_pose);
+// with MOTES_FLAG_IMPULSE_SPLIT with the body's velocities, which then take the push copies
+// (body_split_pose).
 #include "body_passes.cuh"
 #include "cuda_device.h"
 
@@ -28,10 +30,36 @@ __global__ void bodies_push_pose_kernel(shared::StepParams p, BodyBuffers d,
   d.angvel[b] = angvel;
 }
 
+__global__ void bodies_split_pose_kernel(shared::StepParams p, BodyBuffers d,
+                                         const shared::vec4* __restrict__ vel_push,
+                                         const shared::vec4* __restrict__ angmom_push) {
+  const std::uint64_t t = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
+  if (t >= p.body_count) return;
+  const auto b = static_cast<shared::uint>(t);
+  shared::vec4 pos = d.body_pos[b];
+  shared::vec4 quat = d.quat[b];
+  shared::vec4 vel = d.body_vel[b];
+  shared::vec4 angmom = d.angmom[b];
+  shared::vec4 angvel;
+  shared::body_split_pose(pos, quat, vel, angmom, angvel, d.inv_inertia[b], vel_push[b],
+                          angmom_push[b], p.gravity_dt);
+  d.body_pos[b] = pos;
+  d.quat[b] = quat;
+  d.body_vel[b] = vel;
+  d.angmom[b] = angmom;
+  d.angvel[b] = angvel;
+}
+
 }  // namespace
 
 void CudaDevice::launch_bodies_integrate(const shared::StepParams& p) {
   if (p.body_count == 0) return;
+  if ((p.flags & MOTES_FLAG_IMPULSE_SPLIT) != 0u) {
+    bodies_split_pose_kernel<<<blocks_for(p.body_count), kBlock, 0, stream_>>>(
+        p, body_buffers(), buf<shared::vec4>(Buffer::BodyVelPush),
+        buf<shared::vec4>(Buffer::BodyAngMomPush));
+    return;
+  }
   if ((p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u) {
     bodies_push_pose_kernel<<<blocks_for(p.body_count), kBlock, 0, stream_>>>(
         p, body_buffers(), buf<shared::vec4>(Buffer::BodyVelPush),

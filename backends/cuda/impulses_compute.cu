@@ -4,8 +4,10 @@
 // same order), then the planes, and writes only its own impulse, count and moment
 // (shared/impulse.h). Each pair is evaluated lower id first, so the two particles of a contact get
 // bitwise opposite impulses; each keeps the contact's accumulated impulse in its own slot of
-// ContactImpulse (valid while ImpulseStamp matches the lists' build). As
-// backends/openmp/impulses_compute.cpp and shaders/impulses_compute.comp.
+// ContactImpulse (valid while ImpulseStamp matches the lists' build; a correcting sweep of split
+// impulses, MOTES_FLAG_IMPULSE_SPLIT, in ContactImpulseSplit, which the last relaxing sweep,
+// MOTES_FLAG_IMPULSE_PUSH, fills too). As backends/openmp/impulses_compute.cpp and
+// shaders/impulses_compute.comp.
 #include "cuda_device.h"
 #include "shared/grid_walk.h"
 #include "shared/impulse.h"
@@ -40,7 +42,8 @@ __device__ shared::ImpulseBody impulse_body(const ImpulseInputs& in, uint b, uin
 
 __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
                                         vec4* __restrict__ impulse, vec4* __restrict__ moment,
-                                        vec4* __restrict__ acc, const uint* __restrict__ stamp) {
+                                        vec4* __restrict__ acc_main, vec4* __restrict__ acc_split,
+                                        const uint* __restrict__ stamp) {
   const std::uint64_t t = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
   if (t >= p.rigid_particle_count) return;
   const auto i = static_cast<uint>(t);
@@ -58,6 +61,9 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
   const bool counting = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
   const uint own_stamp = stamp[i];
   const std::size_t nr = p.rigid_particle_count;
+  // The accumulated impulses this pass reads and writes, and where it copies them.
+  vec4* const acc = (p.flags & MOTES_FLAG_IMPULSE_SPLIT) != 0u ? acc_split : acc_main;
+  vec4* const copy = (p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u ? acc_split : nullptr;
   vec4 sum(0.0f);
   vec3 moment_sum(0.0f);
   // The impulse of the contact with particle j (rigid particles only), added in order; its
@@ -73,7 +79,10 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
         own, xi, other, xj, i < j, margin,
         in.laws[shared::pair_law_index(i, in.material[i], j, in.material[j], p.material_count)],
         p.gravity_dt, p.flags, a);
-    if (slot != nullptr) *slot = a;
+    if (slot != nullptr) {
+      *slot = a;
+      if (copy != nullptr) copy[slot - acc] = a;
+    }
     shared::impulse_add(
         sum, moment_sum, r,
         shared::contact_acting_point(shared::pair_contact_point(xi, xj), xi, p.flags), own.com);
@@ -96,9 +105,11 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
   }
   for (uint k = 0; k < p.plane_count; ++k) {
     const shared::PlaneData pl = in.planes[k];
-    vec4& a = acc[(std::size_t{p.neighbour_capacity} + k) * nr + i];
+    const std::size_t at = (std::size_t{p.neighbour_capacity} + k) * nr + i;
+    vec4& a = acc[at];
     const vec4 r = shared::plane_contact_impulse(own, xi, pl.normal_offset, margin,
                                                  law_row[pl.material], p.gravity_dt, p.flags, a);
+    if (copy != nullptr) copy[at] = a;
     shared::impulse_add(sum, moment_sum, r,
                         shared::contact_acting_point(
                             shared::plane_contact_point(xi, pl.normal_offset), xi, p.flags),
@@ -123,7 +134,8 @@ void CudaDevice::launch_impulses_compute(const shared::StepParams& p) {
                          buf<uint>(Buffer::NeighbourState)};
   impulses_compute_kernel<<<blocks_for(p.rigid_particle_count), kBlock, 0, stream_>>>(
       p, in, buf<vec4>(Buffer::ParticleForce), buf<vec4>(Buffer::ParticleMoment),
-      buf<vec4>(Buffer::ContactImpulse), buf<uint>(Buffer::ImpulseStamp));
+      buf<vec4>(Buffer::ContactImpulse), buf<vec4>(Buffer::ContactImpulseSplit),
+      buf<uint>(Buffer::ImpulseStamp));
 }
 
 }  // namespace motes::cuda

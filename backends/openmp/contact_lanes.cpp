@@ -125,10 +125,14 @@ void contact_block_velocities(ContactBlock& k, const float* const vel[6]) {
 }
 
 void contact_block_solve(ContactBlock& k, uint flags) {
-  // contact_solve reads only these two flags.
-  switch (flags & (MOTES_FLAG_IMPULSE_COUNT | MOTES_FLAG_IMPULSE_RELAX)) {
+  // contact_solve reads only these three flags.
+  switch (flags &
+          (MOTES_FLAG_IMPULSE_COUNT | MOTES_FLAG_IMPULSE_RELAX | MOTES_FLAG_IMPULSE_SPLIT)) {
     case 0u:
       solve_lanes<0u>(k);
+      break;
+    case MOTES_FLAG_IMPULSE_SPLIT:
+      solve_lanes<MOTES_FLAG_IMPULSE_SPLIT>(k);
       break;
     case MOTES_FLAG_IMPULSE_RELAX:
       solve_lanes<MOTES_FLAG_IMPULSE_RELAX>(k);

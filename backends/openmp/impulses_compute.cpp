@@ -40,7 +40,16 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
   const vec4* angvel0 = buf<vec4>(Buffer::BodyAngVelStart);
   vec4* impulse = buf<vec4>(Buffer::ParticleForce);
   vec4* moment = buf<vec4>(Buffer::ParticleMoment);
-  vec4* acc = buf<vec4>(Buffer::ContactImpulse);
+  // The accumulated impulses this pass reads and writes (a correcting sweep of split impulses:
+  // ContactImpulseSplit), and where it copies them (the last relaxing sweep).
+  vec4* acc = buf<vec4>((p.flags & MOTES_FLAG_IMPULSE_SPLIT) != 0u ? Buffer::ContactImpulseSplit
+                                                                   : Buffer::ContactImpulse);
+  vec4* copy =
+      (p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u ? buf<vec4>(Buffer::ContactImpulseSplit) : nullptr;
+  const auto keep = [acc, copy](std::size_t at, const vec4& a) {
+    acc[at] = a;
+    if (copy != nullptr) copy[at] = a;
+  };
   uint* stamp = buf<uint>(Buffer::ImpulseStamp);
   const uint builds = buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_BUILDS];
   const bool counting = (p.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
@@ -117,8 +126,8 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
           own, xi, impulse_body(in.body[j]), in.pos[j], uint(i) < j, margin,
           in.laws[shared::pair_law_index(uint(i), in.material[i], j, in.material[j], materials)],
           p.gravity_dt, p.flags, a);
-      acc[at] = a;
-      acc[other_at] = a;
+      keep(at, a);
+      keep(other_at, a);
       pair_r[at] = r;
       pair_r[other_at] = vec4(-r.x, -r.y, -r.z, r.w);  // j's side, as pair_impulse gives it
     }
@@ -190,7 +199,7 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
           own, xi, other, xj, static_cast<uint>(i) < j, margin,
           in.laws[shared::pair_law_index(uint(i), in.material[i], j, in.material[j], materials)],
           p.gravity_dt, p.flags, a);
-      if (slot != nullptr) *slot = a;
+      if (slot != nullptr) keep(std::size_t(slot - acc), a);
       shared::impulse_add(
           sum, moment_sum, r,
           shared::contact_acting_point(shared::pair_contact_point(xi, xj), xi, p.flags), own.com);
@@ -216,9 +225,11 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     }
     for (uint k = 0; k < p.plane_count; ++k) {
       const shared::PlaneData pl = in.planes[k];
-      vec4& a = acc[(std::size_t{capacity} + k) * nr + std::size_t(i)];
+      const std::size_t at = (std::size_t{capacity} + k) * nr + std::size_t(i);
+      vec4 a = acc[at];
       const vec4 r = shared::plane_contact_impulse(own, xi, pl.normal_offset, margin,
                                                    law_row[pl.material], p.gravity_dt, p.flags, a);
+      keep(at, a);
       shared::impulse_add(sum, moment_sum, r,
                           shared::contact_acting_point(
                               shared::plane_contact_point(xi, pl.normal_offset), xi, p.flags),

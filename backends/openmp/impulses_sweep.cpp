@@ -38,7 +38,10 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
   const ContactInputs in = contact_inputs();
   const uint* stamp = buf<uint>(Buffer::ImpulseStamp);
   const uint builds = buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_BUILDS];
-  vec4* acc = buf<vec4>(Buffer::ContactImpulse);
+  // A correcting sweep of split impulses starts from ContactImpulseSplit (impulses_compute).
+  vec4* acc = buf<vec4>(!counting && (p.flags & MOTES_FLAG_IMPULSE_SPLIT) != 0u
+                            ? Buffer::ContactImpulseSplit
+                            : Buffer::ContactImpulse);
   const uint wall = p.body_count;
   const shared::ImpulseBody* bodies = impulse_bodies_.data();
   vec4* impulse = buf<vec4>(Buffer::ParticleForce);
@@ -239,6 +242,12 @@ void OpenMPDevice::impulse_contacts_solve(const shared::StepParams& p) {
     contact_block_solve(blk, p.flags);
   };
   impulse_acc_pending_ = true;
+  impulse_acc_into_ = AccInto::Main;
+  if ((p.flags & MOTES_FLAG_IMPULSE_SPLIT) != 0u) {
+    impulse_acc_into_ = AccInto::Split;
+  } else if ((p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u) {
+    impulse_acc_into_ = AccInto::Both;
+  }
   // Each active particle sums its contacts' results in order.
   const auto add = [&](std::int64_t a) {
     vec4 sum(0.0f);
@@ -265,6 +274,7 @@ void OpenMPDevice::impulse_contacts_solve(const shared::StepParams& p) {
   if (!parallel(contacts * 2)) {
     for (std::int64_t k = 0; k < blocks; ++k) pass(k);
     for (std::int64_t a = 0; a < active; ++a) add(a);
+    impulse_acc_keep_relaxed();
     return;
   }
 #pragma omp parallel num_threads(team_)
@@ -274,18 +284,39 @@ void OpenMPDevice::impulse_contacts_solve(const shared::StepParams& p) {
 #pragma omp for schedule(static)
     for (std::int64_t a = 0; a < active; ++a) add(a);
   }
+  impulse_acc_keep_relaxed();
+}
+
+void OpenMPDevice::impulse_acc_keep_relaxed() {
+  // The last relaxing sweep of split impulses: its accumulated impulses are ContactImpulse's at
+  // the substep's end, whatever the correcting sweeps after it do in the lanes.
+  if (impulse_acc_into_ != AccInto::Both) return;
+  impulse_acc_relaxed_.resize(impulse_contacts_.size());
+  for (std::size_t c = 0; c < impulse_contacts_.size(); ++c) {
+    impulse_acc_relaxed_[c] =
+        contact_lane_vec4(impulse_blocks_[c / kContactLanes].acc, int(c % kContactLanes));
+  }
+  impulse_acc_relaxed_pending_ = true;
 }
 
 void OpenMPDevice::impulse_acc_flush() {
   if (!impulse_acc_pending_) return;
   impulse_acc_pending_ = false;
-  vec4* acc = buf<vec4>(Buffer::ContactImpulse);
+  vec4* main = buf<vec4>(Buffer::ContactImpulse);
+  vec4* split = buf<vec4>(Buffer::ContactImpulseSplit);
+  const bool relaxed = impulse_acc_relaxed_pending_ && impulse_acc_into_ == AccInto::Split;
+  impulse_acc_relaxed_pending_ = false;
+  const auto put = [](vec4* acc, const ImpulseContact& ct, const vec4& a) {
+    if (ct.slot != kNone) acc[ct.slot] = a;
+    if (ct.mirror != kNone) acc[ct.mirror] = a;
+  };
   for (std::size_t c = 0; c < impulse_contacts_.size(); ++c) {
     const ImpulseContact& ct = impulse_contacts_[c];
     const vec4 a =
         contact_lane_vec4(impulse_blocks_[c / kContactLanes].acc, int(c % kContactLanes));
-    if (ct.slot != kNone) acc[ct.slot] = a;
-    if (ct.mirror != kNone) acc[ct.mirror] = a;
+    if (impulse_acc_into_ != AccInto::Split) put(main, ct, a);
+    if (impulse_acc_into_ != AccInto::Main) put(split, ct, a);
+    if (relaxed) put(main, ct, impulse_acc_relaxed_[c]);
   }
 }
 

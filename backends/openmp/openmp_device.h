@@ -162,7 +162,16 @@ class OpenMPDevice final : public Device {
   std::vector<ContactBlock> impulse_blocks_;
   bool impulse_contacts_ready_ = false, impulse_responses_ready_ = false;
   bool impulse_acc_pending_ = false;
+  /// Where the lanes' accumulated impulses go back to (split impulses, MOTES_FLAG_IMPULSE_SPLIT):
+  /// ContactImpulse, both it and ContactImpulseSplit (after the last relaxing sweep), or
+  /// ContactImpulseSplit (after a correcting sweep; ContactImpulse then takes the relaxed ones
+  /// kept in impulse_acc_relaxed_ when impulse_acc_relaxed_pending_).
+  enum class AccInto : std::uint8_t { Main, Both, Split };
+  AccInto impulse_acc_into_ = AccInto::Main;
+  std::vector<shared::vec4> impulse_acc_relaxed_;
+  bool impulse_acc_relaxed_pending_ = false;
   void impulse_acc_flush();
+  void impulse_acc_keep_relaxed();
   /// Drops what the last counting pass found (after allocate, or a write of positions or lists):
   /// the next sweep without a counting pass visits every particle.
   void forget_impulse_passes();

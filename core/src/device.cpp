@@ -91,6 +91,8 @@ const char* buffer_name(Buffer b) {
       return "BodyAngVelStart";
     case Buffer::ContactImpulse:
       return "ContactImpulse";
+    case Buffer::ContactImpulseSplit:
+      return "ContactImpulseSplit";
     case Buffer::ImpulseStamp:
       return "ImpulseStamp";
     case Buffer::MotionCheck:
@@ -230,6 +232,7 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
     case Buffer::BodyAngMomPush:
       return {kVec4, s.impulse != 0 ? std::size_t{s.bodies} : 0};
     case Buffer::ContactImpulse:
+    case Buffer::ContactImpulseSplit:
       return {kVec4, s.impulse != 0 ? (std::size_t{s.neighbour_capacity} + s.planes) *
                                           std::size_t{s.rigid_particles}
                                     : 0};

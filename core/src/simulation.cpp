@@ -296,41 +296,45 @@ void Simulation::step_impulses() {
   // Forces (soft bodies, cloth, ropes) are summed once; then the impulse stage runs its own
   // substeps on the contacts the lists hold (docs/architecture.md, "Impulse contacts"). Each:
   // gravity and forces into the velocities; the counting pass (every contact in reach counted,
-  // the start velocities kept, the warm start applied); sweeps with position correction, the
-  // velocities they leave kept for the pose; relaxing sweeps without it, whose velocities the
-  // bodies keep; the pose; the particles follow.
+  // the start velocities kept, the warm start applied); relaxing sweeps without position
+  // correction, whose velocities and accumulated impulses the bodies and contacts keep; sweeps
+  // with it on copies of those (split impulses), whose velocities move the pose; the pose; the
+  // particles follow.
   Device& d = *device_;
   const int substeps = settings_.impulse_substeps;
   const int sweeps = (settings_.impulse_iterations + substeps - 1) / substeps;
-  // The first half of the sweeps with the position correction, the rest without it: the
-  // velocities the bodies keep converge further and carry no push-out speed (docs/architecture.md,
-  // "Impulse contacts").
-  const int correcting = (sweeps + 1) / 2;
-  const int relaxing = sweeps - correcting;
+  // Half the sweeps (rounded up) relax, the rest correct, on copies: the velocities and warm
+  // starts the bodies keep never see the push out of an overlap (docs/architecture.md, "Impulse
+  // contacts"). One sweep a substep corrects and keeps what it leaves.
+  const bool split = sweeps >= 2;
+  const int relaxing = split ? (sweeps + 1) / 2 : 0;
+  const int correcting = sweeps - relaxing;
   shared::StepParams sub = params_;
   sub.gravity_dt.w = params_.gravity_dt.w / static_cast<float>(substeps);
   shared::StepParams velocity = sub;
   velocity.flags |= MOTES_FLAG_BODY_VELOCITY;
   shared::StepParams count = sub;
   count.flags |= MOTES_FLAG_IMPULSE_COUNT;
-  shared::StepParams last = sub;  // the last correcting sweep keeps its velocities for the pose
-  if (relaxing > 0) last.flags |= MOTES_FLAG_IMPULSE_PUSH;
   shared::StepParams relax = sub;
   relax.flags |= MOTES_FLAG_IMPULSE_RELAX;
-  shared::StepParams pose = last;
+  shared::StepParams last = relax;  // the last relaxing sweep keeps its velocities and impulses
+  last.flags |= MOTES_FLAG_IMPULSE_PUSH;
+  shared::StepParams correct = sub;
+  if (split) correct.flags |= MOTES_FLAG_IMPULSE_SPLIT;
+  shared::StepParams pose = correct;
   pose.flags |= MOTES_FLAG_BODY_POSE;
   d.enqueue(Kernel::BodiesReduce, params_);
   for (int s = 0; s < substeps; ++s) {
     d.enqueue(Kernel::BodiesIntegrate, velocity);
     d.enqueue(Kernel::ImpulsesCompute, count);
     d.enqueue(Kernel::ImpulsesApply, count);
-    for (int it = 0; it < correcting; ++it) {
-      d.enqueue(Kernel::ImpulsesCompute, sub);
-      d.enqueue(Kernel::ImpulsesApply, it + 1 == correcting ? last : sub);
-    }
     for (int it = 0; it < relaxing; ++it) {
-      d.enqueue(Kernel::ImpulsesCompute, relax);
-      d.enqueue(Kernel::ImpulsesApply, relax);
+      d.enqueue(Kernel::ImpulsesCompute, it + 1 == relaxing ? last : relax);
+      d.enqueue(Kernel::ImpulsesApply, it + 1 == relaxing ? last : relax);
+    }
+    for (int it = 0; it < correcting; ++it) {
+      d.enqueue(Kernel::ImpulsesCompute, correct);
+      d.enqueue(Kernel::ImpulsesApply, correct);
     }
     d.enqueue(Kernel::BodiesIntegrate, pose);
     d.enqueue(Kernel::ParticlesUpdate, sub);

@@ -78,6 +78,20 @@ MOTES_FN void body_push_pose(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
                               : vec4(body_angular_velocity(quat, inv_inertia, xyz(angmom)), 0.0f);
 }
 
+/// Split impulses' pose (MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_SPLIT): the body moves with
+/// the velocities it has (those the correcting sweeps left) and then keeps vel_push and
+/// angmom_push (those the relaxing sweeps left, which never saw the position correction).
+MOTES_FN void body_split_pose(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
+                              MOTES_INOUT(vec4) vel, MOTES_INOUT(vec4) angmom,
+                              MOTES_OUT(vec4) angvel, vec4 inv_inertia, vec4 vel_push,
+                              vec4 angmom_push, vec4 gravity_dt) {
+  vec4 v = vel;
+  vec4 l = angmom;
+  vel = vel_push;
+  angmom = angmom_push;
+  body_push_pose(pos_invm, quat, angvel, inv_inertia, angmom, v, l, gravity_dt);
+}
+
 /// One semi-implicit Euler step of a free particle (a one-particle body that does not spin), the
 /// linear half of body_integrate with the same arithmetic: v += dt (F/m + g); x += dt v.
 /// Static particles (vel.w, the inverse mass, == 0) are left untouched.

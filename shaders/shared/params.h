@@ -32,8 +32,9 @@ MOTES_SHARED_BEGIN
 #define MOTES_FLAG_SKIN_CHECK 64u
 /// impulses_compute: a relaxing sweep (shared/impulse.h, impulse_target).
 #define MOTES_FLAG_IMPULSE_RELAX 128u
-/// impulses_apply: keep the velocities this sweep leaves (BodyVelPush, BodyAngMomPush) as those
-/// the pose moves with; bodies_integrate with MOTES_FLAG_BODY_POSE: move with them.
+/// impulses_apply: keep the velocities this sweep leaves in BodyVelPush and BodyAngMomPush;
+/// bodies_integrate with MOTES_FLAG_BODY_POSE: move with them. impulses_compute: write the
+/// accumulated impulses to ContactImpulseSplit too (the last relaxing sweep of a split substep).
 #define MOTES_FLAG_IMPULSE_PUSH 256u
 /// Position contacts (shared/position.h, docs/architecture.md "Position contacts"):
 /// impulses_compute projects the overlaps of the predicted poses (with MOTES_FLAG_IMPULSE_COUNT:
@@ -51,6 +52,12 @@ MOTES_SHARED_BEGIN
 /// MOTES_FLAG_POSITION (shared/particle_shift.h) and its velocity by that / dt; nothing else.
 /// Without it, MOTES_FLAG_POSITION makes particles_integrate predict (gravity, no force).
 #define MOTES_FLAG_PARTICLE_SHIFT 4096u
+/// Split impulses (docs/architecture.md, "Impulse contacts"): impulses_compute, a correcting sweep
+/// that reads and writes its accumulated impulses in ContactImpulseSplit (ContactImpulse keeps the
+/// relaxed ones); bodies_integrate with MOTES_FLAG_BODY_POSE: the pose moves with BodyVel and
+/// BodyAngMom (the corrected velocities), which then take BodyVelPush and BodyAngMomPush (the
+/// relaxed ones) back (shared/body_math.h: body_split_pose).
+#define MOTES_FLAG_IMPULSE_SPLIT 8192u
 
 /// Launch parameters of every kernel family; travels with the launch (push constants).
 struct StepParams {

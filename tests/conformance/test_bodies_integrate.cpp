@@ -34,8 +34,10 @@ constexpr double kBodiesIntegrateTolerance = 1.0e-10;
 class BodiesIntegrate : public DeviceTest {
  protected:
   /// push: the impulse stage's pose (MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_PUSH), moved with
-  /// random BodyVelPush and BodyAngMomPush (written too) while the bodies keep their velocities.
-  void run_case(const std::string& layout, World w, bool push = false) {
+  /// random BodyVelPush and BodyAngMomPush (written too) while the bodies keep their velocities;
+  /// with split (MOTES_FLAG_IMPULSE_SPLIT in place of MOTES_FLAG_IMPULSE_PUSH), moved with their
+  /// velocities, which then take the push copies.
+  void run_case(const std::string& layout, World w, bool push = false, bool split = false) {
     std::vector<vec4> vel_push, angmom_push;
     motes_ref::Bodies want = w.bodies;
     if (push) {
@@ -51,8 +53,13 @@ class BodiesIntegrate : public DeviceTest {
                                          rng.uniform(-1e-3f, 1e-3f), 0.0f));
       }
       w.sizes.impulse = 1;
-      w.params.flags |= MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_PUSH;
-      motes_ref::bodies_push_pose(want, vel_push, angmom_push, w.params);
+      if (split) {
+        w.params.flags |= MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_SPLIT;
+        motes_ref::bodies_split_pose(want, vel_push, angmom_push, w.params);
+      } else {
+        w.params.flags |= MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_PUSH;
+        motes_ref::bodies_push_pose(want, vel_push, angmom_push, w.params);
+      }
     } else {
       motes_ref::bodies_integrate(want, w.params);
     }
@@ -97,6 +104,9 @@ TEST_P(BodiesIntegrate, Random31) { run_case("random", random_bodies(53, 31)); }
 TEST_P(BodiesIntegrate, Random1234) { run_case("random", random_bodies(54, 1234)); }
 TEST_P(BodiesIntegrate, Random65536) { run_case("random", random_bodies(55, 65536)); }
 TEST_P(BodiesIntegrate, PushPose1234) { run_case("push pose", random_bodies(56, 1234), true); }
+TEST_P(BodiesIntegrate, SplitPose1234) {
+  run_case("split pose", random_bodies(58, 1234), true, true);
+}
 TEST_P(BodiesIntegrate, Predict1234) {
   // Position contacts' prediction (MOTES_FLAG_POSITION): gravity alone, the random BodyForce and
   // BodyTorque written but not applied.

@@ -125,11 +125,14 @@ class ImpulsesComputeThenApply : public DeviceTest {
       pass(MOTES_FLAG_POSITION);
       pass(MOTES_FLAG_POSITION | MOTES_FLAG_POSITION_VELOCITY);
     } else {
+      // The impulse stage's substep with split impulses: the counting pass, the relaxing sweeps
+      // (the last keeps its velocities and copies its accumulated impulses), the correcting
+      // sweeps on the copies.
       pass(MOTES_FLAG_IMPULSE_COUNT);
-      for (int it = 0; it < kIterations; ++it) {
-        pass(it + 1 == kIterations ? MOTES_FLAG_IMPULSE_PUSH : 0u);
+      for (int it = 0; it < kRelaxing; ++it) {
+        pass(MOTES_FLAG_IMPULSE_RELAX | (it + 1 == kRelaxing ? MOTES_FLAG_IMPULSE_PUSH : 0u));
       }
-      for (int it = 0; it < kRelaxing; ++it) pass(MOTES_FLAG_IMPULSE_RELAX);
+      for (int it = 0; it < kIterations; ++it) pass(MOTES_FLAG_IMPULSE_SPLIT);
     }
     motes_ref::Bodies want = w.bodies;
     for (const StepParams& q : passes) {

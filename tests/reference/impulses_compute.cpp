@@ -30,6 +30,16 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
   const float margin = motes::shared::impulse_margin(p.neighbour_skin);
   s.impulse.assign(nr, vec4(0.0f));
   s.moment.assign(nr, vec4(0.0f));
+  // The accumulated impulses this pass keeps (split impulses' correcting sweeps: acc_split), and
+  // where it copies them (the last relaxing sweep).
+  const bool split = (p.flags & MOTES_FLAG_IMPULSE_SPLIT) != 0u;
+  const bool copy = (p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u;
+  if (split || copy) s.acc_split.resize(s.acc.size(), vec4(0.0f));
+  std::vector<vec4>& acc = split ? s.acc_split : s.acc;
+  const auto keep = [&](std::size_t at, const vec4& a) {
+    acc[at] = a;
+    if (copy) s.acc_split[at] = a;
+  };
   for (std::size_t i = 0; i < nr; ++i) {
     if (particles.vel[i].w == 0.0f) continue;
     const vec4 xi = particles.pos[i];
@@ -41,16 +51,16 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
       const uint j = list[k];
       if (j >= nr) continue;
       const bool slotted = motes::shared::impulse_pair_slotted(nb.count[i], nb.count[j], capacity);
-      vec4& slot = s.acc[k * nr + i];  // only touched when slotted (then k < K)
+      const std::size_t at = k * nr + i;  // only touched when slotted (then k < K)
       const bool valid = !counting || motes::shared::impulse_slots_valid(
                                           s.stamp[i], s.stamp[j], particles.vel[j].w, s.builds);
-      vec4 a = slotted && valid ? slot : vec4(0.0f);
+      vec4 a = slotted && valid ? acc[at] : vec4(0.0f);
       const uint law = motes::shared::pair_law_index(static_cast<uint>(i), particles.material[i], j,
                                                      particles.material[j], p.material_count);
       const vec4 r = motes::shared::pair_impulse(
           own, xi, impulse_body(bodies, s, particles.body[j], p.flags), particles.pos[j], i < j,
           margin, laws[law], p.gravity_dt, p.flags, a);
-      if (slotted) slot = a;
+      if (slotted) keep(at, a);
       motes::shared::impulse_add(
           sum, moment, r,
           motes::shared::contact_acting_point(
@@ -59,11 +69,13 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
     }
     for (std::size_t k = 0; k < planes.size(); ++k) {
       const PlaneData& pl = planes[k];
-      vec4& a = s.acc[(capacity + k) * nr + i];
+      const std::size_t at = (capacity + k) * nr + i;
+      vec4 a = acc[at];
       const vec4 r = motes::shared::plane_contact_impulse(
           own, xi, pl.normal_offset, margin,
           laws[std::size_t{particles.material[i]} * p.material_count + pl.material], p.gravity_dt,
           p.flags, a);
+      keep(at, a);
       motes::shared::impulse_add(
           sum, moment, r,
           motes::shared::contact_acting_point(

@@ -129,6 +129,10 @@ void bodies_integrate(Bodies& bodies, const StepParams& p);
 /// every body, moved with vel_push and angmom_push (BodyVelPush, BodyAngMomPush).
 void bodies_push_pose(Bodies& bodies, const std::vector<vec4>& vel_push,
                       const std::vector<vec4>& angmom_push, const StepParams& p);
+/// bodies_integrate with MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_SPLIT: shared::body_split_pose
+/// on every body (moved with its own velocities, which then take vel_push and angmom_push).
+void bodies_split_pose(Bodies& bodies, const std::vector<vec4>& vel_push,
+                       const std::vector<vec4>& angmom_push, const StepParams& p);
 
 /// particles_update: ParticlePos/Vel xyz of the rigid particles [0, particles.rigid) from the body
 /// pose (shared::particle_position and particle_velocity); w (radius, inverse mass) kept. Returns
@@ -199,14 +203,17 @@ bool clusters_goal(Particles& particles, const std::vector<ClusterMember>& membe
 /// The state of the impulse stage (MOTES_FLAG_IMPULSE) that impulses_compute and impulses_apply
 /// read or write besides the particles and bodies.
 struct ImpulseState {
-  std::vector<vec4> vel0;      ///< B: BodyVelStart (w: the body's counted contacts)
-  std::vector<vec4> angvel0;   ///< B: BodyAngVelStart
-  std::vector<vec4> acc;       ///< (K + P) x Nr: ContactImpulse, slot k of particle i at k Nr + i
-  std::vector<uint> stamp;     ///< Nr: ImpulseStamp
-  uint builds = 0;             ///< NeighbourState[MOTES_NEIGHBOUR_BUILDS]
-  std::vector<vec4> impulse;   ///< Nr: ParticleForce (xyz impulse, w counted contacts)
-  std::vector<vec4> moment;    ///< Nr: ParticleMoment
-  std::vector<vec4> vel_push;  ///< B: BodyVelPush (written with MOTES_FLAG_IMPULSE_PUSH)
+  std::vector<vec4> vel0;     ///< B: BodyVelStart (w: the body's counted contacts)
+  std::vector<vec4> angvel0;  ///< B: BodyAngVelStart
+  std::vector<vec4> acc;      ///< (K + P) x Nr: ContactImpulse, slot k of particle i at k Nr + i
+  /// (K + P) x Nr: ContactImpulseSplit (the correcting sweeps of split impulses, filled by the
+  /// last relaxing sweep: MOTES_FLAG_IMPULSE_SPLIT, MOTES_FLAG_IMPULSE_PUSH)
+  std::vector<vec4> acc_split;
+  std::vector<uint> stamp;        ///< Nr: ImpulseStamp
+  uint builds = 0;                ///< NeighbourState[MOTES_NEIGHBOUR_BUILDS]
+  std::vector<vec4> impulse;      ///< Nr: ParticleForce (xyz impulse, w counted contacts)
+  std::vector<vec4> moment;       ///< Nr: ParticleMoment
+  std::vector<vec4> vel_push;     ///< B: BodyVelPush (written with MOTES_FLAG_IMPULSE_PUSH)
   std::vector<vec4> angmom_push;  ///< B: BodyAngMomPush
 };
 

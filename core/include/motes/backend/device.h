@@ -99,6 +99,10 @@ enum class Buffer : std::uint32_t {
   PartitionRefPos,
   /// uint (1 when Sizes::partition, else 0): particles_displacement's word (shared/halo.h).
   PartitionCheck,
+  /// vec4 (as ContactImpulse): the accumulated impulses of a substep's correcting sweeps
+  /// (MOTES_FLAG_IMPULSE_SPLIT), which start from the relaxed ones; written before it is read in
+  /// every substep (not in checkpoints).
+  ContactImpulseSplit,
   Count
 };
 

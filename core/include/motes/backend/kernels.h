@@ -26,8 +26,10 @@
 //   Static particles get 0. Exact while no particle has moved 0.45 skin since the build.
 // bodies_reduce: BodyForce and BodyTorque: sums over each body's particles in particle order.
 // bodies_integrate: semi-implicit Euler on every dynamic body (shared/body_math.h:
-//   body_integrate; with impulse contacts from BodyVelPush and BodyAngMomPush; with position
-//   contacts, MOTES_FLAG_POSITION, the prediction with gravity alone).
+//   body_integrate; with impulse contacts from BodyVelPush and BodyAngMomPush, or with
+//   MOTES_FLAG_IMPULSE_SPLIT from BodyVel and BodyAngMom, which then take the push copies:
+//   body_split_pose; with position contacts, MOTES_FLAG_POSITION, the prediction with gravity
+//   alone).
 // particles_update: ParticlePos and ParticleVel xyz of the rigid particles [0, Nr) from their
 //   body's pose; asks for a rebuild (NeighbourState) when one has moved too far from its
 //   NeighbourRefPos. With MOTES_FLAG_ABSORB, first ParticleForce =
@@ -51,14 +53,15 @@
 //   list order (each pair evaluated lower id first, negated for the higher), then
 //   plane_contact_impulse over the planes; w = the contacts counted; ParticleMoment = the sum of
 //   (c - x_com) x J; the contacts' accumulated impulses in ContactImpulse (ImpulseStamp says
-//   which are valid). Static particles get 0. With MOTES_FLAG_IMPULSE_COUNT the same (only w is
-//   used). A sweep (no MOTES_FLAG_IMPULSE_COUNT) after its substep's counting pass, positions and
-//   lists unchanged since, may visit only the particles that pass found within reach of a
-//   contact (the others' impulses are 0, as the step needs); a backend that keeps that must forget
-//   it at allocate and at a write of positions or lists. With MOTES_FLAG_POSITION the contacts are
-//   position contacts (shared/position.h: contact_position; ContactImpulse slots zeroed): the
-//   counting pass, the projection, or (MOTES_FLAG_POSITION_VELOCITY) the velocity pass, which may
-//   follow a projection that moved the poses.
+//   which are valid; with MOTES_FLAG_IMPULSE_SPLIT in ContactImpulseSplit instead, and with
+//   MOTES_FLAG_IMPULSE_PUSH written to both). Static particles get 0. With MOTES_FLAG_IMPULSE_COUNT
+//   the same (only w is used). A sweep (no MOTES_FLAG_IMPULSE_COUNT) after its substep's counting
+//   pass, positions and lists unchanged since, may visit only the particles that pass found within
+//   reach of a contact (the others' impulses are 0, as the step needs); a backend that keeps that
+//   must forget it at allocate and at a write of positions or lists. With MOTES_FLAG_POSITION the
+//   contacts are position contacts (shared/position.h: contact_position; ContactImpulse slots
+//   zeroed): the counting pass, the projection, or (MOTES_FLAG_POSITION_VELOCITY) the velocity
+//   pass, which may follow a projection that moved the poses.
 // impulses_apply: every dynamic body sums its particles' ParticleForce and ParticleMoment in
 //   particle order, then shared/impulse.h: body_apply_impulse (BodyVel, BodyAngMom, BodyAngVel).
 //   With MOTES_FLAG_IMPULSE_COUNT instead: BodyVelStart = (BodyVel xyz, the summed count),
@@ -130,8 +133,8 @@
     (ParticlePos, ParticleVel, ParticleBody, ParticleMaterial, BodyPos, BodyQuat, BodyVel,       \
      BodyAngVel, BodyInvInertia, BodyFirst, GridOrder, GridCellStart, SortedPos, SortedBody,     \
      NeighbourList, NeighbourCount, NeighbourRefPos, NeighbourState, ContactLaws, Planes,        \
-     BodyVelStart, BodyAngVelStart, ContactImpulse, ImpulseStamp),                               \
-    (ParticleForce, ParticleMoment, ContactImpulse, ImpulseStamp))                               \
+     BodyVelStart, BodyAngVelStart, ContactImpulse, ImpulseStamp, ContactImpulseSplit),          \
+    (ParticleForce, ParticleMoment, ContactImpulse, ImpulseStamp, ContactImpulseSplit))          \
   X(ImpulsesApply, impulses_apply,                                                               \
     (ParticleForce, ParticleMoment, BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel,          \
      BodyInvInertia, BodyFirst, BodyVelStart, BodyAngVelStart, NeighbourState, ImpulseStamp,     \
