@@ -165,6 +165,7 @@ void make_chain(Case& c, Rng& rng) {
       d.velocity = Eigen::Vector3d(rng.uniform(0.05, 0.15), 0.0, 0.0);
     }
   }
+  c.on_edge.assign(c.bodies.size(), true);  // every domino is one particle thick
   c.settles = true;
   c.duration = 4.0;
   c.rest_from = 3.5;
