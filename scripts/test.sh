@@ -24,8 +24,10 @@ export MOTES_VULKAN_VALIDATION=${MOTES_VULKAN_VALIDATION:-1}
 # side on every core, and at test sizes the hand-offs cost more than they give (the 2-core machine:
 # cloth.json on Vulkan 63 steps/s with two workers, 139 with none; four example scenes on Vulkan
 # under ctest -j2 took 109 s against 83 s): LP_NUM_THREADS=0 runs each dispatch in the thread that
-# submits it. The conformance suite keeps two workers (tests/CMakeLists.txt), so that on lavapipe
-# too the workgroups of a dispatch run side by side, as they do on a GPU.
+# submits it. The conformance suite's kernel and scene cases keep two workers
+# (tests/CMakeLists.txt), so that on lavapipe too the workgroups of a dispatch run side by side, as
+# on a GPU; its extra passes (Conformance.VulkanTwoDimensionalDispatch and .PoisonUnreadBuffers)
+# run with none, like the rest.
 export LP_NUM_THREADS=${LP_NUM_THREADS:-0}
 # --no-tests=error: a build that lists no test fails rather than passing empty.
 ctest --output-on-failure -j "${JOBS:-$(nproc)}" --timeout 900 --no-tests=error \
