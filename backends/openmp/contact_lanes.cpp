@@ -38,11 +38,11 @@ shared::ImpulseBody lane_body(const ContactBlock& k, int s, int l) {
   return o;
 }
 
-/// Side s of lane l as contact_frame reads a body: its centre and its velocities at the
-/// substep's start.
+/// Side s of lane l as contact_frame reads a body: its centre, inverse mass and its velocities at
+/// the substep's start.
 shared::ImpulseBody lane_start_body(const ContactBlock& k, int s, int l) {
   shared::ImpulseBody o = shared::impulse_wall();
-  o.com = vec4(contact_lane_vec3(k.com[s], l), 0.0f);
+  o.com = vec4(contact_lane_vec3(k.com[s], l), k.body[s][0][l]);
   o.vel0 = vec4(k.vel[s][0][l], k.vel[s][1][l], k.vel[s][2][l], 0.0f);
   o.angvel0 = vec4(k.vel[s][3][l], k.vel[s][4][l], k.vel[s][5][l], 0.0f);
   return o;

@@ -90,6 +90,8 @@ inline void contact_lane_start(ContactBlock& k, int l, std::uint32_t ia, std::ui
   contact_lane_put3(k.point, l, c);
   contact_lane_put3(k.com[0], l, shared::xyz(a.com));
   contact_lane_put3(k.com[1], l, shared::xyz(b.com));
+  k.body[0][0][l] = a.com.w;  // what contact_frame reads of them (contact_lane_bodies: the rest)
+  k.body[1][0][l] = b.com.w;
   contact_lane_start_velocities(k, l, 0, a);
   contact_lane_start_velocities(k, l, 1, b);
   k.restitution[l] = law.restitution;

@@ -122,14 +122,14 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
       }
       const std::size_t other_at = std::size_t{m} * nr + j;
       vec4 a = acc[at];
-      const vec4 r = shared::pair_impulse(
+      vec4 on_j;  // j's side, as pair_impulse gives it
+      pair_r[at] = shared::pair_impulse_sides(
           own, xi, impulse_body(in.body[j]), in.pos[j], uint(i) < j, margin,
           in.laws[shared::pair_law_index(uint(i), in.material[i], j, in.material[j], materials)],
-          p.gravity_dt, p.flags, a);
+          p.gravity_dt, p.flags, a, on_j);
+      pair_r[other_at] = on_j;
       keep(at, a);
       keep(other_at, a);
-      pair_r[at] = r;
-      pair_r[other_at] = vec4(-r.x, -r.y, -r.z, r.w);  // j's side, as pair_impulse gives it
     }
   };
 

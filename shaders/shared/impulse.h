@@ -87,10 +87,35 @@ struct ContactFrame {
   vec4 ra;        // xyz: arm on a (c - a's centre), w: separation (< 0: overlap)
   vec4 rb;        // xyz: arm on b, w: r_a + r_b
   vec4 n;         // xyz: unit normal from b towards a, w: normal velocity at the substep's start
-  vec4 target;    // impulse_target and its soft flag: x, y in the correcting sweeps (and the
-                  // counting pass), z, w in the relaxing ones (MOTES_FLAG_IMPULSE_RELAX)
+  vec4 target;    // impulse_target and its soft flag in the correcting sweeps (and the counting
+                  // pass): x, y; the target of the relaxing ones (MOTES_FLAG_IMPULSE_RELAX, never
+                  // soft): z; w: the stack scale (contact_stack_scale)
   vec4 response;  // xyz: the contact's response to a unit normal impulse, w: its normal part
 };
+
+/// The stack scale of a contact between bodies a and b (position_stack_scale: negative when a is
+/// the lower body, positive when b is, 1 for none): the lower body of a resting contact between
+/// two dynamic bodies counts as heavier in every pass of the substep, as position contacts do
+/// (docs/architecture.md, "Impulse contacts": why a column of offset boxes needs it); 1 when
+/// either body is static.
+MOTES_FN float contact_stack_scale(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, float rsum,
+                                   float vn0, vec4 gravity_dt) {
+  // Continuous in vn0: the full scale up to the bounce speed, none from twice it, linear between
+  // (a jump at one speed is a decision two backends' roundings can take apart).
+  bool on = a.com.w != 0.0f && b.com.w != 0.0f;
+  float g = length(xyz(gravity_dt));
+  float bounce = MOTES_IMPULSE_BOUNCE_SUBSTEPS * g * gravity_dt.w;
+  float dh = g > 0.0f ? -dot(xyz(a.com) - xyz(b.com), xyz(gravity_dt)) / g : 0.0f;
+  float f = rsum / (rsum + abs(dh));
+  float w = g > 0.0f ? clamp((vn0 + 2.0f * bounce) / max(bounce, 1e-30f), 0.0f, 1.0f) : 0.0f;
+  float fw = 1.0f + w * (f - 1.0f);
+  return on ? (dh > 0.0f ? fw : -fw) : 1.0f;
+}
+
+/// The stack scale's factor on side a (side_b false) or b of a contact: the lower body's.
+MOTES_FN float contact_side_scale(float s, bool side_b) {
+  return side_b ? (s > 0.0f ? s : 1.0f) : (s < 0.0f ? -s : 1.0f);
+}
 
 /// A contact's frame before its response is known (contact_frame_response: the bodies' contact
 /// counts, which scale it, are known only after the counting pass).
@@ -107,11 +132,11 @@ MOTES_FN ContactFrame contact_frame(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBod
   f.rb = vec4(rb, rsum);
   f.n = vec4(n, vn0);
   float soft = 0.0f;
-  float relax_soft = 0.0f;
+  float relax_soft = 0.0f;  // 0 whatever it was: relaxing sweeps are never soft
   float target = impulse_target(sep, rsum, vn0, restitution, gravity_dt, 0u, soft);
   float relax_target =
       impulse_target(sep, rsum, vn0, restitution, gravity_dt, MOTES_FLAG_IMPULSE_RELAX, relax_soft);
-  f.target = vec4(target, soft, relax_target, relax_soft);
+  f.target = vec4(target, soft, relax_target, contact_stack_scale(a, b, rsum, vn0, gravity_dt));
   f.response = vec4(0.0f);
   return f;
 }
@@ -121,7 +146,8 @@ MOTES_FN ContactFrame contact_frame(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBod
 MOTES_FN void contact_frame_response(MOTES_INOUT(ContactFrame) f, MOTES_IN(ImpulseBody) a,
                                      MOTES_IN(ImpulseBody) b) {
   vec3 n = xyz(f.n);
-  vec3 response = impulse_response(a, xyz(f.ra), n) + impulse_response(b, xyz(f.rb), n);
+  vec3 response = impulse_response(a, xyz(f.ra), n) * contact_side_scale(f.target.w, false) +
+                  impulse_response(b, xyz(f.rb), n) * contact_side_scale(f.target.w, true);
   f.response = vec4(response, dot(response, n));
 }
 
@@ -141,7 +167,7 @@ MOTES_FN vec4 contact_solve(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b,
   bool relaxing = (flags & MOTES_FLAG_IMPULSE_RELAX) != 0u;
   bool counting = (flags & MOTES_FLAG_IMPULSE_COUNT) != 0u;
   float target = relaxing ? f.target.z : f.target.x;
-  float soft = relaxing ? f.target.w : f.target.y;
+  float soft = relaxing ? 0.0f : f.target.y;
   float counts = 1.0f;
   vec3 old_total = xyz(acc);
   float jn = acc.w;
@@ -168,7 +194,8 @@ MOTES_FN vec4 contact_solve(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b,
     if (vt2 > 0.0f && law.friction != 0.0f) {
       float vt_len = sqrt(vt2);
       vec3 t = vt / vt_len;
-      float kt = impulse_inverse_mass(a, ra, t) + impulse_inverse_mass(b, rb, t);
+      float kt = impulse_inverse_mass(a, ra, t) * contact_side_scale(f.target.w, false) +
+                 impulse_inverse_mass(b, rb, t) * contact_side_scale(f.target.w, true);
       jt -= t * (vt_len / kt);
     }
   }
@@ -207,8 +234,9 @@ MOTES_FN vec4 contact_solve(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b,
 /// substep's contacts (openmp) solves each sweep from them, with the same bits.
 MOTES_FN vec4 contact_impulse(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, vec3 c, vec3 n,
                               float sep, float rsum, ContactLaw law, vec4 gravity_dt, uint flags,
-                              MOTES_INOUT(vec4) acc) {
+                              MOTES_INOUT(vec4) acc, MOTES_OUT(float) stack) {
   ContactFrame f = contact_frame(a, b, c, n, sep, rsum, law.restitution, gravity_dt);
+  stack = f.target.w;
   if ((flags & MOTES_FLAG_IMPULSE_COUNT) == 0u) {
     contact_frame_response(f, a, b);
   }
@@ -223,7 +251,8 @@ MOTES_FN vec4 contact_impulse(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, 
 /// centres coincide.
 MOTES_FN vec4 particle_contact_impulse(MOTES_IN(ImpulseBody) a, vec4 xa, MOTES_IN(ImpulseBody) b,
                                        vec4 xb, float margin, ContactLaw law, vec4 gravity_dt,
-                                       uint flags, MOTES_INOUT(vec4) acc) {
+                                       uint flags, MOTES_INOUT(vec4) acc, MOTES_OUT(float) stack) {
+  stack = 1.0f;
   vec3 d = xyz(xa) - xyz(xb);
   float dist2 = dot(d, d);
   float rsum = xa.w + xb.w;
@@ -234,7 +263,7 @@ MOTES_FN vec4 particle_contact_impulse(MOTES_IN(ImpulseBody) a, vec4 xa, MOTES_I
   }
   float dist = sqrt(dist2);
   return contact_impulse(a, b, pair_contact_point(xa, xb), d / dist, dist - rsum, rsum, law,
-                         gravity_dt, flags, acc);
+                         gravity_dt, flags, acc, stack);
 }
 
 /// The position contact (shared/position.h: contact_position) of particle a (centre xa, radius
@@ -267,6 +296,27 @@ MOTES_FN uint pair_law_index(uint i, uint mi, uint j, uint mj, uint materials) {
   return i < j ? mi * materials + mj : mj * materials + mi;
 }
 
+/// pair_impulse's impulse contact, both sides at once: the impulse on body `own` returned, the one
+/// on body `other` in other_side (the openmp sweeps evaluate a contact once for both particles).
+/// Each is its side's share of the contact's impulse (contact_stack_scale: the lower body's is
+/// less).
+MOTES_FN vec4 pair_impulse_sides(MOTES_IN(ImpulseBody) own, vec4 xi, MOTES_IN(ImpulseBody) other,
+                                 vec4 xj, bool own_first, float margin, ContactLaw law,
+                                 vec4 gravity_dt, uint flags, MOTES_INOUT(vec4) acc,
+                                 MOTES_OUT(vec4) other_side) {
+  float stack = 1.0f;
+  vec4 r = own_first ? particle_contact_impulse(own, xi, other, xj, margin, law, gravity_dt, flags,
+                                                acc, stack)
+                     : particle_contact_impulse(other, xj, own, xi, margin, law, gravity_dt, flags,
+                                                acc, stack);
+  float sa = contact_side_scale(stack, false);
+  float sb = contact_side_scale(stack, true);
+  vec4 on_a = vec4(r.x * sa, r.y * sa, r.z * sa, r.w);  // the lower id's side
+  vec4 on_b = vec4(-r.x * sb, -r.y * sb, -r.z * sb, r.w);
+  other_side = own_first ? on_b : on_a;
+  return own_first ? on_a : on_b;
+}
+
 /// The impulse on body `own` (w: counted) of its particle xi and particle xj of body `other`;
 /// own_first: xi has the lower particle id (see particle_contact_impulse). acc: the contact's
 /// accumulated impulse, as the lower id sees it (the same bits in both particles' slots).
@@ -280,11 +330,9 @@ MOTES_FN vec4 pair_impulse(MOTES_IN(ImpulseBody) own, vec4 xi, MOTES_IN(ImpulseB
             : particle_contact_position(other, xj, own, xi, margin, law, gravity_dt, flags, acc);
     return own_first ? r.a : r.b;
   }
-  if (own_first) {
-    return particle_contact_impulse(own, xi, other, xj, margin, law, gravity_dt, flags, acc);
-  }
-  vec4 r = particle_contact_impulse(other, xj, own, xi, margin, law, gravity_dt, flags, acc);
-  return vec4(-r.x, -r.y, -r.z, r.w);
+  vec4 other_side;
+  return pair_impulse_sides(own, xi, other, xj, own_first, margin, law, gravity_dt, flags, acc,
+                            other_side);
 }
 
 /// The impulse on body a of its particle xa and a static half-space plane (solid where
@@ -305,7 +353,8 @@ MOTES_FN vec4 plane_contact_impulse(MOTES_IN(ImpulseBody) a, vec4 xa, vec4 norma
                             plane_contact_rel(c, np), law, gravity_dt, flags, acc)
         .a;
   }
-  return contact_impulse(a, impulse_wall(), c, np, sep, xa.w, law, gravity_dt, flags, acc);
+  float stack = 1.0f;  // a wall: never scaled
+  return contact_impulse(a, impulse_wall(), c, np, sep, xa.w, law, gravity_dt, flags, acc, stack);
 }
 
 /// True when the contact of particles i and j (neighbour counts ci and cj) keeps its accumulated
