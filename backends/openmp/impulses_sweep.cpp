@@ -259,13 +259,11 @@ void OpenMPDevice::impulse_contacts_solve(const shared::StepParams& p) {
       const vec4 r = contact_lane_vec4(blk.result, l);
       const float stack = blk.frame[15][l];  // the stack scale: each side's share (pair_impulse)
       if ((entries[e] & 1u) == 0u) {
-        const float s = shared::contact_side_scale(stack, false);
-        const vec4 q(r.x * s, r.y * s, r.z * s, r.w);
+        const vec4 q = shared::contact_side_impulse(r, stack, false);
         sum = sum + q;
         moment_sum += shared::cross(contact_lane_vec3(blk.frame, l), shared::xyz(q));
       } else {  // the higher id's side: pair_impulse's negation, about its own arm
-        const float s = shared::contact_side_scale(stack, true);
-        const vec4 q(-r.x * s, -r.y * s, -r.z * s, r.w);
+        const vec4 q = shared::contact_side_impulse(r, stack, true);
         sum = sum + q;
         moment_sum += shared::cross(contact_lane_vec3(blk.frame + 4, l), shared::xyz(q));
       }

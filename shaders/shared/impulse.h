@@ -105,16 +105,17 @@ MOTES_FN float contact_stack_scale(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody
   bool on = a.com.w != 0.0f && b.com.w != 0.0f;
   float g = length(xyz(gravity_dt));
   float bounce = MOTES_IMPULSE_BOUNCE_SUBSTEPS * g * gravity_dt.w;
-  float dh = g > 0.0f ? -dot(xyz(a.com) - xyz(b.com), xyz(gravity_dt)) / g : 0.0f;
-  float f = rsum / (rsum + abs(dh));
+  float s = stack_height_scale(xyz(a.com), xyz(b.com), rsum, g, gravity_dt);
   float w = g > 0.0f ? clamp((vn0 + 2.0f * bounce) / max(bounce, 1e-30f), 0.0f, 1.0f) : 0.0f;
-  float fw = 1.0f + w * (f - 1.0f);
-  return on ? (dh > 0.0f ? fw : -fw) : 1.0f;
+  float fw = 1.0f + w * (abs(s) - 1.0f);
+  return on ? (s > 0.0f ? fw : -fw) : 1.0f;
 }
 
-/// The stack scale's factor on side a (side_b false) or b of a contact: the lower body's.
-MOTES_FN float contact_side_scale(float s, bool side_b) {
-  return side_b ? (s > 0.0f ? s : 1.0f) : (s < 0.0f ? -s : 1.0f);
+/// A contact's impulse r on side a (side_b false) or, negated, on side b, each scaled by its share
+/// (stack_side_scale of the contact's stack scale s); w is kept.
+MOTES_FN vec4 contact_side_impulse(vec4 r, float s, bool side_b) {
+  float k = side_b ? -stack_side_scale(s, true) : stack_side_scale(s, false);
+  return vec4(r.x * k, r.y * k, r.z * k, r.w);
 }
 
 /// A contact's frame before its response is known (contact_frame_response: the bodies' contact
@@ -146,8 +147,8 @@ MOTES_FN ContactFrame contact_frame(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBod
 MOTES_FN void contact_frame_response(MOTES_INOUT(ContactFrame) f, MOTES_IN(ImpulseBody) a,
                                      MOTES_IN(ImpulseBody) b) {
   vec3 n = xyz(f.n);
-  vec3 response = impulse_response(a, xyz(f.ra), n) * contact_side_scale(f.target.w, false) +
-                  impulse_response(b, xyz(f.rb), n) * contact_side_scale(f.target.w, true);
+  vec3 response = impulse_response(a, xyz(f.ra), n) * stack_side_scale(f.target.w, false) +
+                  impulse_response(b, xyz(f.rb), n) * stack_side_scale(f.target.w, true);
   f.response = vec4(response, dot(response, n));
 }
 
@@ -194,8 +195,8 @@ MOTES_FN vec4 contact_solve(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b,
     if (vt2 > 0.0f && law.friction != 0.0f) {
       float vt_len = sqrt(vt2);
       vec3 t = vt / vt_len;
-      float kt = impulse_inverse_mass(a, ra, t) * contact_side_scale(f.target.w, false) +
-                 impulse_inverse_mass(b, rb, t) * contact_side_scale(f.target.w, true);
+      float kt = impulse_inverse_mass(a, ra, t) * stack_side_scale(f.target.w, false) +
+                 impulse_inverse_mass(b, rb, t) * stack_side_scale(f.target.w, true);
       jt -= t * (vt_len / kt);
     }
   }
@@ -309,10 +310,8 @@ MOTES_FN vec4 pair_impulse_sides(MOTES_IN(ImpulseBody) own, vec4 xi, MOTES_IN(Im
                                                 acc, stack)
                      : particle_contact_impulse(other, xj, own, xi, margin, law, gravity_dt, flags,
                                                 acc, stack);
-  float sa = contact_side_scale(stack, false);
-  float sb = contact_side_scale(stack, true);
-  vec4 on_a = vec4(r.x * sa, r.y * sa, r.z * sa, r.w);  // the lower id's side
-  vec4 on_b = vec4(-r.x * sb, -r.y * sb, -r.z * sb, r.w);
+  vec4 on_a = contact_side_impulse(r, stack, false);  // the lower id's side
+  vec4 on_b = contact_side_impulse(r, stack, true);
   other_side = own_first ? on_b : on_a;
   return own_first ? on_a : on_b;
 }

@@ -55,6 +55,15 @@ MOTES_SHARED_BEGIN
 /// 2020 use 2); resting contacts close at |g| h every substep and do not.
 #define MOTES_POSITION_BOUNCE_SUBSTEPS 2.0f
 
+/// f = size / (size + |dh|) of two bodies whose centres are dh apart along -gravity (g: |gravity|),
+/// negated when a is the lower (b lower: positive; level or no gravity: -1, no scaling): the
+/// height part of position_stack_scale and contact_stack_scale.
+MOTES_FN float stack_height_scale(vec3 com_a, vec3 com_b, float size, float g, vec4 gravity_dt) {
+  float dh = g > 0.0f ? -dot(com_a - com_b, xyz(gravity_dt)) / g : 0.0f;
+  float f = size / (size + abs(dh));
+  return dh > 0.0f ? f : -f;
+}
+
 /// Mass scaling of resting contacts in stacks (Macklin et al. 2014, section 5.1, without the
 /// exponential, whose bits differ between backends): in a contact of bodies whose centres are dh
 /// apart along -gravity, the lower body's inverse mass and inertia count f = size / (size + |dh|)
@@ -69,9 +78,13 @@ MOTES_FN float position_stack_scale(vec3 com_a, vec3 com_b, float size, float vn
   if (!(g > 0.0f) || vn0 < -MOTES_POSITION_BOUNCE_SUBSTEPS * g * gravity_dt.w) {
     return 1.0f;
   }
-  float dh = -dot(com_a - com_b, xyz(gravity_dt)) / g;
-  float f = size / (size + abs(dh));
-  return dh > 0.0f ? f : -f;
+  return stack_height_scale(com_a, com_b, size, g, gravity_dt);
+}
+
+/// The factor a stack scale s (position_stack_scale, contact_stack_scale) puts on side a
+/// (side_b false) or side b of a contact: the lower body's f, 1 for the other.
+MOTES_FN float stack_side_scale(float s, bool side_b) {
+  return side_b ? (s > 0.0f ? s : 1.0f) : (s < 0.0f ? -s : 1.0f);
 }
 
 /// What a position contact does to each of its two bodies (xyz: the impulse, w: 1 for a contact
@@ -157,8 +170,8 @@ MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(Impulse
       impulse_point_velocity(a.vel0, a.angvel0, ra) - impulse_point_velocity(b.vel0, b.angvel0, rb);
   float vn0 = dot(u0, n);
   float f = position_stack_scale(xyz(a.com), xyz(b.com), size, vn0, gravity_dt);
-  float sa = f < 0.0f ? -f : 1.0f;
-  float sb = f > 0.0f ? f : 1.0f;
+  float sa = stack_side_scale(f, false);
+  float sb = stack_side_scale(f, true);
   float kn = sa * impulse_inverse_mass(a, ra, n) + sb * impulse_inverse_mass(b, rb, n);
   if (!(kn > 0.0f)) {
     return res;
