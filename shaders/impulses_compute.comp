@@ -39,7 +39,6 @@ void acc_write(uint slot, vec4 a) {
 void main() {
   uint i = thread_index();
   if (i >= p.rigid_particle_count) return;
-  vec4 xi = particle_pos[i];
   if (particle_vel[i].w == 0.0f) {  // static particle: its impulse is never used
     particle_force[i] = vec4(0.0f);
     particle_moment[i] = vec4(0.0f);
@@ -47,6 +46,7 @@ void main() {
   }
   float margin = impulse_margin(p.neighbour_skin);
   uint bi = particle_body[i];
+  vec4 xi = contact_particle(particle_pos[i], body_quat[bi], particle_local[i], p.flags);
   ImpulseBody own = impulse_body(bi);
   uint law_base = particle_material[i] * p.material_count;
   uint builds = neighbour_state[MOTES_NEIGHBOUR_BUILDS];
@@ -65,15 +65,16 @@ void main() {
       bool valid = !counting ||
                    impulse_slots_valid(own_stamp, impulse_stamp[j], particle_vel[j].w, builds);
       vec4 a = slotted && valid ? acc_read(slot) : vec4(0.0f);
-      vec4 xj = particle_pos[j];
-      vec4 r = pair_impulse(own, xi, impulse_body(particle_body[j]), xj, i < j, margin,
+      uint bj = particle_body[j];
+      vec4 xj = contact_particle(particle_pos[j], body_quat[bj], particle_local[j], p.flags);
+      vec3 arm;
+      vec4 r = pair_impulse(own, xi, impulse_body(bj), xj, i < j, margin,
                             contact_laws[pair_law_index(i, particle_material[i], j,
                                                          particle_material[j],
                                                          p.material_count)],
-                            p.gravity_dt, p.flags, a);
+                            p.gravity_dt, p.flags, a, arm);
       if (slotted) acc_write(slot, a);
-      impulse_add(sum, moment_sum, r, contact_acting_point(pair_contact_point(xi, xj), xi, p.flags),
-                  own.com);
+      impulse_add(sum, moment_sum, r, arm);
     }
   } else {
     uint lo[27];
@@ -84,15 +85,16 @@ void main() {
         if (contact_excluded(sorted_body[t], bi)) continue;
         uint j = grid_order[t];
         if (j >= p.rigid_particle_count) continue;
-        vec4 xj = particle_pos[j];
+        uint bj = particle_body[j];
+        vec4 xj = contact_particle(particle_pos[j], body_quat[bj], particle_local[j], p.flags);
         vec4 none = vec4(0.0f);  // no slot beyond the list's capacity
-        vec4 q = pair_impulse(own, xi, impulse_body(particle_body[j]), xj, i < j, margin,
+        vec3 arm;
+        vec4 q = pair_impulse(own, xi, impulse_body(bj), xj, i < j, margin,
                               contact_laws[pair_law_index(i, particle_material[i], j,
                                                           particle_material[j],
                                                           p.material_count)],
-                              p.gravity_dt, p.flags, none);
-        impulse_add(sum, moment_sum, q,
-                    contact_acting_point(pair_contact_point(xi, xj), xi, p.flags), own.com);
+                              p.gravity_dt, p.flags, none, arm);
+        impulse_add(sum, moment_sum, q, arm);
       }
     }
   }
@@ -100,12 +102,12 @@ void main() {
     PlaneData pl = planes[k];
     uint slot = (p.neighbour_capacity + k) * nr + i;
     vec4 a = acc_read(slot);
+    vec3 arm;
     vec4 r = plane_contact_impulse(own, xi, pl.normal_offset, margin,
-                                   contact_laws[law_base + pl.material], p.gravity_dt, p.flags, a);
+                                   contact_laws[law_base + pl.material], p.gravity_dt, p.flags, a,
+                                   arm);
     acc_write(slot, a);
-    impulse_add(sum, moment_sum, r,
-                contact_acting_point(plane_contact_point(xi, pl.normal_offset), xi, p.flags),
-                own.com);
+    impulse_add(sum, moment_sum, r, arm);
   }
   particle_force[i] = sum;
   particle_moment[i] = vec4(moment_sum, 0.0f);

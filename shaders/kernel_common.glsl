@@ -57,6 +57,7 @@ layout(std430, binding = B_CONTACT_IMPULSE_SPLIT) buffer ContactImpulseSplitBuf 
   vec4 contact_impulse_split[];
 };
 layout(std430, binding = B_IMPULSE_STAMP) buffer ImpulseStampBuf { uint impulse_stamp[]; };
+layout(std430, binding = B_BODY_POS_LOW) buffer BodyPosLowBuf { vec4 body_pos_low[]; };
 layout(std430, binding = B_MOTION_CHECK) buffer MotionCheckBuf { uint motion_check[]; };
 layout(std430, binding = B_LINK_EXCLUSIONS) readonly buffer LinkExclusionsBuf { uint link_exclusions[]; };
 layout(std430, binding = B_HALO_INDEX) readonly buffer HaloIndexBuf { uint halo_index[]; };

@@ -24,6 +24,7 @@ namespace {
 
 /// impulses_compute's inputs: those of every contact, and the bodies' state.
 struct ImpulseInputs : ContactInputs {
+  const vec4* __restrict__ local;
   const vec4* __restrict__ com;
   const vec4* __restrict__ quat;
   const vec4* __restrict__ inv_inertia;
@@ -47,7 +48,6 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
   const std::uint64_t t = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
   if (t >= p.rigid_particle_count) return;
   const auto i = static_cast<uint>(t);
-  const vec4 xi = in.pos[i];
   if (in.vel[i].w == 0.0f) {  // static particle: its impulse is never used
     impulse[i] = vec4(0.0f);
     moment[i] = vec4(0.0f);
@@ -55,6 +55,7 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
   }
   const float margin = shared::impulse_margin(p.neighbour_skin);
   const uint bi = in.body[i];
+  const vec4 xi = shared::contact_particle(in.pos[i], in.quat[bi], in.local[i], p.flags);
   const shared::ImpulseBody own = impulse_body(in, bi, p.flags);
   const shared::ContactLaw* law_row = in.laws + std::size_t{in.material[i]} * p.material_count;
   const uint builds = in.state[MOTES_NEIGHBOUR_BUILDS];
@@ -70,22 +71,22 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
   // accumulated impulse in slot `slot` (nullptr: none).
   const auto add_contact = [&](uint j, vec4* slot) {
     if (j >= p.rigid_particle_count) return;
-    const vec4 xj = in.pos[j];
-    const shared::ImpulseBody other = impulse_body(in, in.body[j], p.flags);
+    const uint bj = in.body[j];
+    const vec4 xj = shared::contact_particle(in.pos[j], in.quat[bj], in.local[j], p.flags);
+    const shared::ImpulseBody other = impulse_body(in, bj, p.flags);
     const bool valid =
         !counting || shared::impulse_slots_valid(own_stamp, stamp[j], in.vel[j].w, builds);
     vec4 a = slot != nullptr && valid ? *slot : vec4(0.0f);
+    vec3 arm;
     const vec4 r = shared::pair_impulse(
         own, xi, other, xj, i < j, margin,
         in.laws[shared::pair_law_index(i, in.material[i], j, in.material[j], p.material_count)],
-        p.gravity_dt, p.flags, a);
+        p.gravity_dt, p.flags, a, arm);
     if (slot != nullptr) {
       *slot = a;
       if (copy != nullptr) copy[slot - acc] = a;
     }
-    shared::impulse_add(
-        sum, moment_sum, r,
-        shared::contact_acting_point(shared::pair_contact_point(xi, xj), xi, p.flags), own.com);
+    shared::impulse_add(sum, moment_sum, r, arm);
   };
   const uint c = in.count[i];
   if (c <= p.neighbour_capacity) {
@@ -107,13 +108,11 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
     const shared::PlaneData pl = in.planes[k];
     const std::size_t at = (std::size_t{p.neighbour_capacity} + k) * nr + i;
     vec4& a = acc[at];
-    const vec4 r = shared::plane_contact_impulse(own, xi, pl.normal_offset, margin,
-                                                 law_row[pl.material], p.gravity_dt, p.flags, a);
+    vec3 arm;
+    const vec4 r = shared::plane_contact_impulse(
+        own, xi, pl.normal_offset, margin, law_row[pl.material], p.gravity_dt, p.flags, a, arm);
     if (copy != nullptr) copy[at] = a;
-    shared::impulse_add(sum, moment_sum, r,
-                        shared::contact_acting_point(
-                            shared::plane_contact_point(xi, pl.normal_offset), xi, p.flags),
-                        own.com);
+    shared::impulse_add(sum, moment_sum, r, arm);
   }
   impulse[i] = sum;
   moment[i] = vec4(moment_sum, 0.0f);
@@ -124,6 +123,7 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
 void CudaDevice::launch_impulses_compute(const shared::StepParams& p) {
   if (p.rigid_particle_count == 0) return;
   const ImpulseInputs in{contact_inputs(),
+                         buf<vec4>(Buffer::ParticleLocal),
                          buf<vec4>(Buffer::BodyPos),
                          buf<vec4>(Buffer::BodyQuat),
                          buf<vec4>(Buffer::BodyInvInertia),

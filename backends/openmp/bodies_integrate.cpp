@@ -1,7 +1,7 @@
 // bodies_integrate: one semi-implicit Euler step of every body (shared/body_math.h); with
 // MOTES_FLAG_IMPULSE_PUSH the pose moves with BodyVelPush and BodyAngMomPush (body_push_pose);
 // with MOTES_FLAG_IMPULSE_SPLIT with the body's velocities, which then take the push copies
-// (body_split_pose).
+// (body_split_pose); both move the centre as the pair BodyPos + BodyPosLow.
 #include <chrono>
 #include <cstdint>
 
@@ -27,8 +27,9 @@ void OpenMPDevice::bodies_integrate(const shared::StepParams& p) {
   if ((p.flags & MOTES_FLAG_IMPULSE_SPLIT) != 0u) {
     const vec4* vel_push = buf<vec4>(Buffer::BodyVelPush);
     const vec4* angmom_push = buf<vec4>(Buffer::BodyAngMomPush);
+    vec4* low = buf<vec4>(Buffer::BodyPosLow);
     for_items(bodies, parallel(bodies), [&](std::int64_t b) {
-      shared::body_split_pose(pos[b], quat[b], vel[b], angmom[b], angvel[b], inv_inertia[b],
+      shared::body_split_pose(pos[b], low[b], quat[b], vel[b], angmom[b], angvel[b], inv_inertia[b],
                               vel_push[b], angmom_push[b], p.gravity_dt);
     });
     record(Kernel::BodiesIntegrate, start);
@@ -37,9 +38,10 @@ void OpenMPDevice::bodies_integrate(const shared::StepParams& p) {
   if ((p.flags & MOTES_FLAG_IMPULSE_PUSH) != 0u) {
     const vec4* vel_push = buf<vec4>(Buffer::BodyVelPush);
     const vec4* angmom_push = buf<vec4>(Buffer::BodyAngMomPush);
+    vec4* low = buf<vec4>(Buffer::BodyPosLow);
     for_items(bodies, parallel(bodies), [&](std::int64_t b) {
-      shared::body_push_pose(pos[b], quat[b], angvel[b], inv_inertia[b], angmom[b], vel_push[b],
-                             angmom_push[b], p.gravity_dt);
+      shared::body_push_pose(pos[b], low[b], quat[b], angvel[b], inv_inertia[b], angmom[b],
+                             vel_push[b], angmom_push[b], p.gravity_dt);
     });
     record(Kernel::BodiesIntegrate, start);
     return;

@@ -67,6 +67,17 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     });
   }
   const shared::ImpulseBody* frames = impulse_frames_.data();
+  // Each rigid particle as its contacts take it (shared::contact_particle), made with the frames.
+  const bool positions = (p.flags & MOTES_FLAG_POSITION) != 0u;
+  if (!positions && (counting || impulse_points_.size() != std::size_t(n))) {
+    impulse_points_.resize(std::size_t(n));
+    vec4* points = impulse_points_.data();
+    const vec4* local = buf<vec4>(Buffer::ParticleLocal);
+    for_items(n, parallel(n), [&](std::int64_t i) {
+      points[i] = shared::contact_particle(in.pos[i], quat[in.body[i]], local[i], p.flags);
+    });
+  }
+  const vec4* xs = positions ? in.pos : impulse_points_.data();
   const auto impulse_body = [&](uint b) {
     shared::ImpulseBody s = frames[b];
     shared::impulse_body_state(s, body_vel[b], body_angvel[b], vel0[b], angvel0[b], p.flags);
@@ -108,7 +119,7 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
   const auto lower_pairs = [&](std::int64_t i, const std::uint8_t* active) {
     const uint c = in.count[i];
     if (in.vel[i].w == 0.0f || c > capacity) return;
-    const vec4 xi = in.pos[i];
+    const vec4 xi = xs[i];
     bool built = false;
     shared::ImpulseBody own;
     for (uint k = 0; k < c; ++k) {
@@ -124,7 +135,7 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
       vec4 a = acc[at];
       vec4 on_j;  // j's side, as pair_impulse gives it
       pair_r[at] = shared::pair_impulse_sides(
-          own, xi, impulse_body(in.body[j]), in.pos[j], uint(i) < j, margin,
+          own, xi, impulse_body(in.body[j]), xs[j], uint(i) < j, margin,
           in.laws[shared::pair_law_index(uint(i), in.material[i], j, in.material[j], materials)],
           p.gravity_dt, p.flags, a, on_j);
       pair_r[other_at] = on_j;
@@ -137,7 +148,7 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
   // pass that keeps its contacts (impulses_count_kept) only finds which particles touch.
   bool defer = false;
   const auto particle = [&](std::int64_t i) {
-    const vec4 xi = in.pos[i];
+    const vec4 xi = xs[i];
     if (in.vel[i].w == 0.0f) {  // static particle: its impulse is never used
       impulse[i] = vec4(0.0f);
       moment[i] = vec4(0.0f);
@@ -148,19 +159,18 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
       // Nothing within reach (the common case: most particles touch nothing): the result of the
       // full evaluation below, without building the bodies: every slot of a contact out of reach
       // is cleared, no impulse, no count.
-      const float reach_add = margin;
+      // The tests of pair_impulse and plane_contact_impulse, from the same numbers.
+      const shared::ImpulseBody& own_frame = frames[in.body[i]];
       bool touches = false;
       for (uint k = 0; k < c && !touches; ++k) {
         const uint j = in.list[std::size_t{k} * stride + std::size_t(i)];
         if (j >= p.rigid_particle_count) continue;
-        const vec4 xj = in.pos[j];
-        const vec3 d = shared::xyz(xi) - shared::xyz(xj);
-        const float dist2 = shared::dot(d, d);
-        const float reach = xi.w + xj.w + reach_add;
-        touches = dist2 < reach * reach && dist2 != 0.0f;
+        const shared::ContactPair pr =
+            shared::contact_pair(own_frame, xi, frames[in.body[j]], xs[j], uint(i) < j, p.flags);
+        touches = shared::pair_within_reach(pr.xa, pr.xb, margin);
       }
       for (uint k = 0; k < p.plane_count && !touches; ++k) {
-        const vec4 no = in.planes[k].normal_offset;
+        const vec4 no = shared::contact_plane(in.planes[k].normal_offset, own_frame, p.flags);
         touches = shared::dot(shared::xyz(no), shared::xyz(xi)) - no.w - xi.w < margin;
       }
       if (!touches) {
@@ -190,26 +200,28 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     // accumulated impulse in slot `slot` (nullptr: none).
     auto add_contact = [&](uint j, vec4* slot) {
       if (j >= p.rigid_particle_count) return;
-      const vec4 xj = in.pos[j];
+      const vec4 xj = xs[j];
       const shared::ImpulseBody other = impulse_body(in.body[j]);
       const bool valid =
           !counting || shared::impulse_slots_valid(own_stamp, stamp[j], in.vel[j].w, builds);
       vec4 a = slot != nullptr && valid ? *slot : vec4(0.0f);
+      vec3 arm;
       const vec4 r = shared::pair_impulse(
           own, xi, other, xj, static_cast<uint>(i) < j, margin,
           in.laws[shared::pair_law_index(uint(i), in.material[i], j, in.material[j], materials)],
-          p.gravity_dt, p.flags, a);
+          p.gravity_dt, p.flags, a, arm);
       if (slot != nullptr) keep(std::size_t(slot - acc), a);
-      shared::impulse_add(
-          sum, moment_sum, r,
-          shared::contact_acting_point(shared::pair_contact_point(xi, xj), xi, p.flags), own.com);
+      shared::impulse_add(sum, moment_sum, r, arm);
     };
     if (c <= capacity) {
       for (uint k = 0; k < c; ++k) {
         const uint j = in.list[std::size_t{k} * stride + std::size_t(i)];
         if (pairs_once && mirror[std::size_t{k} * nr + std::size_t(i)] != kNoMirror) {
+          const bool own_first = uint(i) < j;
+          const shared::ContactPair pr =
+              shared::contact_pair(own, xi, frames[in.body[j]], xs[j], own_first, p.flags);
           shared::impulse_add(sum, moment_sum, pair_r[std::size_t{k} * nr + std::size_t(i)],
-                              shared::pair_contact_point(xi, in.pos[j]), own.com);
+                              shared::pair_contact_arm(pr, !own_first, p.flags));
           continue;
         }
         const bool slotted =
@@ -227,13 +239,11 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
       const shared::PlaneData pl = in.planes[k];
       const std::size_t at = (std::size_t{capacity} + k) * nr + std::size_t(i);
       vec4 a = acc[at];
-      const vec4 r = shared::plane_contact_impulse(own, xi, pl.normal_offset, margin,
-                                                   law_row[pl.material], p.gravity_dt, p.flags, a);
+      vec3 arm;
+      const vec4 r = shared::plane_contact_impulse(
+          own, xi, pl.normal_offset, margin, law_row[pl.material], p.gravity_dt, p.flags, a, arm);
       keep(at, a);
-      shared::impulse_add(sum, moment_sum, r,
-                          shared::contact_acting_point(
-                              shared::plane_contact_point(xi, pl.normal_offset), xi, p.flags),
-                          own.com);
+      shared::impulse_add(sum, moment_sum, r, arm);
     }
     impulse[i] = sum;
     moment[i] = vec4(moment_sum, 0.0f);

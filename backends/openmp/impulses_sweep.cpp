@@ -36,6 +36,7 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
   const uint materials = p.material_count;
   const float margin = shared::impulse_margin(p.neighbour_skin);
   const ContactInputs in = contact_inputs();
+  const vec4* xs = impulse_points_.data();  // shared::contact_particle, made by impulses_compute
   const uint* stamp = buf<uint>(Buffer::ImpulseStamp);
   const uint builds = buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_BUILDS];
   // A correcting sweep of split impulses starts from ContactImpulseSplit (impulses_compute).
@@ -79,7 +80,7 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
       continue;
     }
     const std::size_t before = impulse_entries_.size();
-    const vec4 xi = in.pos[i];
+    const vec4 xi = xs[i];
     const uint c = in.count[i];
     for (uint k = 0; k < c; ++k) {
       const uint j = in.list[std::size_t{k} * stride + i];
@@ -95,15 +96,11 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
         }
         continue;
       }
-      // particle_contact_impulse's test and frame, the lower id as a.
+      // pair_impulse's pair, test and frame, the lower id as a.
       const bool own_first = i < j;
-      const vec4 xa = own_first ? xi : in.pos[j];
-      const vec4 xb = own_first ? in.pos[j] : xi;
-      const vec3 d = shared::xyz(xa) - shared::xyz(xb);
-      const float dist2 = shared::dot(d, d);
-      const float rsum = xa.w + xb.w;
-      const float reach = rsum + margin;
-      const bool near = !(dist2 >= reach * reach || dist2 == 0.0f);
+      const shared::ContactPair pr = shared::contact_pair(
+          bodies[in.body[i]], xi, bodies[in.body[j]], xs[j], own_first, p.flags);
+      const bool near = shared::pair_within_reach(pr.xa, pr.xb, margin);
       const bool slotted = shared::impulse_pair_slotted(c, in.count[j], capacity);
       if (m != kNone) {
         slot_contact[std::size_t{m} * nr + j] = near ? uint(impulse_contacts_.size()) : kNone;
@@ -112,7 +109,9 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
         if (counting && slotted) acc[at] = vec4(0.0f);  // particle_contact_impulse's clearing
         continue;
       }
-      const float dist = shared::sqrt(dist2);
+      const vec3 d = shared::xyz(pr.xa) - shared::xyz(pr.xb);
+      const float rsum = pr.xa.w + pr.xb.w;
+      const float dist = shared::sqrt(shared::dot(d, d));
       const uint index = uint(impulse_contacts_.size());
       ImpulseContact& ct = impulse_contacts_.emplace_back();
       ct.a = own_first ? in.body[i] : in.body[j];
@@ -124,15 +123,16 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
       const bool warm =
           !counting || shared::impulse_slots_valid(stamp[i], stamp[j], in.vel[j].w, builds);
       contact_lane_start(
-          lane(index), int(index % kContactLanes), ct.a, ct.b, shared::pair_contact_point(xa, xb),
-          d / dist, dist - rsum, rsum, bodies[ct.a], bodies[ct.b],
+          lane(index), int(index % kContactLanes), ct.a, ct.b,
+          shared::pair_contact_point(pr.xa, pr.xb), d / dist, dist - rsum, rsum, pr.a, pr.b,
           in.laws[shared::pair_law_index(i, in.material[i], j, in.material[j], materials)],
           ct.slot != kNone && warm ? acc[ct.slot] : vec4(0.0f));
       impulse_entries_.push_back(index * 2u + (own_first ? 0u : 1u));
     }
     const uint own_law = in.material[i] * materials;
     for (uint k = 0; k < p.plane_count; ++k) {
-      const vec4 no = in.planes[k].normal_offset;
+      const vec4 no =
+          shared::contact_plane(in.planes[k].normal_offset, bodies[in.body[i]], p.flags);
       const float sep = shared::dot(shared::xyz(no), shared::xyz(xi)) - no.w - xi.w;
       const std::size_t slot = (std::size_t{capacity} + k) * nr + i;
       if (sep >= margin) {  // plane_contact_impulse's test and clearing
@@ -147,8 +147,8 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
       ct.mirror = kNone;
       contact_lane_start(lane(index), int(index % kContactLanes), ct.a, ct.b,
                          shared::plane_contact_point(xi, no), shared::xyz(no), sep, xi.w,
-                         bodies[ct.a], bodies[wall], in.laws[own_law + in.planes[k].material],
-                         acc[slot]);
+                         shared::contact_body(bodies[ct.a], p.flags), bodies[wall],
+                         in.laws[own_law + in.planes[k].material], acc[slot]);
       impulse_entries_.push_back(index * 2u);
     }
     // A particle that touches something has a contact entry; one that does not has had its

@@ -180,6 +180,7 @@ void OpenMPDevice::forget_impulse_passes() {
   impulse_active_.clear();
   impulse_body_active_.clear();
   impulse_frames_.clear();
+  impulse_points_.clear();
   impulse_contacts_ready_ = false;
   impulse_acc_pending_ = false;  // written back already, or its buffer made anew (allocate)
 }

@@ -41,6 +41,7 @@ static_assert(B_HALO_DATA == static_cast<int>(Buffer::HaloData));
 static_assert(B_PARTITION_REF_POS == static_cast<int>(Buffer::PartitionRefPos));
 static_assert(B_PARTITION_CHECK == static_cast<int>(Buffer::PartitionCheck));
 static_assert(B_CONTACT_IMPULSE_SPLIT == static_cast<int>(Buffer::ContactImpulseSplit));
+static_assert(B_BODY_POS_LOW == static_cast<int>(Buffer::BodyPosLow));
 static_assert(B_BODY_VEL_PUSH == static_cast<int>(Buffer::BodyVelPush));
 static_assert(B_BODY_ANGMOM_PUSH == static_cast<int>(Buffer::BodyAngMomPush));
 static_assert(B_ENERGY_PARTIALS == static_cast<int>(Buffer::EnergyPartials));

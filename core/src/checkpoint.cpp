@@ -9,8 +9,9 @@
 //     u64 length + bytes, only when it is not empty);
 //   sections: {the buffer's name (buffer_name, 32 bytes padded with zeros), u32 element bytes,
 //     u32 0, u64 bytes, the buffer's first `bytes` bytes}, one per buffer of state_buffers(), in
-//     that order, in the device's order (the same on every backend): 17, and an 18th
-//     (PartitionRefPos) for one rank of a run over MPI ranks;
+//     that order, in the device's order (the same on every backend): 18 (17 in files written
+//     before BodyPosLow, still read), and PartitionRefPos after them for one rank of a run over
+//     MPI ranks;
 //   checksum: FNV-1a 64 of every byte before it.
 // Version 2 (still read): the same, but each section starts {u32 buffer, u32 element bytes, u64
 // bytes} with the buffer's number in the Buffer enum as it was then (kVersion2Buffers), so that
@@ -67,14 +68,16 @@ constexpr std::size_t kV1HeaderBytes = 48;
 /// (docs/architecture.md, "The step"). Not here: the fixed inputs (covered by the setup hash),
 /// forces (written before they are read in every substep) and GridBucket and SortedPos (read only
 /// by the list build that rewrites them).
-/// The impulse contacts' history (ContactImpulse, ImpulseStamp) came last: files written before
-/// it have kSectionsBeforeImpulses sections and are read when those buffers are empty.
-constexpr std::array<Buffer, 17> kStateBuffers = {
+/// The impulse contacts' history (ContactImpulse, ImpulseStamp) came later: files written before
+/// it have kSectionsBeforeImpulses sections and are read when those buffers are empty. The
+/// centres' parts below their floats (BodyPosLow) came last: files without that section are
+/// read with zeros there.
+constexpr std::array<Buffer, 18> kStateBuffers = {
     Buffer::ParticlePos,     Buffer::ParticleVel,    Buffer::BodyPos,       Buffer::BodyQuat,
     Buffer::BodyVel,         Buffer::BodyAngMom,     Buffer::BodyAngVel,    Buffer::ClusterFrames,
     Buffer::NeighbourRefPos, Buffer::NeighbourState, Buffer::NeighbourList, Buffer::NeighbourCount,
     Buffer::GridOrder,       Buffer::GridCellStart,  Buffer::SortedBody,    Buffer::ContactImpulse,
-    Buffer::ImpulseStamp,
+    Buffer::ImpulseStamp,    Buffer::BodyPosLow,
 };
 constexpr std::size_t kSectionsBeforeImpulses = 15;
 // load_state checks these sections by position.
@@ -575,9 +578,15 @@ Status Simulation::load_state(const std::string& path) {
   };
   // A rank's checkpoint of a run over MPI ranks ends with the partition reference; a single
   // process's has none.
-  const std::vector<Buffer> expected = state_buffers(sizes_);
-  const bool with_reference = sections.size() == kStateBuffers.size() + 1 &&
-                              sections.back().buffer == Buffer::PartitionRefPos;
+  std::vector<Buffer> expected = state_buffers(sizes_);
+  // A file written before BodyPosLow was saved: zeros there.
+  const bool with_low = std::any_of(sections.begin(), sections.end(), [](const Section& s) {
+    return s.buffer == Buffer::BodyPosLow;
+  });
+  if (!with_low) expected.erase(std::find(expected.begin(), expected.end(), Buffer::BodyPosLow));
+  const std::size_t state_sections = kStateBuffers.size() - (with_low ? 0 : 1);
+  const bool with_reference =
+      sections.size() == state_sections + 1 && sections.back().buffer == Buffer::PartitionRefPos;
   if (sizes_.partition != 0 && !with_reference) {
     return Status::error(fmt::format(
         "{}: a single process's checkpoint: this simulation is one rank of a run over MPI ranks, "
@@ -660,6 +669,11 @@ Status Simulation::load_state(const std::string& path) {
     if (Status s = d.write(expected[k], bytes.data() + sections[k].offset, sections[k].bytes); !s) {
       return s;
     }
+  }
+  if (const std::size_t low = buffer_layout(Buffer::BodyPosLow, sizes_).bytes();
+      !with_low && low != 0) {
+    const std::vector<unsigned char> zeros(low, 0);
+    if (Status s = d.write(Buffer::BodyPosLow, zeros.data(), zeros.size()); !s) return s;
   }
   if (Status s = d.synchronize(); !s) return s;
   steps_ = h.step;

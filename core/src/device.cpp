@@ -93,6 +93,8 @@ const char* buffer_name(Buffer b) {
       return "ContactImpulse";
     case Buffer::ContactImpulseSplit:
       return "ContactImpulseSplit";
+    case Buffer::BodyPosLow:
+      return "BodyPosLow";
     case Buffer::ImpulseStamp:
       return "ImpulseStamp";
     case Buffer::MotionCheck:
@@ -230,6 +232,7 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
     case Buffer::BodyAngVelStart:
     case Buffer::BodyVelPush:
     case Buffer::BodyAngMomPush:
+    case Buffer::BodyPosLow:
       return {kVec4, s.impulse != 0 ? std::size_t{s.bodies} : 0};
     case Buffer::ContactImpulse:
     case Buffer::ContactImpulseSplit:

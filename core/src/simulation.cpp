@@ -76,6 +76,9 @@ Status write_layout(Device& d, const layout::HostLayout& host) {
   };
   // A rank of a run over MPI ranks: the partition's reference positions.
   if (host.sizes.partition != 0) uploads.push_back(of(Buffer::PartitionRefPos, p.pos));
+  // Impulse contacts: every centre of mass starts as its float (nothing below it).
+  const std::vector<vec4> low(host.sizes.impulse != 0 ? r.pos.size() : 0, vec4(0.0f));
+  if (!low.empty()) uploads.push_back(of(Buffer::BodyPosLow, low));
   Status s = d.allocate(host.sizes);
   for (const Upload& u : uploads) {
     if (!s) break;
@@ -453,6 +456,8 @@ Result<Snapshot> Simulation::snapshot() {
   if (st) st = read_vector(d, Buffer::BodyVel, bvel, nb);
   if (st) st = read_vector(d, Buffer::BodyAngMom, bangmom, nb);
   if (st) st = read_vector(d, Buffer::BodyAngVel, bangvel, nb);
+  std::vector<vec4> blow;
+  if (st && sizes_.impulse != 0) st = read_vector(d, Buffer::BodyPosLow, blow, nb);
   std::vector<shared::ClusterFrame> frames;
   if (st) st = read_vector(d, Buffer::ClusterFrames, frames, sizes_.clusters);
   if (!st) return st;
@@ -471,6 +476,7 @@ Result<Snapshot> Simulation::snapshot() {
   s.body_vel.resize(scene_bodies);
   s.body_angmom.resize(scene_bodies);
   s.body_angvel.resize(scene_bodies);
+  if (sizes_.impulse != 0) s.body_pos_low.assign(scene_bodies, vec4(0.0f));
   for (std::size_t b = 0; b < scene_bodies; ++b) {
     const BodyInfo& info = bodies_[b];
     const std::uint32_t at = device_index_[b];
@@ -511,6 +517,7 @@ Result<Snapshot> Simulation::snapshot() {
     s.body_vel[b] = bvel[at];
     s.body_angmom[b] = bangmom[at];
     s.body_angvel[b] = bangvel[at];
+    if (!blow.empty()) s.body_pos_low[b] = blow[at];
   }
   for (const auto& [b, q] : sphere_turns_) s.body_quat[b] = q;
   return s;
@@ -571,6 +578,8 @@ Status Simulation::restore(const Snapshot& state, bool rebuild) {
   const std::size_t n = sizes_.particles;
   const std::size_t nb = sizes_.bodies;
   std::vector<vec4> ppos(n), pvel(n), bpos(nb), bquat(nb), bvel(nb), bangmom(nb), bangvel(nb);
+  std::vector<vec4> blow(sizes_.impulse != 0 ? nb : 0, vec4(0.0f));
+  const bool with_low = state.body_pos_low.size() == bodies_.size();
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     const BodyInfo& info = bodies_[b];
     const std::uint32_t at = device_index_[b];
@@ -586,6 +595,7 @@ Status Simulation::restore(const Snapshot& state, bool rebuild) {
     bvel[at] = state.body_vel[b];
     bangmom[at] = state.body_angmom[b];
     bangvel[at] = state.body_angvel[b];
+    if (with_low && !blow.empty()) blow[at] = state.body_pos_low[b];
   }
   const std::uint32_t neighbour_state[4] = {1u, 0u, 0u, 0u};  // rebuild at the next step
   Status s = write_vector(d, Buffer::ParticlePos, ppos);
@@ -595,6 +605,7 @@ Status Simulation::restore(const Snapshot& state, bool rebuild) {
   if (s) s = write_vector(d, Buffer::BodyVel, bvel);
   if (s) s = write_vector(d, Buffer::BodyAngMom, bangmom);
   if (s) s = write_vector(d, Buffer::BodyAngVel, bangvel);
+  if (s && !blow.empty()) s = write_vector(d, Buffer::BodyPosLow, blow);
   if (s && !rebuild && sizes_.partition != 0) s = write_vector(d, Buffer::PartitionRefPos, ppos);
   if (s && rebuild) s = d.write(Buffer::NeighbourState, neighbour_state, sizeof neighbour_state);
   if (s && rebuild) s = clear_contact_history();

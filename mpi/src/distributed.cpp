@@ -78,7 +78,7 @@ Status status_of(const Result<T>& r) {
   return r ? Status::ok() : r.status();
 }
 
-/// A record on the wire: (body, particles, cluster rotations, plane impulses) as bits, the five
+/// A record on the wire: (body, particles, cluster rotations, plane impulses) as bits, the six
 /// body vectors, the positions, the velocities, the rotations, the plane impulses.
 void append(std::vector<vec4>& out, const Record& r) {
   const auto bits = [](std::size_t n) {
@@ -109,8 +109,8 @@ std::vector<Record> parse(const std::vector<vec4>& in, const std::vector<int>* c
     const std::size_t n = std::bit_cast<std::uint32_t>(in[at].y);
     const std::size_t c = std::bit_cast<std::uint32_t>(in[at].z);
     const std::size_t q = std::bit_cast<std::uint32_t>(in[at].w);
-    std::copy_n(in.begin() + static_cast<std::ptrdiff_t>(at + 1), 5, r.state.begin());
-    auto next = in.begin() + static_cast<std::ptrdiff_t>(at + 6);
+    std::copy_n(in.begin() + static_cast<std::ptrdiff_t>(at + 1), r.state.size(), r.state.begin());
+    auto next = in.begin() + static_cast<std::ptrdiff_t>(at + 1 + r.state.size());
     const auto take = [&next](std::vector<vec4>& v, std::size_t count) {
       v.assign(next, next + static_cast<std::ptrdiff_t>(count));
       next += static_cast<std::ptrdiff_t>(count);
@@ -119,7 +119,7 @@ std::vector<Record> parse(const std::vector<vec4>& in, const std::vector<int>* c
     take(r.vel, n);
     take(r.rotations, c);
     take(r.planes, q);
-    at += 6 + 2 * n + c + q;
+    at += 1 + r.state.size() + 2 * n + c + q;
     records.push_back(std::move(r));
     if (source != nullptr) source->push_back(static_cast<int>(rank));
   }
@@ -371,8 +371,10 @@ Result<std::vector<Record>> DistributedSimulation::owned_records() {
     const BodyInfo& info = infos[k];
     Record r;
     r.body = local_bodies_[k];
-    r.state = {snap->body_pos[k], snap->body_quat[k], snap->body_vel[k], snap->body_angmom[k],
-               snap->body_angvel[k]};
+    r.state = {
+        snap->body_pos[k],    snap->body_quat[k],
+        snap->body_vel[k],    snap->body_angmom[k],
+        snap->body_angvel[k], snap->body_pos_low.empty() ? vec4(0.0f) : snap->body_pos_low[k]};
     const auto p = snap->particle_pos.begin() + info.first_particle;
     const auto v = snap->particle_vel.begin() + info.first_particle;
     r.pos.assign(p, p + info.particle_count);
@@ -756,6 +758,7 @@ Status DistributedSimulation::write_records(const std::vector<LocalEntry>& entri
     state.body_vel.push_back(r.state[2]);
     state.body_angmom.push_back(r.state[3]);
     state.body_angvel.push_back(r.state[4]);
+    state.body_pos_low.push_back(r.state[5]);
     if (r.rotations.size() != infos[k].cluster_count) {
       return Status::error(fmt::format("body {}: {} cluster rotations for {} clusters", r.body,
                                        r.rotations.size(), infos[k].cluster_count));
@@ -918,6 +921,7 @@ Result<Snapshot> DistributedSimulation::gather(int root) {
   s.body_vel.resize(nb);
   s.body_angmom.resize(nb);
   s.body_angvel.resize(nb);
+  s.body_pos_low.resize(nb);
   std::vector<char> seen(nb, 0);
   for (const Record& r : parse(all)) {
     const BodyInfo& info = bodies_[r.body];
@@ -933,6 +937,7 @@ Result<Snapshot> DistributedSimulation::gather(int root) {
     s.body_vel[r.body] = r.state[2];
     s.body_angmom[r.body] = r.state[3];
     s.body_angvel[r.body] = r.state[4];
+    s.body_pos_low[r.body] = r.state[5];
   }
   for (std::size_t b = 0; b < nb; ++b) {
     if (seen[b] == 0) return Status::error(fmt::format("gather: body {} has no owner", b));

@@ -15,7 +15,8 @@
 #   properties: the seeded random impulse scenes (tests/properties), and the same scenes with
 #     position contacts (RandomPositionScenes), on CUDA and Vulkan,
 #     MOTES_PROPERTY_SEEDS per kind and backend (default 500) in batches of MOTES_PROPERTY_BATCH
-#     (default 250), and the kept seeds, into properties.txt; LIMIT_PROPERTIES seconds each backend
+#     (default 250), the kept seeds and the far ones (FarImpulseScenes), into properties.txt;
+#     LIMIT_PROPERTIES seconds each backend
 #   unit: the unit tests' CUDA cases (checkpoint resume on CUDA, the CLI on CUDA), into unit.txt
 #   scenes: every examples/scenes/*.json to its end (its settings.duration) on CUDA and on Vulkan
 #     with the validation layer (MOTES_SCENE_BACKENDS, default "cuda vulkan"), one after another,
@@ -86,7 +87,7 @@ if [[ " $parts " == *" properties "* ]]; then
     MOTES_VULKAN_VALIDATION=0 MOTES_PROPERTY_SEEDS=${MOTES_PROPERTY_SEEDS:-500} \
       MOTES_PROPERTY_BATCH=${MOTES_PROPERTY_BATCH:-250} TAIL_LINES=30 \
       part "${LIMIT_PROPERTIES:-240}" properties motes_property_tests --gtest_brief=1 \
-      --gtest_filter="*/${backend}_*:*KeptImpulseSeeds*/${backend}" ||
+      --gtest_filter="*/${backend}_*:*KeptImpulseSeeds*/${backend}:*FarImpulseScenes*/${backend}" ||
       status=1
   done
 fi

@@ -66,30 +66,47 @@ MOTES_FN void body_integrate(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
 /// body's own: with MOTES_FLAG_IMPULSE_PUSH the impulse stage moves a body with the velocities its
 /// sweeps with position correction left (vel_push, angmom_push) and keeps the relaxed ones
 /// (shared/impulse.h); w then comes from the body's own angular momentum at the new orientation.
-MOTES_FN void body_push_pose(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
-                             MOTES_OUT(vec4) angvel, vec4 inv_inertia, vec4 angmom, vec4 vel_push,
-                             vec4 angmom_push, vec4 gravity_dt) {
+/// The centre moves as a pair of floats, pos_invm and low (BodyPosLow): the move and what earlier
+/// moves' rounding lost are added to it and what this addition's rounding loses is kept in low
+/// (compensated summation), so that moves smaller than the spacing of floats at the centre add up
+/// instead of vanishing. 50 m from the origin floats are 3.8 um apart, and a resting body's moves
+/// are far smaller: its centre stuck while it turned, and chains and piles there jittered
+/// (docs/architecture.md, "Impulse contacts").
+MOTES_FN void body_push_pose(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) low,
+                             MOTES_INOUT(vec4) quat, MOTES_OUT(vec4) angvel, vec4 inv_inertia,
+                             vec4 angmom, vec4 vel_push, vec4 angmom_push, vec4 gravity_dt) {
   vec4 v = vel_push;
   vec4 l = angmom_push;
   vec4 w = vec4(0.0f);
+  vec3 start = xyz(pos_invm);
   body_integrate(pos_invm, quat, v, l, w, inv_inertia, vec4(0.0f), vec4(0.0f), gravity_dt,
                  MOTES_FLAG_BODY_POSE);
-  angvel = pos_invm.w == 0.0f ? vec4(0.0f)
-                              : vec4(body_angular_velocity(quat, inv_inertia, xyz(angmom)), 0.0f);
+  if (pos_invm.w == 0.0f) {
+    angvel = vec4(0.0f);
+    return;
+  }
+  // The move's products rounded on their own (mul_rn), so that every backend keeps the same low.
+  float dt = gravity_dt.w;
+  vec3 move = vec3(mul_rn(vel_push.x, dt), mul_rn(vel_push.y, dt), mul_rn(vel_push.z, dt));
+  vec3 lost;
+  vec3 x = add_exact(start, move + xyz(low), lost);
+  pos_invm = vec4(x, pos_invm.w);
+  low = vec4(lost, 0.0f);
+  angvel = vec4(body_angular_velocity(quat, inv_inertia, xyz(angmom)), 0.0f);
 }
 
 /// Split impulses' pose (MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_SPLIT): the body moves with
 /// the velocities it has (those the correcting sweeps left) and then keeps vel_push and
 /// angmom_push (those the relaxing sweeps left, which never saw the position correction).
-MOTES_FN void body_split_pose(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) quat,
-                              MOTES_INOUT(vec4) vel, MOTES_INOUT(vec4) angmom,
-                              MOTES_OUT(vec4) angvel, vec4 inv_inertia, vec4 vel_push,
-                              vec4 angmom_push, vec4 gravity_dt) {
+MOTES_FN void body_split_pose(MOTES_INOUT(vec4) pos_invm, MOTES_INOUT(vec4) low,
+                              MOTES_INOUT(vec4) quat, MOTES_INOUT(vec4) vel,
+                              MOTES_INOUT(vec4) angmom, MOTES_OUT(vec4) angvel, vec4 inv_inertia,
+                              vec4 vel_push, vec4 angmom_push, vec4 gravity_dt) {
   vec4 v = vel;
   vec4 l = angmom;
   vel = vel_push;
   angmom = angmom_push;
-  body_push_pose(pos_invm, quat, angvel, inv_inertia, angmom, v, l, gravity_dt);
+  body_push_pose(pos_invm, low, quat, angvel, inv_inertia, angmom, v, l, gravity_dt);
 }
 
 /// One semi-implicit Euler step of a free particle (a one-particle body that does not spin), the

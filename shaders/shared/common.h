@@ -113,6 +113,15 @@ MOTES_FN float mul_rn(float a, float b) {
 MOTES_FN float mul_rn(float a, float b) { return a * b; }
 #endif
 
+/// a + b rounded, and in err what the rounding lost, exactly (Knuth's TwoSum: six operations in
+/// the order written, which no compiler may reorder; GLSL marks them `precise`).
+MOTES_FN vec3 add_exact(vec3 a, vec3 b, MOTES_OUT(vec3) err) {
+  vec3 s = a + b;
+  vec3 bb = s - a;
+  err = (a - (s - bb)) + (b - bb);
+  return s;
+}
+
 MOTES_SHARED_END
 
 #else  // GLSL
@@ -129,6 +138,13 @@ vec4 choose(bool c, vec4 a, vec4 b) { return c ? a : b; }
 float mul_rn(float a, float b) {
   precise float r = a * b;
   return r;
+}
+vec3 add_exact(vec3 a, vec3 b, out vec3 err) {
+  precise vec3 s = a + b;
+  precise vec3 bb = s - a;
+  precise vec3 e = (a - (s - bb)) + (b - bb);
+  err = e;
+  return s;
 }
 
 #endif

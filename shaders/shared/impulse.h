@@ -244,6 +244,15 @@ MOTES_FN vec4 contact_impulse(MOTES_IN(ImpulseBody) a, MOTES_IN(ImpulseBody) b, 
   return contact_solve(a, b, f, law, flags, acc);
 }
 
+/// True when particles xa and xb (w: radii) are within reach of a contact: their gap below margin
+/// (impulse_margin) and their centres apart.
+MOTES_FN bool pair_within_reach(vec4 xa, vec4 xb, float margin) {
+  vec3 d = xyz(xa) - xyz(xb);
+  float dist2 = dot(d, d);
+  float reach = xa.w + xb.w + margin;
+  return !(dist2 >= reach * reach || dist2 == 0.0f);
+}
+
 /// The impulse on body a of particle a (centre xa, radius ra) touching particle b, as a change of
 /// the contact's accumulated impulse acc (contact_impulse). The pair is always evaluated in the
 /// order (lower particle id first), so that the two particles of a contact compute bitwise
@@ -254,15 +263,13 @@ MOTES_FN vec4 particle_contact_impulse(MOTES_IN(ImpulseBody) a, vec4 xa, MOTES_I
                                        vec4 xb, float margin, ContactLaw law, vec4 gravity_dt,
                                        uint flags, MOTES_INOUT(vec4) acc, MOTES_OUT(float) stack) {
   stack = 1.0f;
-  vec3 d = xyz(xa) - xyz(xb);
-  float dist2 = dot(d, d);
-  float rsum = xa.w + xb.w;
-  float reach = rsum + margin;
-  if (dist2 >= reach * reach || dist2 == 0.0f) {
+  if (!pair_within_reach(xa, xb, margin)) {
     acc = vec4(0.0f);  // zero already in the iterations: positions do not change within them
     return vec4(0.0f);
   }
-  float dist = sqrt(dist2);
+  vec3 d = xyz(xa) - xyz(xb);
+  float rsum = xa.w + xb.w;
+  float dist = sqrt(dot(d, d));
   return contact_impulse(a, b, pair_contact_point(xa, xb), d / dist, dist - rsum, rsum, law,
                          gravity_dt, flags, acc, stack);
 }
@@ -297,6 +304,68 @@ MOTES_FN uint pair_law_index(uint i, uint mi, uint j, uint mj, uint materials) {
   return i < j ? mi * materials + mj : mj * materials + mi;
 }
 
+/// A rigid particle as impulse contacts take it (w: its radius): its offset from its body's
+/// centre, R local, not its position. A pair's geometry is then the difference of the bodies'
+/// centres (exact for bodies nearer each other than to the origin) and of two small offsets, as
+/// precise far from the origin as near it. Positions 50 m out are 3.8 um apart in float, a fifth
+/// of the slop, and rounding each particle's position on its own made resting chains and piles
+/// creep there (docs/architecture.md, "Impulse contacts"). Position contacts
+/// (MOTES_FLAG_POSITION), whose sweeps read positions that the poses have not made, take the
+/// position.
+MOTES_FN vec4 contact_particle(vec4 pos, vec4 quat, vec4 local, uint flags) {
+  return (flags & MOTES_FLAG_POSITION) != 0u ? pos : vec4(quat_rotate(quat, xyz(local)), pos.w);
+}
+
+/// A body as the impulse contacts of one of its particles (contact_particle) see it: its centre at
+/// the origin. Position contacts: as it is.
+MOTES_FN ImpulseBody contact_body(MOTES_IN(ImpulseBody) b, uint flags) {
+  ImpulseBody o = b;
+  if ((flags & MOTES_FLAG_POSITION) == 0u) o.com = vec4(0.0f, 0.0f, 0.0f, b.com.w);
+  return o;
+}
+
+/// A pair of rigid particles as particle_contact_impulse evaluates it: the lower id first (a).
+struct ContactPair {
+  ImpulseBody a;
+  ImpulseBody b;
+  vec4 xa;
+  vec4 xb;
+};
+
+/// Particle xi of body own and xj of body other (contact_particle), the lower id first (own_first:
+/// xi's), placed for impulse contacts with a's centre at the origin: xa its offset, b's centre at
+/// com_b - com_a and xb there plus its offset. Both particles of the pair make the same bits.
+MOTES_FN ContactPair contact_pair(MOTES_IN(ImpulseBody) own, vec4 xi, MOTES_IN(ImpulseBody) other,
+                                  vec4 xj, bool own_first, uint flags) {
+  ContactPair pr;
+  if (own_first) {
+    pr.a = own;
+    pr.b = other;
+    pr.xa = xi;
+    pr.xb = xj;
+  } else {
+    pr.a = other;
+    pr.b = own;
+    pr.xa = xj;
+    pr.xb = xi;
+  }
+  if ((flags & MOTES_FLAG_POSITION) == 0u) {
+    vec3 shift = xyz(pr.b.com) - xyz(pr.a.com);
+    pr.a.com = vec4(0.0f, 0.0f, 0.0f, pr.a.com.w);
+    pr.b.com = vec4(shift, pr.b.com.w);
+    pr.xb = vec4(shift + xyz(pr.xb), pr.xb.w);
+  }
+  return pr;
+}
+
+/// Where the contact of a pair (contact_pair) acts on its particle of the lower id's side (side_b
+/// false) or the other's, about that side's centre (contact_acting_point).
+MOTES_FN vec3 pair_contact_arm(MOTES_IN(ContactPair) pr, bool side_b, uint flags) {
+  vec3 c = pair_contact_point(pr.xa, pr.xb);
+  return side_b ? contact_acting_point(c, pr.xb, flags) - xyz(pr.b.com)
+                : contact_acting_point(c, pr.xa, flags) - xyz(pr.a.com);
+}
+
 /// pair_impulse's impulse contact, both sides at once: the impulse on body `own` returned, the one
 /// on body `other` in other_side (the openmp sweeps evaluate a contact once for both particles).
 /// Each is its side's share of the contact's impulse (contact_stack_scale: the lower body's is
@@ -306,22 +375,24 @@ MOTES_FN vec4 pair_impulse_sides(MOTES_IN(ImpulseBody) own, vec4 xi, MOTES_IN(Im
                                  vec4 gravity_dt, uint flags, MOTES_INOUT(vec4) acc,
                                  MOTES_OUT(vec4) other_side) {
   float stack = 1.0f;
-  vec4 r = own_first ? particle_contact_impulse(own, xi, other, xj, margin, law, gravity_dt, flags,
-                                                acc, stack)
-                     : particle_contact_impulse(other, xj, own, xi, margin, law, gravity_dt, flags,
-                                                acc, stack);
+  ContactPair pr = contact_pair(own, xi, other, xj, own_first, flags);
+  vec4 r = particle_contact_impulse(pr.a, pr.xa, pr.b, pr.xb, margin, law, gravity_dt, flags, acc,
+                                    stack);
   vec4 on_a = contact_side_impulse(r, stack, false);  // the lower id's side
   vec4 on_b = contact_side_impulse(r, stack, true);
   other_side = own_first ? on_b : on_a;
   return own_first ? on_a : on_b;
 }
 
-/// The impulse on body `own` (w: counted) of its particle xi and particle xj of body `other`;
-/// own_first: xi has the lower particle id (see particle_contact_impulse). acc: the contact's
-/// accumulated impulse, as the lower id sees it (the same bits in both particles' slots).
+/// The impulse on body `own` (w: counted) of its particle xi and particle xj of body `other` (both
+/// as contact_particle gives them); own_first: xi has the lower particle id (see
+/// particle_contact_impulse). acc: the contact's accumulated impulse, as the lower id sees it (the
+/// same bits in both particles' slots). arm: where it acts on own, from own's centre
+/// (pair_contact_arm).
 MOTES_FN vec4 pair_impulse(MOTES_IN(ImpulseBody) own, vec4 xi, MOTES_IN(ImpulseBody) other, vec4 xj,
                            bool own_first, float margin, ContactLaw law, vec4 gravity_dt,
-                           uint flags, MOTES_INOUT(vec4) acc) {
+                           uint flags, MOTES_INOUT(vec4) acc, MOTES_OUT(vec3) arm) {
+  arm = pair_contact_arm(contact_pair(own, xi, other, xj, own_first, flags), !own_first, flags);
   if ((flags & MOTES_FLAG_POSITION) != 0u) {  // the same evaluation, each side its own result
     PositionPair r =
         own_first
@@ -334,26 +405,45 @@ MOTES_FN vec4 pair_impulse(MOTES_IN(ImpulseBody) own, vec4 xi, MOTES_IN(ImpulseB
                             other_side);
 }
 
+/// A plane (normal, offset) as the impulse contacts of a particle of body b (contact_particle) see
+/// it: offset by b's centre. Position contacts: as it is.
+MOTES_FN vec4 contact_plane(vec4 normal_offset, MOTES_IN(ImpulseBody) b, uint flags) {
+  if ((flags & MOTES_FLAG_POSITION) != 0u) return normal_offset;
+  return vec4(xyz(normal_offset), normal_offset.w - dot(xyz(normal_offset), xyz(b.com)));
+}
+
+/// Where the contact of particle xa (contact_particle) of body a and a plane acts on it, about a's
+/// centre (contact_acting_point).
+MOTES_FN vec3 plane_contact_arm(MOTES_IN(ImpulseBody) a, vec4 xa, vec4 normal_offset, uint flags) {
+  ImpulseBody o = contact_body(a, flags);
+  vec4 no = contact_plane(normal_offset, a, flags);
+  return contact_acting_point(plane_contact_point(xa, no), xa, flags) - xyz(o.com);
+}
+
 /// The impulse on body a of its particle xa and a static half-space plane (solid where
 /// dot(normal, x) < offset), at the particle's point nearest the plane, as a change of the
-/// contact's accumulated impulse acc (contact_impulse).
+/// contact's accumulated impulse acc (contact_impulse); xa as contact_particle gives it. arm:
+/// where it acts, from a's centre (plane_contact_arm).
 MOTES_FN vec4 plane_contact_impulse(MOTES_IN(ImpulseBody) a, vec4 xa, vec4 normal_offset,
                                     float margin, ContactLaw law, vec4 gravity_dt, uint flags,
-                                    MOTES_INOUT(vec4) acc) {
-  vec3 np = xyz(normal_offset);
-  float sep = dot(np, xyz(xa)) - normal_offset.w - xa.w;
+                                    MOTES_INOUT(vec4) acc, MOTES_OUT(vec3) arm) {
+  arm = plane_contact_arm(a, xa, normal_offset, flags);
+  ImpulseBody o = contact_body(a, flags);
+  vec4 no = contact_plane(normal_offset, a, flags);
+  vec3 np = xyz(no);
+  float sep = dot(np, xyz(xa)) - no.w - xa.w;
   if (sep >= margin) {
     acc = vec4(0.0f);  // zero already in the iterations: positions do not change within them
     return vec4(0.0f);
   }
-  vec3 c = plane_contact_point(xa, normal_offset);
+  vec3 c = plane_contact_point(xa, no);
   if ((flags & MOTES_FLAG_POSITION) != 0u) {
-    return contact_position(a, impulse_wall(), xyz(xa), c, np, sep, 2.0f * xa.w,
+    return contact_position(o, impulse_wall(), xyz(xa), c, np, sep, 2.0f * xa.w,
                             plane_contact_rel(c, np), law, gravity_dt, flags, acc)
         .a;
   }
   float stack = 1.0f;  // a wall: never scaled
-  return contact_impulse(a, impulse_wall(), c, np, sep, xa.w, law, gravity_dt, flags, acc, stack);
+  return contact_impulse(o, impulse_wall(), c, np, sep, xa.w, law, gravity_dt, flags, acc, stack);
 }
 
 /// True when the contact of particles i and j (neighbour counts ci and cj) keeps its accumulated
@@ -384,12 +474,11 @@ MOTES_FN bool neighbour_keeps_slots(uint old_count, uint new_count, bool same_en
   return old_count == new_count && new_count <= capacity && same_entries;
 }
 
-/// Adds a contact's impulse r (w: counted) at point c to a particle's sums: the impulse and count
-/// (sum), the moment about the body's centre com (moment).
-MOTES_FN void impulse_add(MOTES_INOUT(vec4) sum, MOTES_INOUT(vec3) moment, vec4 r, vec3 c,
-                          vec4 com) {
+/// Adds a contact's impulse r (w: counted) acting at arm from the body's centre to a particle's
+/// sums: the impulse and count (sum), the moment about the body's centre (moment).
+MOTES_FN void impulse_add(MOTES_INOUT(vec4) sum, MOTES_INOUT(vec3) moment, vec4 r, vec3 arm) {
   sum = sum + r;
-  moment += cross(c - xyz(com), xyz(r));
+  moment += cross(arm, xyz(r));
 }
 
 /// Body state at the end of an impulse iteration: v += J / m, L += tau, w = I^-1(q) L.

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "shared/links.h"
+#include "shared/quaternion.h"
 
 namespace motes_conf {
 
@@ -199,6 +200,12 @@ World make_world(Rng& rng, std::vector<vec4> positions, std::uint32_t flags, boo
                    vec3(static_cast<float>(centre[0]), static_cast<float>(centre[1]),
                         static_cast<float>(centre[2])),
                    inv_particle_mass / static_cast<float>(len));
+    // Body-frame offsets that put each particle where it is (to rounding): impulse contacts take
+    // a particle's place from its body's pose (shared/impulse.h: contact_particle).
+    for (std::size_t k = i; k < i + len; ++k) {
+      const vec3 r = motes::shared::xyz(p.pos[k]) - motes::shared::xyz(b.pos.back());
+      p.local[k] = vec4(motes::shared::quat_rotate_inverse(b.quat.back(), r), 0.0f);
+    }
     i += len;
   }
   b.first.push_back(static_cast<uint>(rigid));

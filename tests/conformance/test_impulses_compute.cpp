@@ -149,10 +149,11 @@ class ImpulsesComputeThenApply : public DeviceTest {
                         Buffer::BodyPos,          Buffer::BodyQuat,       Buffer::BodyInvInertia,
                         Buffer::BodyVel,          Buffer::BodyAngMom,     Buffer::BodyAngVel,
                         Buffer::BodyFirst,        Buffer::NeighbourState, Buffer::ContactImpulse,
-                        Buffer::ImpulseStamp}));
+                        Buffer::ImpulseStamp,     Buffer::ParticleLocal}));
     const std::vector<uint> state = {0u, kBuilds, 0u, 0u};
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleVel, w.particles.vel));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleLocal, w.particles.local));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleBody, w.particles.body));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleMaterial, w.particles.material));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourList, list_buffer(nb, capacity)));
@@ -307,10 +308,11 @@ class ImpulsesCompute : public DeviceTest {
                         Buffer::BodyPos,          Buffer::BodyQuat,       Buffer::BodyInvInertia,
                         Buffer::BodyVel,          Buffer::BodyAngMom,     Buffer::BodyAngVel,
                         Buffer::BodyFirst,        Buffer::NeighbourState, Buffer::ContactImpulse,
-                        Buffer::ImpulseStamp}));
+                        Buffer::ImpulseStamp,     Buffer::ParticleLocal}));
     const std::vector<uint> state = {0u, kBuilds, 0u, 0u};
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticlePos, w.particles.pos));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleVel, w.particles.vel));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleLocal, w.particles.local));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleBody, w.particles.body));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleMaterial, w.particles.material));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::NeighbourList, list_buffer(nb, capacity)));

@@ -17,23 +17,24 @@ void bodies_integrate(Bodies& bodies, const StepParams& p) {
   }
 }
 
-void bodies_push_pose(Bodies& bodies, const std::vector<vec4>& vel_push,
+void bodies_push_pose(Bodies& bodies, std::vector<vec4>& pos_low, const std::vector<vec4>& vel_push,
                       const std::vector<vec4>& angmom_push, const StepParams& p) {
   bodies.angvel.assign(bodies.size(), vec4(0.0f));
   for (std::size_t b = 0; b < bodies.size(); ++b) {
-    motes::shared::body_push_pose(bodies.pos[b], bodies.quat[b], bodies.angvel[b],
+    motes::shared::body_push_pose(bodies.pos[b], pos_low[b], bodies.quat[b], bodies.angvel[b],
                                   bodies.inv_inertia[b], bodies.angmom[b], vel_push[b],
                                   angmom_push[b], p.gravity_dt);
   }
 }
 
-void bodies_split_pose(Bodies& bodies, const std::vector<vec4>& vel_push,
-                       const std::vector<vec4>& angmom_push, const StepParams& p) {
+void bodies_split_pose(Bodies& bodies, std::vector<vec4>& pos_low,
+                       const std::vector<vec4>& vel_push, const std::vector<vec4>& angmom_push,
+                       const StepParams& p) {
   bodies.angvel.assign(bodies.size(), vec4(0.0f));
   for (std::size_t b = 0; b < bodies.size(); ++b) {
-    motes::shared::body_split_pose(bodies.pos[b], bodies.quat[b], bodies.vel[b], bodies.angmom[b],
-                                   bodies.angvel[b], bodies.inv_inertia[b], vel_push[b],
-                                   angmom_push[b], p.gravity_dt);
+    motes::shared::body_split_pose(bodies.pos[b], pos_low[b], bodies.quat[b], bodies.vel[b],
+                                   bodies.angmom[b], bodies.angvel[b], bodies.inv_inertia[b],
+                                   vel_push[b], angmom_push[b], p.gravity_dt);
   }
 }
 

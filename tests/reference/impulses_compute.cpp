@@ -19,6 +19,12 @@ ImpulseBody impulse_body(const Bodies& bodies, const ImpulseState& s, uint b, ui
                                         flags);
 }
 
+/// Rigid particle i as its contacts take it (shared::contact_particle).
+vec4 particle(const Particles& particles, const Bodies& bodies, std::size_t i, uint flags) {
+  return motes::shared::contact_particle(particles.pos[i], bodies.quat[particles.body[i]],
+                                         particles.local[i], flags);
+}
+
 }  // namespace
 
 void impulses_compute(const Particles& particles, const Bodies& bodies, const Neighbours& nb,
@@ -42,7 +48,7 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
   };
   for (std::size_t i = 0; i < nr; ++i) {
     if (particles.vel[i].w == 0.0f) continue;
-    const vec4 xi = particles.pos[i];
+    const vec4 xi = particle(particles, bodies, i, p.flags);
     const ImpulseBody own = impulse_body(bodies, s, particles.body[i], p.flags);
     vec4 sum(0.0f);
     vec3 moment(0.0f);
@@ -57,30 +63,25 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
       vec4 a = slotted && valid ? acc[at] : vec4(0.0f);
       const uint law = motes::shared::pair_law_index(static_cast<uint>(i), particles.material[i], j,
                                                      particles.material[j], p.material_count);
-      const vec4 r = motes::shared::pair_impulse(
-          own, xi, impulse_body(bodies, s, particles.body[j], p.flags), particles.pos[j], i < j,
-          margin, laws[law], p.gravity_dt, p.flags, a);
+      vec3 arm;
+      const vec4 r =
+          motes::shared::pair_impulse(own, xi, impulse_body(bodies, s, particles.body[j], p.flags),
+                                      particle(particles, bodies, j, p.flags), i < j, margin,
+                                      laws[law], p.gravity_dt, p.flags, a, arm);
       if (slotted) keep(at, a);
-      motes::shared::impulse_add(
-          sum, moment, r,
-          motes::shared::contact_acting_point(
-              motes::shared::pair_contact_point(xi, particles.pos[j]), xi, p.flags),
-          own.com);
+      motes::shared::impulse_add(sum, moment, r, arm);
     }
     for (std::size_t k = 0; k < planes.size(); ++k) {
       const PlaneData& pl = planes[k];
       const std::size_t at = (capacity + k) * nr + i;
       vec4 a = acc[at];
+      vec3 arm;
       const vec4 r = motes::shared::plane_contact_impulse(
           own, xi, pl.normal_offset, margin,
           laws[std::size_t{particles.material[i]} * p.material_count + pl.material], p.gravity_dt,
-          p.flags, a);
+          p.flags, a, arm);
       keep(at, a);
-      motes::shared::impulse_add(
-          sum, moment, r,
-          motes::shared::contact_acting_point(
-              motes::shared::plane_contact_point(xi, pl.normal_offset), xi, p.flags),
-          own.com);
+      motes::shared::impulse_add(sum, moment, r, arm);
     }
     s.impulse[i] = sum;
     s.moment[i] = vec4(moment, 0.0f);

@@ -126,13 +126,15 @@ void bodies_reduce(const std::vector<vec4>& particle_pos, const std::vector<vec4
 /// bodies_integrate: shared::body_integrate on every body, with p.gravity_dt.
 void bodies_integrate(Bodies& bodies, const StepParams& p);
 /// bodies_integrate with MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_PUSH: shared::body_push_pose on
-/// every body, moved with vel_push and angmom_push (BodyVelPush, BodyAngMomPush).
-void bodies_push_pose(Bodies& bodies, const std::vector<vec4>& vel_push,
+/// every body, moved with vel_push and angmom_push (BodyVelPush, BodyAngMomPush), the centre as
+/// the pair pos + pos_low (BodyPosLow).
+void bodies_push_pose(Bodies& bodies, std::vector<vec4>& pos_low, const std::vector<vec4>& vel_push,
                       const std::vector<vec4>& angmom_push, const StepParams& p);
 /// bodies_integrate with MOTES_FLAG_BODY_POSE | MOTES_FLAG_IMPULSE_SPLIT: shared::body_split_pose
 /// on every body (moved with its own velocities, which then take vel_push and angmom_push).
-void bodies_split_pose(Bodies& bodies, const std::vector<vec4>& vel_push,
-                       const std::vector<vec4>& angmom_push, const StepParams& p);
+void bodies_split_pose(Bodies& bodies, std::vector<vec4>& pos_low,
+                       const std::vector<vec4>& vel_push, const std::vector<vec4>& angmom_push,
+                       const StepParams& p);
 
 /// particles_update: ParticlePos/Vel xyz of the rigid particles [0, particles.rigid) from the body
 /// pose (shared::particle_position and particle_velocity); w (radius, inverse mass) kept. Returns

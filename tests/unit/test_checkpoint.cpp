@@ -563,7 +563,7 @@ TEST(Checkpoint, RunRecordExtensionOnlyWhenGiven) {
   std::memcpy(&record, bytes.data() + 88, 8);
   std::memcpy(&sections, bytes.data() + 84, 4);
   EXPECT_EQ(record, plain.size());
-  EXPECT_EQ(sections, 17u);
+  EXPECT_EQ(sections, 18u);
   EXPECT_TRUE(std::equal(plain.begin(), plain.end(), bytes.begin() + 96));
   std::uint64_t last = 0;
   std::memcpy(&last, bytes.data() + bytes.size() - 8, 8);
@@ -603,7 +603,7 @@ TEST(Checkpoint, RunRecordExtensionOnlyWhenGiven) {
 
 // One rank's simulation of a run over MPI ranks (created with HaloLists) has a partition
 // reference, from which particles_displacement decides the next partition: its checkpoint holds
-// it as an 18th section, a resume gets the same displacements, and the two kinds of checkpoint do
+// it as a 19th section, a resume gets the same displacements, and the two kinds of checkpoint do
 // not load into each other's simulations.
 TEST(Checkpoint, ARanksCheckpointKeepsThePartitionReference) {
   TempDir tmp;
@@ -628,7 +628,7 @@ TEST(Checkpoint, ARanksCheckpointKeepsThePartitionReference) {
   const std::vector<unsigned char> bytes = read_bytes(path);
   std::uint32_t sections = 0;
   std::memcpy(&sections, bytes.data() + 84, 4);
-  EXPECT_EQ(sections, 18u);
+  EXPECT_EQ(sections, 19u);
 
   // The same 60 steps without the partition: displacements from the start.
   auto unpartitioned = rank_sim();
@@ -679,6 +679,50 @@ TEST(Checkpoint, SectionsNameTheirBuffers) {
   write_bytes(tmp / "renamed.mck", bytes);
   expect_refused(*s.sim, tmp / "renamed.mck", "a section of unknown buffer 'ParticlePosition'",
                  true);
+}
+
+// A file written before BodyPosLow was saved (its last section, the centres' parts below their
+// floats, which impulse contacts keep) still loads, with zeros there: the impulse pile's
+// checkpoint without that section loads into the same state but BodyPosLow, which reads zero.
+TEST(Checkpoint, FilesWithoutBodyPosLowLoadWithZeros) {
+  TempDir tmp;
+  auto a = make("openmp", "impulse_pile");
+  ASSERT_TRUE(a);
+  ASSERT_TRUE(a->step(40));
+  const std::string path = tmp / "full.mck";
+  ASSERT_TRUE(a->save_state(path));
+  std::vector<unsigned char> bytes = read_bytes(path);
+  const std::size_t bodies = a->sizes().bodies;
+  ASSERT_GT(bodies, 0u);
+  // The last section: a 48-byte header (name, element bytes, 0, bytes), then its bytes.
+  const std::size_t last = bytes.size() - 8 - (48 + 16 * bodies);
+  ASSERT_EQ(std::string(reinterpret_cast<const char*>(bytes.data() + last)), "BodyPosLow");
+  bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(last), bytes.end() - 8);
+  const std::uint32_t sections = 17;
+  std::memcpy(bytes.data() + 84, &sections, 4);
+  const std::uint64_t file_bytes = bytes.size();
+  std::memcpy(bytes.data() + 16, &file_bytes, 8);
+  fix_checksum(bytes);
+  write_bytes(tmp / "old.mck", bytes);
+  std::vector<motes::shared::vec4> low(bodies, motes::shared::vec4(1.0f));
+  auto b = make("openmp", "impulse_pile");
+  ASSERT_TRUE(b);
+  ASSERT_TRUE(b->step(3));  // its own BodyPosLow, which the load must clear
+  ASSERT_TRUE(b->load_state(tmp / "old.mck")) << "a file without BodyPosLow";
+  ASSERT_TRUE(b->device().read(Buffer::BodyPosLow, low.data(), low.size() * 16));
+  for (const motes::shared::vec4& v : low) {
+    EXPECT_EQ(v.x, 0.0f);
+    EXPECT_EQ(v.y, 0.0f);
+    EXPECT_EQ(v.z, 0.0f);
+  }
+  const auto want = a->snapshot();
+  const auto got = b->snapshot();
+  ASSERT_TRUE(want && got);
+  EXPECT_EQ(got->particle_pos.size(), want->particle_pos.size());
+  for (std::size_t i = 0; i < want->particle_pos.size(); ++i) {
+    EXPECT_EQ(got->particle_pos[i].x, want->particle_pos[i].x) << i;
+  }
+  EXPECT_TRUE(b->step(10));
 }
 
 // tests/data/checkpoint/mixed-v2-step300.mck: a version 2 checkpoint (sections numbered by the

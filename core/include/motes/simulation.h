@@ -34,6 +34,9 @@ struct Snapshot {
   std::vector<shared::vec4> body_vel;
   std::vector<shared::vec4> body_angmom;
   std::vector<shared::vec4> body_angvel;
+  /// Impulse contacts only (else empty): the part of each body's centre of mass below its float
+  /// (Buffer::BodyPosLow; zero for bodies that are not rigid). Empty when restoring: zeros.
+  std::vector<shared::vec4> body_pos_low;
   /// Rotation of each shape-matching cluster's last fit (device order): the next fit starts
   /// from it, so a bitwise resume needs it.
   std::vector<shared::vec4> cluster_rotation;

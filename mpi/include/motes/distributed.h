@@ -113,8 +113,10 @@ class DistributedSimulation {
   /// A body's state as ranks exchange it: its body vectors, then its particles' positions and
   /// velocities (Snapshot layouts).
   struct Record {
-    std::uint32_t body = 0;               ///< scene body index
-    std::array<shared::vec4, 5> state{};  ///< position, orientation, velocity, L, omega
+    std::uint32_t body = 0;  ///< scene body index
+    /// position, orientation, velocity, L, omega, the centre's part below its float (impulse
+    /// contacts: Snapshot::body_pos_low; else 0)
+    std::array<shared::vec4, 6> state{};
     std::vector<shared::vec4> pos, vel;
     std::vector<shared::vec4> rotations;  ///< a soft body's clusters' last rotations
     /// Impulse contacts: its particles' accumulated impulses with the planes (Snapshot).

@@ -103,6 +103,11 @@ enum class Buffer : std::uint32_t {
   /// (MOTES_FLAG_IMPULSE_SPLIT), which start from the relaxed ones; written before it is read in
   /// every substep (not in checkpoints).
   ContactImpulseSplit,
+  /// vec4 (B with impulse contacts, else 0): xyz, the part of each body's centre of mass below
+  /// BodyPos's rounding: the impulse stage's poses move the centre as this pair of floats
+  /// (shared/body_math.h: body_push_pose), so that a body far from the origin moves by less than
+  /// the spacing of floats there. w: 0.
+  BodyPosLow,
   Count
 };
 

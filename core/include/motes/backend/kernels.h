@@ -28,8 +28,8 @@
 // bodies_integrate: semi-implicit Euler on every dynamic body (shared/body_math.h:
 //   body_integrate; with impulse contacts from BodyVelPush and BodyAngMomPush, or with
 //   MOTES_FLAG_IMPULSE_SPLIT from BodyVel and BodyAngMom, which then take the push copies:
-//   body_split_pose; with position contacts, MOTES_FLAG_POSITION, the prediction with gravity
-//   alone).
+//   body_split_pose, both moving the centre as the pair BodyPos + BodyPosLow; with position
+//   contacts, MOTES_FLAG_POSITION, the prediction with gravity alone).
 // particles_update: ParticlePos and ParticleVel xyz of the rigid particles [0, Nr) from their
 //   body's pose; asks for a rebuild (NeighbourState) when one has moved too far from its
 //   NeighbourRefPos. With MOTES_FLAG_ABSORB, first ParticleForce =
@@ -49,8 +49,9 @@
 //   (shared/links.h: constraint_correction) on ParticlePos and ParticleVel; asks for a rebuild
 //   when a particle it moved is too far from its NeighbourRefPos.
 // impulses_compute: impulse contacts (shared/impulse.h), rigid particles [0, Nr) only:
-//   ParticleForce xyz = the sum of particle_contact_impulse over its list's rigid particles in
-//   list order (each pair evaluated lower id first, negated for the higher), then
+//   ParticleForce xyz = the sum of pair_impulse over its list's rigid particles in list order
+//   (each pair evaluated lower id first, negated for the higher; the particles as
+//   contact_particle gives them: R ParticleLocal, or ParticlePos for position contacts), then
 //   plane_contact_impulse over the planes; w = the contacts counted; ParticleMoment = the sum of
 //   (c - x_com) x J; the contacts' accumulated impulses in ContactImpulse (ImpulseStamp says
 //   which are valid; with MOTES_FLAG_IMPULSE_SPLIT in ContactImpulseSplit instead, and with
@@ -111,8 +112,8 @@
     (BodyForce, BodyTorque))                                                                     \
   X(BodiesIntegrate, bodies_integrate,                                                           \
     (BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel, BodyInvInertia, BodyForce, BodyTorque,  \
-     BodyVelPush, BodyAngMomPush),                                                               \
-    (BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel))                                        \
+     BodyVelPush, BodyAngMomPush, BodyPosLow),                                                   \
+    (BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel, BodyPosLow))                            \
   X(ParticlesUpdate, particles_update,                                                           \
     (ParticlePos, ParticleVel, ParticleForce, ParticleLocal, ParticleBody, BodyPos, BodyQuat,    \
      BodyVel, BodyAngVel, NeighbourRefPos, NeighbourState),                                      \
@@ -130,10 +131,10 @@
     (ParticlePos, ParticleVel, NeighbourRefPos, NeighbourState, Constraints),                    \
     (ParticlePos, ParticleVel, NeighbourState))                                                  \
   X(ImpulsesCompute, impulses_compute,                                                           \
-    (ParticlePos, ParticleVel, ParticleBody, ParticleMaterial, BodyPos, BodyQuat, BodyVel,       \
-     BodyAngVel, BodyInvInertia, BodyFirst, GridOrder, GridCellStart, SortedPos, SortedBody,     \
-     NeighbourList, NeighbourCount, NeighbourRefPos, NeighbourState, ContactLaws, Planes,        \
-     BodyVelStart, BodyAngVelStart, ContactImpulse, ImpulseStamp, ContactImpulseSplit),          \
+    (ParticlePos, ParticleVel, ParticleLocal, ParticleBody, ParticleMaterial, BodyPos, BodyQuat, \
+     BodyVel, BodyAngVel, BodyInvInertia, BodyFirst, GridOrder, GridCellStart, SortedPos,        \
+     SortedBody, NeighbourList, NeighbourCount, NeighbourRefPos, NeighbourState, ContactLaws,    \
+     Planes, BodyVelStart, BodyAngVelStart, ContactImpulse, ImpulseStamp, ContactImpulseSplit),  \
     (ParticleForce, ParticleMoment, ContactImpulse, ImpulseStamp, ContactImpulseSplit))          \
   X(ImpulsesApply, impulses_apply,                                                               \
     (ParticleForce, ParticleMoment, BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel,          \
