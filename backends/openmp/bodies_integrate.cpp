@@ -14,6 +14,8 @@ using shared::vec4;
 
 void OpenMPDevice::bodies_integrate(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
+  // The poses move (not in the velocity half): particles_update places the particles again.
+  if ((p.flags & MOTES_FLAG_BODY_VELOCITY) == 0u) impulse_points_ready_ = false;
   const auto bodies = static_cast<std::int64_t>(p.body_count);
   vec4* pos = buf<vec4>(Buffer::BodyPos);
   vec4* quat = buf<vec4>(Buffer::BodyQuat);

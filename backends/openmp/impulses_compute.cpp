@@ -67,15 +67,17 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
     });
   }
   const shared::ImpulseBody* frames = impulse_frames_.data();
-  // Each rigid particle as its contacts take it (shared::contact_particle), made with the frames.
+  // Each rigid particle as its contacts take it (shared::contact_particle): particles_update
+  // makes them with the positions; here when it has not since the poses last changed.
   const bool positions = (p.flags & MOTES_FLAG_POSITION) != 0u;
-  if (!positions && (counting || impulse_points_.size() != std::size_t(n))) {
+  if (!positions && (!impulse_points_ready_ || impulse_points_.size() != std::size_t(n))) {
     impulse_points_.resize(std::size_t(n));
     vec4* points = impulse_points_.data();
     const vec4* local = buf<vec4>(Buffer::ParticleLocal);
     for_items(n, parallel(n), [&](std::int64_t i) {
       points[i] = shared::contact_particle(in.pos[i], quat[in.body[i]], local[i], p.flags);
     });
+    impulse_points_ready_ = true;
   }
   const vec4* xs = positions ? in.pos : impulse_points_.data();
   const auto impulse_body = [&](uint b) {
@@ -165,9 +167,10 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
       for (uint k = 0; k < c && !touches; ++k) {
         const uint j = in.list[std::size_t{k} * stride + std::size_t(i)];
         if (j >= p.rigid_particle_count) continue;
-        const shared::ContactPair pr =
-            shared::contact_pair(own_frame, xi, frames[in.body[j]], xs[j], uint(i) < j, p.flags);
-        touches = shared::pair_within_reach(pr.xa, pr.xb, margin);
+        vec4 xa, xb;
+        shared::pair_places(own_frame.com, xi, frames[in.body[j]].com, xs[j], uint(i) < j, p.flags,
+                            xa, xb);
+        touches = shared::pair_within_reach(xa, xb, margin);
       }
       for (uint k = 0; k < p.plane_count && !touches; ++k) {
         const vec4 no = shared::contact_plane(in.planes[k].normal_offset, own_frame, p.flags);

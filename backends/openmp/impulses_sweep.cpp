@@ -98,9 +98,10 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
       }
       // pair_impulse's pair, test and frame, the lower id as a.
       const bool own_first = i < j;
-      const shared::ContactPair pr = shared::contact_pair(
-          bodies[in.body[i]], xi, bodies[in.body[j]], xs[j], own_first, p.flags);
-      const bool near = shared::pair_within_reach(pr.xa, pr.xb, margin);
+      vec4 xa, xb;
+      shared::pair_places(bodies[in.body[i]].com, xi, bodies[in.body[j]].com, xs[j], own_first,
+                          p.flags, xa, xb);
+      const bool near = shared::pair_within_reach(xa, xb, margin);
       const bool slotted = shared::impulse_pair_slotted(c, in.count[j], capacity);
       if (m != kNone) {
         slot_contact[std::size_t{m} * nr + j] = near ? uint(impulse_contacts_.size()) : kNone;
@@ -109,6 +110,8 @@ bool OpenMPDevice::impulse_contacts_build(const shared::StepParams& p, bool coun
         if (counting && slotted) acc[at] = vec4(0.0f);  // particle_contact_impulse's clearing
         continue;
       }
+      const shared::ContactPair pr = shared::contact_pair(
+          bodies[in.body[i]], xi, bodies[in.body[j]], xs[j], own_first, p.flags);
       const vec3 d = shared::xyz(pr.xa) - shared::xyz(pr.xb);
       const float rsum = pr.xa.w + pr.xb.w;
       const float dist = shared::sqrt(shared::dot(d, d));

@@ -137,6 +137,7 @@ Status OpenMPDevice::write(Buffer b, const void* src, std::size_t bytes) {
   impulse_acc_flush();
   if (bytes > 0) std::memcpy(buffers_[i].data(), src, bytes);
   impulse_contacts_ready_ = false;  // what the kept contact frames were made from may have changed
+  impulse_points_ready_ = false;    // and the particles' places (poses, offsets)
   if (b == Buffer::NeighbourList || b == Buffer::NeighbourCount) impulse_mirror_.clear();
   // New positions or lists: the last counting pass no longer says who touches whom.
   if (b == Buffer::ParticlePos || b == Buffer::NeighbourList || b == Buffer::NeighbourCount) {
@@ -181,6 +182,7 @@ void OpenMPDevice::forget_impulse_passes() {
   impulse_body_active_.clear();
   impulse_frames_.clear();
   impulse_points_.clear();
+  impulse_points_ready_ = false;
   impulse_contacts_ready_ = false;
   impulse_acc_pending_ = false;  // written back already, or its buffer made anew (allocate)
 }

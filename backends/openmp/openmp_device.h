@@ -126,9 +126,11 @@ class OpenMPDevice final : public Device {
   void contacts_shift(const shared::StepParams& p);
   /// impulses_compute: each body's shared::impulse_body_frame, made by the counting pass.
   std::vector<shared::ImpulseBody> impulse_frames_;
-  /// impulses_compute: each rigid particle as its impulse contacts take it
-  /// (shared::contact_particle), made by the counting pass.
+  /// Each rigid particle as its impulse contacts take it (shared::contact_particle), made by
+  /// particles_update with the positions (impulse contacts only), or by impulses_compute when it
+  /// has not since the poses or any buffer last changed (impulse_points_ready_ false).
   std::vector<shared::vec4> impulse_points_;
+  bool impulse_points_ready_ = false;
   /// impulses_compute's sweeps evaluate a contact of two dynamic rigid particles once, at the
   /// lower id, for both: per list slot k of particle i (k N_r + i), the slot of i in its partner's
   /// list (kNoMirror: none, the particle evaluates it itself), made at the first counting pass

@@ -8,6 +8,7 @@
 
 #include "openmp_device.h"
 #include "shared/body_math.h"
+#include "shared/impulse.h"
 #include "shared/neighbours.h"
 
 namespace motes::openmp {
@@ -31,6 +32,13 @@ void OpenMPDevice::particles_update(const shared::StepParams& p) {
   const bool absorb = (p.flags & MOTES_FLAG_ABSORB) != 0u;
   vec4* impulse = absorb ? buf<vec4>(Buffer::ParticleForce) : nullptr;
   vec4* moment = absorb ? buf<vec4>(Buffer::ParticleMoment) : nullptr;
+  // Impulse contacts: each particle's rotated offset too (shared::contact_particle), the rotation
+  // the position makes anyway.
+  vec4* points = nullptr;
+  if (sizes_.impulse != 0) {
+    impulse_points_.resize(std::size_t(n));
+    points = impulse_points_.data();
+  }
 
   // One particle follows its body; true when it moved far enough to ask for new lists.
   const auto follow = [&](std::int64_t i) {
@@ -49,6 +57,7 @@ void OpenMPDevice::particles_update(const shared::StepParams& p) {
     }
     const shared::vec3 x = shared::particle_position(body_pos[b], q, r);
     const shared::vec3 u = shared::particle_velocity(q, v, w, r);
+    if (points != nullptr) points[i] = shared::contact_particle(pos[i], q, r, 0u);
     pos[i] = vec4(x, pos[i].w);
     vel[i] = vec4(u, vel[i].w);
     return shared::neighbour_moved_too_far(pos[i], ref[i], p.neighbour_skin);
@@ -61,6 +70,7 @@ void OpenMPDevice::particles_update(const shared::StepParams& p) {
     for (std::int64_t i = 0; i < n; ++i) moved |= follow(i) ? 1u : 0u;
   }
   if (moved != 0) buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_REBUILD] = 1;
+  impulse_points_ready_ = points != nullptr;
   record(Kernel::ParticlesUpdate, start);
 }
 

@@ -332,6 +332,18 @@ struct ContactPair {
   vec4 xb;
 };
 
+/// contact_pair's particles alone (xa, xb), from their bodies' centres own_com and other_com: what
+/// a test of the pair's reach needs (pair_within_reach), the same bits.
+MOTES_FN void pair_places(vec4 own_com, vec4 xi, vec4 other_com, vec4 xj, bool own_first,
+                          uint flags, MOTES_OUT(vec4) xa, MOTES_OUT(vec4) xb) {
+  xa = own_first ? xi : xj;
+  xb = own_first ? xj : xi;
+  if ((flags & MOTES_FLAG_POSITION) == 0u) {
+    vec3 shift = own_first ? xyz(other_com) - xyz(own_com) : xyz(own_com) - xyz(other_com);
+    xb = vec4(shift + xyz(xb), xb.w);
+  }
+}
+
 /// Particle xi of body own and xj of body other (contact_particle), the lower id first (own_first:
 /// xi's), placed for impulse contacts with a's centre at the origin: xa its offset, b's centre at
 /// com_b - com_a and xb there plus its offset. Both particles of the pair make the same bits.
@@ -341,19 +353,14 @@ MOTES_FN ContactPair contact_pair(MOTES_IN(ImpulseBody) own, vec4 xi, MOTES_IN(I
   if (own_first) {
     pr.a = own;
     pr.b = other;
-    pr.xa = xi;
-    pr.xb = xj;
   } else {
     pr.a = other;
     pr.b = own;
-    pr.xa = xj;
-    pr.xb = xi;
   }
+  pair_places(own.com, xi, other.com, xj, own_first, flags, pr.xa, pr.xb);
   if ((flags & MOTES_FLAG_POSITION) == 0u) {
-    vec3 shift = xyz(pr.b.com) - xyz(pr.a.com);
+    pr.b.com = vec4(xyz(pr.b.com) - xyz(pr.a.com), pr.b.com.w);
     pr.a.com = vec4(0.0f, 0.0f, 0.0f, pr.a.com.w);
-    pr.b.com = vec4(shift, pr.b.com.w);
-    pr.xb = vec4(shift + xyz(pr.xb), pr.xb.w);
   }
   return pr;
 }
