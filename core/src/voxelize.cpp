@@ -733,40 +733,49 @@ Result<double> diameter_for_count(const PreparedMesh& mesh, std::size_t target) 
     return c;
   };
 
-  // Bracket: d_small gives at least the target, d_large at most.
+  // Bracket: d_small gives at least the target, d_large at most. Steps of 0.8 or 1.25, or as far
+  // as the cube root of count / target when that is further: the count goes like 1/d^3, and an
+  // open mesh's first guess (from its signed volume) can be off by a factor of 30 in the count,
+  // each step on the way a fill of a fine lattice. The ends stay the last diameters seen on
+  // either side of the target.
   double d = std::cbrt(volume / goal);
   auto first = evaluate(d);
   if (!first) return first.status();
   double d_small = d, d_large = d;
   double c = first.value();
-  while (c < goal) {
-    d_small *= 0.8;
+  if (c < goal) {
     // A mesh that fills less than 0.1% of its bounding box encloses almost no volume (a closed
     // but collapsed surface): stop before the lattice grows without bound.
-    if (box_volume / (d_small * d_small * d_small) > 1000.0 * goal) {
-      const bool open = mesh.rule == Rule::winding || mesh.rule == Rule::winding_boundary;
-      return Status::error(fmt::format(
-          "{}: cannot reach {} particles: only {:.0f} at diameter {} m, where the lattice over "
-          "the bounding box already has 1000 times more cells (the mesh encloses almost no "
-          "volume{})",
-          mesh.name, target, c, d_small / 0.8,
-          open && !mesh.condition.empty()
-              ? fmt::format(": it is {} and its winding number is above 0.5 almost nowhere",
-                            mesh.condition)
-              : std::string()));
+    const double d_least = std::cbrt(box_volume / (1000.0 * goal));
+    while (c < goal) {
+      const double next = d_small * (c > 0.0 ? std::min(0.8, std::cbrt(c / goal)) : 0.8);
+      if (d_small * 0.8 < d_least) {
+        const bool open = mesh.rule == Rule::winding || mesh.rule == Rule::winding_boundary;
+        return Status::error(fmt::format(
+            "{}: cannot reach {} particles: only {:.0f} at diameter {} m, where the lattice over "
+            "the bounding box already has 1000 times more cells (the mesh encloses almost no "
+            "volume{})",
+            mesh.name, target, c, d_small,
+            open && !mesh.condition.empty()
+                ? fmt::format(": it is {} and its winding number is above 0.5 almost nowhere",
+                              mesh.condition)
+                : std::string()));
+      }
+      d_large = d_small;
+      d_small = std::max(next, d_least);
+      auto r = evaluate(d_small);
+      if (!r) return r.status();
+      c = r.value();
     }
-    auto r = evaluate(d_small);
-    if (!r) return r.status();
-    c = r.value();
+  } else {
+    while (c > goal) {
+      d_small = d_large;
+      d_large *= std::max(1.25, std::cbrt(c / goal));
+      auto r = evaluate(d_large);
+      if (!r) return r.status();
+      c = r.value();
+    }
   }
-  c = first.value();
-  while (c > goal) {
-    d_large *= 1.25;
-    auto r = evaluate(d_large);
-    if (!r) return r.status();
-    c = r.value();
-  }
-  if (d_small == d_large) return best_d;
   // Keep count(d_small) >= target >= count(d_large) and halve the bracket in log d.
   for (int iteration = 0; iteration < 60 && best_miss > 0.0 && d_large > d_small * (1.0 + 1e-9);
        ++iteration) {

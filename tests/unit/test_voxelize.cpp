@@ -577,5 +577,26 @@ TEST(VoxelizeOpen, SheetsWithoutVolumeAreErrors) {
       << counted.message();
 }
 
+TEST(VoxelizeOpen, SliverFanReachesItsTargetCount) {
+  // fuzz_mesh's input raw_open_fan_slow without its triangles of repeated indices: slivers from
+  // a cluster near the origin (five vertices at one point, told apart by index only) to a vertex
+  // 170 units away. Its signed volume says 4,000 and the winding number fills about 110, so the
+  // first guess at the diameter gives 1,427 particles for a target of 50; the search steps by the
+  // cube root of the miss and must still end near 50, with a diameter that gives its count again.
+  TriangleMesh mesh;
+  mesh.source = "sliver fan";
+  mesh.vertices = {{0, 0, -1},   {-1, -1, -17}, {-1, -1, -1}, {-1, -1, -1},
+                   {-1, -1, -1}, {-1, -1, -1},  {-1, -1, -1}, {100, 97, 101}};
+  mesh.triangles = {{4, 1, 5}, {0, 3, 5}, {0, 4, 1}, {7, 6, 4}, {3, 2, 0},
+                    {2, 1, 4}, {5, 6, 4}, {6, 7, 0}, {1, 5, 0}, {5, 4, 2},
+                    {3, 7, 2}, {7, 6, 3}, {0, 4, 3}, {4, 7, 1}, {2, 6, 1}};
+  auto particles = voxelize_to(mesh, 50);
+  ASSERT_TRUE(particles) << particles.message();
+  EXPECT_NEAR(static_cast<double>(particles->points.size()), 50.0, 2.5);
+  auto again = voxelize_at(mesh, particles->diameter);
+  ASSERT_TRUE(again) << again.message();
+  EXPECT_EQ(again->points.size(), particles->points.size());
+}
+
 }  // namespace
 }  // namespace motes
