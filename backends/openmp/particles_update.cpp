@@ -3,9 +3,6 @@
 // MOTES_FLAG_ABSORB each first hands what the constraints did to it to its body (an impulse and its
 // moment, shared/body_math.h: particle_absorbed_impulse); with MOTES_FLAG_PARTICLE_SHIFT too, the
 // reaction of its position contacts that contacts_compute left in ParticleForce.
-#include <omp.h>
-
-#include <algorithm>
 #include <chrono>
 #include <cstdint>
 
@@ -63,6 +60,8 @@ uint follow_range(const Follow& f, std::int64_t begin, std::int64_t end) {
   uint moved = 0;
   for (std::int64_t i = begin; i < end; ++i) {
     const uint b = body[i];
+    // Read into locals first: the compiler then rotates local[i] once for the position and the
+    // velocity (the same rotation, the same bits), which it may not across the stores.
     const vec4 q = quat[b];
     const vec4 r = local[i];
     const vec4 v = body_vel[b];
@@ -125,15 +124,11 @@ void OpenMPDevice::particles_update(const shared::StepParams& p) {
   if (!parallel(n)) {  // without entering an OpenMP region (for_items)
     moved = follow_range(f, 0, n);
   } else {
-#pragma omp parallel num_threads(team_) reduction(| : moved)
-    {
-      // schedule(static)'s split: equal runs, the first n % threads one longer.
-      const std::int64_t threads = omp_get_num_threads();
-      const std::int64_t t = omp_get_thread_num();
-      const std::int64_t size = n / threads, extra = n % threads;
-      const std::int64_t begin = t * size + std::min(t, extra);
-      moved |= follow_range(f, begin, begin + size + (t < extra ? 1 : 0));
-    }
+    // One run of particles a thread.
+    const std::int64_t runs = team_;
+#pragma omp parallel for num_threads(team_) schedule(static) reduction(| : moved)
+    for (std::int64_t t = 0; t < runs; ++t)
+      moved |= follow_range(f, t * n / runs, (t + 1) * n / runs);
   }
   if (moved != 0) buf<uint>(Buffer::NeighbourState)[MOTES_NEIGHBOUR_REBUILD] = 1;
   impulse_points_ready_ = f.points != nullptr;
