@@ -10,6 +10,7 @@
 #include <iterator>
 #include <map>
 #include <numbers>
+#include <random>
 #include <set>
 #include <string>
 #include <tuple>
@@ -596,6 +597,37 @@ TEST(VoxelizeOpen, SliverFanReachesItsTargetCount) {
   auto again = voxelize_at(mesh, particles->diameter);
   ASSERT_TRUE(again) << again.message();
   EXPECT_EQ(again->points.size(), particles->points.size());
+}
+
+TEST(VoxelizeOpen, RandomFansReachATargetOrSayWhyNot) {
+  // Seeded variations of the fan above: 2 to 6 vertices in a cluster, one to three far away, 6 to
+  // 20 triangles among them. The search for 50 particles either ends with a diameter that gives
+  // its count again, or refuses the mesh with a message that names it.
+  std::mt19937 rng(20261129u);
+  std::uniform_int_distribution<int> near(-2, 2), far(30, 120), sign(0, 1);
+  for (int seed = 0; seed < 24; ++seed) {
+    SCOPED_TRACE(seed);
+    TriangleMesh mesh;
+    mesh.source = "fan " + std::to_string(seed);
+    const int cluster = 2 + seed % 5, tips = 1 + seed % 3;
+    for (int v = 0; v < cluster; ++v) mesh.vertices.emplace_back(near(rng), near(rng), near(rng));
+    for (int v = 0; v < tips; ++v) {
+      const auto out = [&] { return (sign(rng) != 0 ? 1 : -1) * far(rng); };
+      mesh.vertices.emplace_back(out(), out(), out());
+    }
+    std::uniform_int_distribution<int> vertex(0, cluster + tips - 1);
+    const int triangles = 6 + seed % 15;
+    for (int t = 0; t < triangles; ++t)
+      mesh.triangles.emplace_back(vertex(rng), vertex(rng), vertex(rng));
+    auto particles = voxelize_to(mesh, 50);
+    if (!particles) {
+      EXPECT_EQ(particles.message().rfind(mesh.source + ": ", 0), 0U) << particles.message();
+      continue;
+    }
+    auto again = voxelize_at(mesh, particles->diameter);
+    ASSERT_TRUE(again) << again.message();
+    EXPECT_EQ(again->points.size(), particles->points.size());
+  }
 }
 
 }  // namespace
