@@ -24,7 +24,11 @@
 // to look into a failure, MOTES_PROPERTY_TRACE=1 (each case's fastest body every 25 ms, the
 // particles that drifted) and MOTES_PROPERTY_ITERATIONS / MOTES_PROPERTY_SUBSTEPS (the scene's
 // impulse_iterations and impulse_substeps instead of the defaults),
-// MOTES_PROPERTY_POSITION_SUBSTEPS (RandomPositionScenes' substeps a frame, default 24).
+// MOTES_PROPERTY_POSITION_SUBSTEPS (RandomPositionScenes' substeps a frame, default 24);
+// MOTES_PROPERTY_SAVE=FILE with MOTES_PROPERTY_SAVE_AT=T (s): the batch's state at the first look
+// at or after T as a checkpoint, and MOTES_PROPERTY_LOAD=FILE: the run goes on from one (written
+// by the same cases on any backend: a state from one backend replayed on another; with other
+// ITERATIONS or SUBSTEPS, its state alone, the contacts' impulses starting cold).
 // scripts/gpu/run-suite.sh runs thousands on the GPU machine (both suites).
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -139,6 +143,20 @@ void dump_case(const std::string& dir, const Case& c, const motes::Snapshot& s,
   std::fclose(f);
 }
 
+/// Loads checkpoint `path` into a simulation of `scene` (the settings it was written with) on
+/// openmp and writes its state into `into` (a simulation of the same cases, other settings).
+motes::Status write_checkpoint_state(const motes::Scene& scene, const std::string& path,
+                                     motes::Simulation& into) {
+  motes::Result<std::unique_ptr<motes::Device>> device = motes::open_device("openmp", -1, {});
+  if (!device) return device.status();
+  auto other = motes::Simulation::create(scene, std::move(device).value());
+  if (!other) return other.status();
+  if (motes::Status st = other.value()->load_state(path); !st) return st;
+  motes::Result<motes::Snapshot> state = other.value()->snapshot();
+  if (!state) return state.status();
+  return into.write_state(*state);
+}
+
 /// Runs `cases` side by side on `backend`; one outcome per case.
 std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Case>& cases,
                                std::string& skip, bool positions) {
@@ -155,6 +173,7 @@ std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Cas
     batch.scene.settings.substeps =
         std::max(1, env_int("MOTES_PROPERTY_POSITION_SUBSTEPS", kPositionSubsteps));
   }
+  const motes::Scene saved_scene = batch.scene;  // the settings a checkpoint was written with
   // Experiments: other sweeps or substeps than the defaults every scene gets.
   if (const int v = env_int("MOTES_PROPERTY_ITERATIONS", 0); v > 0) {
     batch.scene.settings.impulse_iterations = v;
@@ -207,10 +226,34 @@ std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Cas
   // A look every 25 ms of simulated time (every frame of position contacts).
   const auto chunk =
       static_cast<std::uint64_t>(std::max(1.0, std::round(kChunk * kDt / s.settings().dt)));
-  for (std::uint64_t done = 0; done < steps;) {
+  std::uint64_t done = 0;
+  if (const char* load = std::getenv("MOTES_PROPERTY_LOAD"); load != nullptr && *load != '\0') {
+    motes::Status st = motes::Status::ok();
+    if (saved_scene.settings.impulse_iterations == batch.scene.settings.impulse_iterations &&
+        saved_scene.settings.impulse_substeps == batch.scene.settings.impulse_substeps) {
+      st = s.load_state(load);
+    } else {  // other settings: the state alone (the contacts' memory starts cold)
+      st = write_checkpoint_state(saved_scene, load, s);
+    }
+    if (!st) {
+      for (Outcome& o : out) o.failure = st.message();
+      return out;
+    }
+    done = s.steps();
+  }
+  const char* save = std::getenv("MOTES_PROPERTY_SAVE");
+  const double save_at = std::getenv("MOTES_PROPERTY_SAVE_AT") != nullptr
+                             ? std::atof(std::getenv("MOTES_PROPERTY_SAVE_AT"))
+                             : 0.0;
+  bool saved = save == nullptr || *save == '\0';
+  while (done < steps) {
     const std::uint64_t n = std::min<std::uint64_t>(chunk, steps - done);
     motes::Status st = s.step(n);
     done += n;
+    if (st && !saved && s.time() >= save_at - 1e-9) {
+      st = s.save_state(save);
+      saved = true;
+    }
     motes::Result<motes::Snapshot> snap = st ? s.snapshot() : motes::Result<motes::Snapshot>(st);
     if (!snap) {
       for (Outcome& o : out) {
