@@ -208,18 +208,17 @@ Status VulkanDevice::create_pipelines() {
   const char* no_subgroups = std::getenv("MOTES_VULKAN_NO_SUBGROUPS");
   use_subgroups_ = physical_.subgroup_arithmetic &&
                    (no_subgroups == nullptr || std::strcmp(no_subgroups, "1") != 0);
-  std::array<const Shader*, kPipelineCount> shaders{};
   std::uint32_t descriptors = 0;
   for (std::size_t i = 0; i < kPipelineCount; ++i) {
     std::string name = kPipelineShaders[i];
     if (use_subgroups_ && static_cast<Pipeline>(i) == Pipeline::GridBuildScanBlock) {
       name += "_subgroup";
     }
-    shaders[i] = find_shader(name);
-    if (shaders[i] == nullptr) {
+    shaders_[i] = find_shader(name);
+    if (shaders_[i] == nullptr) {
       return Status::error(fmt::format("vulkan: shader {} is not embedded in this build", name));
     }
-    used_bindings_[i] = spirv_bindings(shaders[i]->words, shaders[i]->word_count);
+    used_bindings_[i] = spirv_bindings(shaders_[i]->words, shaders_[i]->word_count);
     descriptors += static_cast<std::uint32_t>(std::popcount(used_bindings_[i]));
   }
 
@@ -282,18 +281,20 @@ Status VulkanDevice::create_pipelines() {
     }
   }
 
-  for (std::size_t i = 0; i < kPipelineCount; ++i) {
-    const Shader* shader = shaders[i];
-    VkShaderModuleCreateInfo module_info{};
-    module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-    module_info.codeSize = shader->word_count * 4;
-    module_info.pCode = shader->words;
-    VkShaderModule module = VK_NULL_HANDLE;
-    if (Status s = check(vkCreateShaderModule(device_, &module_info, nullptr, &module),
-                         "vkCreateShaderModule");
-        !s) {
-      return s;
-    }
+  return Status::ok();
+}
+
+VkPipeline VulkanDevice::pipeline_at(std::size_t i) const {
+  if (pipelines_[i] != VK_NULL_HANDLE || !pipeline_error_) return pipelines_[i];
+  const Shader* shader = shaders_[i];
+  VkShaderModuleCreateInfo module_info{};
+  module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+  module_info.codeSize = shader->word_count * 4;
+  module_info.pCode = shader->words;
+  VkShaderModule module = VK_NULL_HANDLE;
+  VkResult r = vkCreateShaderModule(device_, &module_info, nullptr, &module);
+  const char* what = "vkCreateShaderModule";
+  if (r == VK_SUCCESS) {
     VkComputePipelineCreateInfo pipe{};
     pipe.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
     pipe.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
@@ -301,12 +302,16 @@ Status VulkanDevice::create_pipelines() {
     pipe.stage.module = module;
     pipe.stage.pName = "main";
     pipe.layout = pipeline_layouts_[i];
-    const VkResult r =
-        vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipe, nullptr, &pipelines_[i]);
+    r = vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipe, nullptr, &pipelines_[i]);
     vkDestroyShaderModule(device_, module, nullptr);
-    if (Status s = check(r, "vkCreateComputePipelines"); !s) return s;
+    what = "vkCreateComputePipelines";
   }
-  return Status::ok();
+  if (r != VK_SUCCESS) {
+    pipelines_[i] = VK_NULL_HANDLE;
+    pipeline_error_ = Status::error(fmt::format("vulkan ({}): {} of shader {} failed: {}",
+                                                info_.name, what, shader->name, result_name(r)));
+  }
+  return pipelines_[i];
 }
 
 VulkanDevice::~VulkanDevice() {

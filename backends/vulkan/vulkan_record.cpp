@@ -104,7 +104,9 @@ void VulkanDevice::record_passes(VkCommandBuffer cb, const std::vector<Pass>& pa
 
 void VulkanDevice::bind(VkCommandBuffer cb, Pipeline pipeline, const PushConstants& push) const {
   const auto i = static_cast<std::size_t>(pipeline);
-  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipelines_[i]);
+  const VkPipeline pipe = pipeline_at(i);
+  if (pipe == VK_NULL_HANDLE) return;  // recorded, never submitted: record() and run_once() fail
+  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
   vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layouts_[i], 0, 1, &sets_[i],
                           0, nullptr);
   vkCmdPushConstants(cb, pipeline_layouts_[i], VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
@@ -182,7 +184,12 @@ Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool ti
     if (timing) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, queries_, q++);
   }
   barrier(cb, Sync::All);
-  if (Status s = check(vkEndCommandBuffer(cb), "vkEndCommandBuffer"); !s) {
+  Status s = check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
+  if (s && !pipeline_error_) {
+    if (error_) error_ = pipeline_error_;
+    s = pipeline_error_;
+  }
+  if (!s) {
     vkFreeCommandBuffers(device_, pool_, 1, &cb);
     return s;
   }
@@ -208,6 +215,10 @@ Status VulkanDevice::run_once(const std::function<void(VkCommandBuffer)>& fill) 
   fill(cb);
   barrier(cb, Sync::All);
   Status s = check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
+  if (s && !pipeline_error_) {
+    if (error_) error_ = pipeline_error_;
+    s = pipeline_error_;
+  }
   if (s) s = submit_and_wait(&cb, 1);
   vkFreeCommandBuffers(device_, pool_, 1, &cb);
   return s;
