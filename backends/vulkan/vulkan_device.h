@@ -124,6 +124,8 @@ class VulkanDevice final : public Device {
                                  std::vector<Kernel>* spans = nullptr);
   /// Timestamps a timed recording of `ops` writes (NeighboursUpdate: three pairs).
   static std::uint32_t timestamps_for(const std::vector<Op>& ops);
+  /// Ends a recording: its error, or that of a pipeline it needed (pipeline_error_).
+  Status end_recording(VkCommandBuffer cb);
   Status submit_and_wait(const VkCommandBuffer* commands, std::uint32_t count);
   /// Runs a one-off command buffer filled by `fill` and waits for it.
   Status run_once(const std::function<void(VkCommandBuffer)>& fill);

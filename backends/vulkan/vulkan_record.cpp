@@ -184,16 +184,21 @@ Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool ti
     if (timing) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, queries_, q++);
   }
   barrier(cb, Sync::All);
-  Status s = check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
-  if (s && !pipeline_error_) {
-    if (error_) error_ = pipeline_error_;
-    s = pipeline_error_;
-  }
+  Status s = end_recording(cb);
   if (!s) {
     vkFreeCommandBuffers(device_, pool_, 1, &cb);
     return s;
   }
   return cb;
+}
+
+Status VulkanDevice::end_recording(VkCommandBuffer cb) {
+  Status s = check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
+  if (s && !pipeline_error_) {  // a pipeline this recording binds could not be created
+    if (error_) error_ = pipeline_error_;
+    s = pipeline_error_;
+  }
+  return s;
 }
 
 Status VulkanDevice::submit_and_wait(const VkCommandBuffer* commands, std::uint32_t count) {
@@ -214,11 +219,7 @@ Status VulkanDevice::run_once(const std::function<void(VkCommandBuffer)>& fill) 
   barrier(cb, Sync::All);
   fill(cb);
   barrier(cb, Sync::All);
-  Status s = check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
-  if (s && !pipeline_error_) {
-    if (error_) error_ = pipeline_error_;
-    s = pipeline_error_;
-  }
+  Status s = end_recording(cb);
   if (s) s = submit_and_wait(&cb, 1);
   vkFreeCommandBuffers(device_, pool_, 1, &cb);
   return s;

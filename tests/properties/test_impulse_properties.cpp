@@ -174,7 +174,7 @@ std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Cas
     batch.scene.settings.substeps =
         std::max(1, env_int("MOTES_PROPERTY_POSITION_SUBSTEPS", kPositionSubsteps));
   }
-  const motes::Scene saved_scene = batch.scene;  // the settings a checkpoint was written with
+  const motes::Scene saved_scene = batch.scene;  // the default settings, before the experiments
   // Experiments: other sweeps or substeps than the defaults every scene gets.
   if (const int v = env_int("MOTES_PROPERTY_ITERATIONS", 0); v > 0) {
     batch.scene.settings.impulse_iterations = v;
@@ -229,13 +229,10 @@ std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Cas
       static_cast<std::uint64_t>(std::max(1.0, std::round(kChunk * kDt / s.settings().dt)));
   std::uint64_t done = 0;
   if (const char* load = std::getenv("MOTES_PROPERTY_LOAD"); load != nullptr && *load != '\0') {
-    motes::Status st = motes::Status::ok();
-    if (saved_scene.settings.impulse_iterations == batch.scene.settings.impulse_iterations &&
-        saved_scene.settings.impulse_substeps == batch.scene.settings.impulse_substeps) {
-      st = s.load_state(load);
-    } else {  // other settings: the state alone (the contacts' memory starts cold)
-      st = write_checkpoint_state(saved_scene, load, s);
-    }
+    motes::Status st = s.load_state(load);
+    // Written with the default sweeps and substeps and run with others: the state alone (the
+    // contacts' memory starts cold); if that fails too, the first refusal is the one to read.
+    if (!st && write_checkpoint_state(saved_scene, load, s)) st = motes::Status::ok();
     if (!st) {
       for (Outcome& o : out) o.failure = st.message();
       return out;
@@ -243,9 +240,8 @@ std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Cas
     done = s.steps();
   }
   const char* save = std::getenv("MOTES_PROPERTY_SAVE");
-  const double save_at = std::getenv("MOTES_PROPERTY_SAVE_AT") != nullptr
-                             ? std::atof(std::getenv("MOTES_PROPERTY_SAVE_AT"))
-                             : 0.0;
+  const char* save_at_text = std::getenv("MOTES_PROPERTY_SAVE_AT");
+  const double save_at = save_at_text != nullptr ? std::atof(save_at_text) : 0.0;
   bool saved = save == nullptr || *save == '\0';
   while (done < steps) {
     const std::uint64_t n = std::min<std::uint64_t>(chunk, steps - done);
