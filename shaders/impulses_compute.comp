@@ -74,7 +74,7 @@ void main() {
                                                          p.material_count)],
                             p.gravity_dt, p.flags, a, arm);
       if (slotted) acc_write(slot, a);
-      impulse_add(sum, moment_sum, r, arm);
+      impulse_add(sum, moment_sum, r, arm, p.flags);
     }
   } else {
     uint lo[27];
@@ -94,7 +94,7 @@ void main() {
                                                           particle_material[j],
                                                           p.material_count)],
                               p.gravity_dt, p.flags, none, arm);
-        impulse_add(sum, moment_sum, q, arm);
+        impulse_add(sum, moment_sum, q, arm, p.flags);
       }
     }
   }
@@ -107,7 +107,7 @@ void main() {
                                    contact_laws[law_base + pl.material], p.gravity_dt, p.flags, a,
                                    arm);
     acc_write(slot, a);
-    impulse_add(sum, moment_sum, r, arm);
+    impulse_add(sum, moment_sum, r, arm, p.flags);
   }
   particle_force[i] = sum;
   particle_moment[i] = vec4(moment_sum, 0.0f);

@@ -178,6 +178,8 @@ Status CudaDevice::allocate(const Sizes& sizes) {
   host_first_.clear();
   host_body_.clear();
   bodies_fusable_ = false;
+  largest_body_ = 0;
+  smallest_body_ = 0;
   auto fail = [&](cudaError_t e, const std::string& what) {
     cudaGetLastError();
     release_buffers();
@@ -265,6 +267,17 @@ void CudaDevice::update_fusable() {
   constexpr shared::uint kFusedBodyParticles = 4;
   bodies_fusable_ = false;
   const std::size_t bodies = sizes_.bodies;
+  largest_body_ = 0;
+  smallest_body_ = 0;
+  if (host_first_.size() == bodies + 1 && bodies > 0) {
+    smallest_body_ = ~shared::uint{0};
+    for (std::size_t b = 0; b < bodies; ++b) {
+      const shared::uint n =
+          host_first_[b + 1] > host_first_[b] ? host_first_[b + 1] - host_first_[b] : 0u;
+      largest_body_ = std::max(largest_body_, n);
+      smallest_body_ = std::min(smallest_body_, n);
+    }
+  }
   if (host_first_.size() != bodies + 1 || host_body_.size() != sizes_.particles) return;
   if (host_first_[0] != 0 || host_first_[bodies] != sizes_.rigid_particles) return;
   for (std::size_t b = 0; b < bodies; ++b) {

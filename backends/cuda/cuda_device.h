@@ -132,6 +132,12 @@ class CudaDevice final : public Device {
   /// small, so that it computes what the three separate kernels compute.
   std::vector<shared::uint> host_first_, host_body_;
   bool bodies_fusable_ = false;
+  /// The most and the fewest particles a body has (0: not known: BodyFirst not written whole).
+  shared::uint largest_body_ = 0;
+  shared::uint smallest_body_ = 0;
+  /// Bodies of this many particles (four chunks of shared/impulse.h: MOTES_BODY_CHUNK) or more take
+  /// impulses_apply's block per body, the others a thread each (impulses_apply.cu).
+  static constexpr shared::uint kWideBodyParticles = 256;
   void update_fusable();
 
   /// This device's halo outbox and the opened outboxes of other processes (halo_outbox.cpp).

@@ -86,7 +86,7 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
       *slot = a;
       if (copy != nullptr) copy[slot - acc] = a;
     }
-    shared::impulse_add(sum, moment_sum, r, arm);
+    shared::impulse_add(sum, moment_sum, r, arm, p.flags);
   };
   const uint c = in.count[i];
   if (c <= p.neighbour_capacity) {
@@ -112,7 +112,7 @@ __global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
     const vec4 r = shared::plane_contact_impulse(
         own, xi, pl.normal_offset, margin, law_row[pl.material], p.gravity_dt, p.flags, a, arm);
     if (copy != nullptr) copy[at] = a;
-    shared::impulse_add(sum, moment_sum, r, arm);
+    shared::impulse_add(sum, moment_sum, r, arm, p.flags);
   }
   impulse[i] = sum;
   moment[i] = vec4(moment_sum, 0.0f);

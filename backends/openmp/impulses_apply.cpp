@@ -51,26 +51,62 @@ void OpenMPDevice::impulses_apply(const shared::StepParams& p) {
                          ? impulse_body_active_.data()
                          : nullptr;
   const uint* active = impulse_active_.data();
+  // The counting pass before the last projection sweep of position contacts: each body's contact
+  // Gram bound too (shared/contact_gram.h), from its particles' centres.
+  const bool gram = (p.flags & MOTES_FLAG_POSITION_GRAM) != 0u;
+  const vec4* pos = gram ? buf<vec4>(Buffer::ParticlePos) : nullptr;
   for_items(bodies, parallel(bodies), [&](std::int64_t b) {
+    // The sums in the contract's order (shared/impulse.h, MOTES_BODY_CHUNK): each chunk of the
+    // body's particles in particle order, then the chunks in order. A chunk without touching
+    // particles adds zeros, which change nothing: skipped, as those particles are.
     vec4 sum(0.0f);
     vec3 m(0.0f);
-    if (com[b].w != 0.0f && runs != nullptr) {
-      for (uint k = runs[b]; k < runs[b + 1]; ++k) {  // the same particles in the same order
-        sum = sum + impulse[active[k]];
-        m += shared::xyz(moment[active[k]]);
+    vec4 part(0.0f);
+    vec3 part_m(0.0f);
+    uint chunk = 0;
+    shared::ContactGram g;
+    shared::ContactGram part_g;
+    if (gram) {
+      g = shared::gram_zero();
+      part_g = shared::gram_zero();
+    }
+    const auto close_chunk = [&] {
+      sum = sum + part;
+      m += part_m;
+      part = vec4(0.0f);
+      part_m = vec3(0.0f);
+      if (gram) {
+        shared::gram_merge(g, part_g);
+        part_g = shared::gram_zero();
       }
+    };
+    const auto add = [&](uint i) {
+      const uint c = shared::body_chunk(i, first[b]);
+      if (c != chunk) {
+        close_chunk();
+        chunk = c;
+      }
+      part = part + impulse[i];
+      part_m += shared::xyz(moment[i]);
+      if (gram) {
+        shared::gram_add(part_g, impulse[i], moment[i], shared::xyz(pos[i]) - shared::xyz(com[b]));
+      }
+    };
+    if (com[b].w != 0.0f && runs != nullptr) {
+      for (uint k = runs[b]; k < runs[b + 1]; ++k) add(active[k]);  // the same particles in order
     } else if (com[b].w != 0.0f) {
       for (uint i = first[b]; i < first[b + 1]; ++i) {
         // A particle the counting pass found touching nothing has zeros, whose sum changes
         // nothing: skip reading them.
         if (touches != nullptr && touches[i] == 0) continue;
-        sum = sum + impulse[i];
-        m += shared::xyz(moment[i]);
+        add(i);
       }
     }
+    close_chunk();
     if (count_only) {  // the stage's start, then the warm start
       vel0[b] = shared::impulse_start_velocity(vel[b], vel0[b], sum.w, p.flags);
       angvel0[b] = shared::impulse_start_angular_velocity(angvel[b], angvel0[b], p.flags);
+      if (gram) angvel0[b].w = shared::gram_bound(g, com[b], quat[b], inv_inertia[b]);
       if (com[b].w != 0.0f) {
         for (uint i = first[b]; i < first[b + 1]; ++i) stamp[i] = builds;
       }

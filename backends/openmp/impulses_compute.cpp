@@ -214,7 +214,7 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
           in.laws[shared::pair_law_index(uint(i), in.material[i], j, in.material[j], materials)],
           p.gravity_dt, p.flags, a, arm);
       if (slot != nullptr) keep(std::size_t(slot - acc), a);
-      shared::impulse_add(sum, moment_sum, r, arm);
+      shared::impulse_add(sum, moment_sum, r, arm, p.flags);
     };
     if (c <= capacity) {
       for (uint k = 0; k < c; ++k) {
@@ -224,7 +224,7 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
           const shared::ContactPair pr =
               shared::contact_pair(own, xi, frames[in.body[j]], xs[j], own_first, p.flags);
           shared::impulse_add(sum, moment_sum, pair_r[std::size_t{k} * nr + std::size_t(i)],
-                              shared::pair_contact_arm(pr, !own_first, p.flags));
+                              shared::pair_contact_arm(pr, !own_first, p.flags), p.flags);
           continue;
         }
         const bool slotted =
@@ -246,7 +246,7 @@ void OpenMPDevice::impulses_compute(const shared::StepParams& p) {
       const vec4 r = shared::plane_contact_impulse(
           own, xi, pl.normal_offset, margin, law_row[pl.material], p.gravity_dt, p.flags, a, arm);
       keep(at, a);
-      shared::impulse_add(sum, moment_sum, r, arm);
+      shared::impulse_add(sum, moment_sum, r, arm, p.flags);
     }
     impulse[i] = sum;
     moment[i] = vec4(moment_sum, 0.0f);

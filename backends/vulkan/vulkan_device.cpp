@@ -437,6 +437,8 @@ Status VulkanDevice::allocate(const Sizes& sizes) {
   free_recordings();
   release_buffers();
   sizes_ = sizes;
+  largest_body_ = 0;
+  smallest_body_ = 0;
 
   // The bucket-count scan: level 0 is GridCellStart (T + 1 values); each level's block totals
   // are the next level's values, until one block holds them all.
@@ -610,6 +612,21 @@ Status VulkanDevice::write(Buffer b, const void* src, std::size_t bytes) {
   if (bytes > buffers_[i].data_bytes) {
     return Status::error(fmt::format("vulkan: writing {} bytes into {} of {} bytes", bytes,
                                      buffer_name(b), buffers_[i].data_bytes));
+  }
+  if (b == Buffer::BodyFirst) {  // which impulses_apply shader suits the bodies
+    largest_body_ = 0;
+    smallest_body_ = 0;
+    const std::size_t words = bytes / sizeof(shared::uint);
+    if (words == std::size_t{sizes_.bodies} + 1 && words > 1) {
+      std::vector<shared::uint> first(words);
+      std::memcpy(first.data(), src, words * sizeof(shared::uint));
+      smallest_body_ = ~shared::uint{0};
+      for (std::size_t k = 0; k + 1 < words; ++k) {
+        const shared::uint n = first[k + 1] > first[k] ? first[k + 1] - first[k] : 0u;
+        largest_body_ = std::max(largest_body_, n);
+        smallest_body_ = std::min(smallest_body_, n);
+      }
+    }
   }
   if (bytes == 0) return Status::ok();
   if (Status s = flush(); !s) return s;

@@ -24,13 +24,14 @@ namespace motes::vulkan {
 
 /// The passes of families that need more than one pipeline, each a shader of its own
 /// (shaders/FAMILY_PASS.comp), before the family's own shader (shaders/FAMILY.comp).
-#define MOTES_VULKAN_PASSES(X)                 \
-  X(GridBuildClear, grid_build_clear)          \
-  X(GridBuildCount, grid_build_count)          \
-  X(GridBuildScanBlock, grid_build_scan_block) \
-  X(GridBuildScanAdd, grid_build_scan_add)     \
-  X(GridBuildScatter, grid_build_scatter)      \
-  X(NeighboursBuildBegin, neighbours_build_begin)
+#define MOTES_VULKAN_PASSES(X)                    \
+  X(GridBuildClear, grid_build_clear)             \
+  X(GridBuildCount, grid_build_count)             \
+  X(GridBuildScanBlock, grid_build_scan_block)    \
+  X(GridBuildScanAdd, grid_build_scan_add)        \
+  X(GridBuildScatter, grid_build_scatter)         \
+  X(NeighboursBuildBegin, neighbours_build_begin) \
+  X(ImpulsesApplyWide, impulses_apply_wide)
 
 /// The compute pipelines: one per kernel family (motes/backend/kernels.h), whose shader is
 /// shaders/NAME.comp, then the extra passes.
@@ -201,6 +202,12 @@ class VulkanDevice final : public Device {
 
   Sizes sizes_;
   bool allocated_ = false;
+  /// The most and the fewest particles a body has (0: not known: BodyFirst not written whole);
+  /// bodies of kWideBodyParticles (four chunks of shared/impulse.h: MOTES_BODY_CHUNK) or more take
+  /// impulses_apply_wide.comp, the others impulses_apply.comp (impulses_apply.cpp).
+  shared::uint largest_body_ = 0;
+  shared::uint smallest_body_ = 0;
+  static constexpr shared::uint kWideBodyParticles = 256;
   std::array<GpuBuffer, kBindingCount> buffers_{};
   GpuBuffer staging_;
   /// Scan levels of the grid build: offset and count of each level's values.

@@ -384,6 +384,9 @@ void Simulation::step_positions(const shared::StepParams& lists) {
   first.flags |= MOTES_FLAG_POSITION_FIRST;
   shared::StepParams first_count = count;
   first_count.flags |= MOTES_FLAG_POSITION_FIRST;
+  // The last count also bounds each body's step in the velocity pass (shared/contact_gram.h).
+  shared::StepParams last_count = count;
+  last_count.flags |= MOTES_FLAG_POSITION_GRAM;
   shared::StepParams velocity = project;
   velocity.flags |= MOTES_FLAG_POSITION_VELOCITY;
   shared::StepParams shift = project;
@@ -405,8 +408,11 @@ void Simulation::step_positions(const shared::StepParams& lists) {
     d.enqueue(Kernel::NeighboursUpdate, lists);
     for (int it = 0; it < kPositionProjectionSweeps && bodies; ++it) {
       if (it > 0) d.enqueue(Kernel::ParticlesUpdate, params_);
-      d.enqueue(Kernel::ImpulsesCompute, it == 0 ? first_count : count);
-      d.enqueue(Kernel::ImpulsesApply, it == 0 ? first_count : count);
+      const shared::StepParams& c = it == 0                               ? first_count
+                                    : it + 1 == kPositionProjectionSweeps ? last_count
+                                                                          : count;
+      d.enqueue(Kernel::ImpulsesCompute, c);
+      d.enqueue(Kernel::ImpulsesApply, c);
       d.enqueue(Kernel::ImpulsesCompute, it == 0 ? first : project);
       d.enqueue(Kernel::ImpulsesApply, it == 0 ? first : project);
     }

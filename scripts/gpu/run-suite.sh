@@ -24,7 +24,8 @@
 #     0, no warning line, every step done, the summary's guard line says "no warning"), into
 #     scenes.md: a row per run (scene, backend, steps, wall time, steps/s, guard line, verdict),
 #     then the output of each run that failed. Any warning, failure or run cut off fails the part.
-#     LIMIT_SCENE seconds a run (default 240), LIMIT_SCENES seconds for them all (default 540)
+#     LIMIT_SCENE seconds a run (default 240), LIMIT_SCENES seconds for them all (default 540);
+#     MOTES_SCENES: the scene files (a glob; default examples/scenes/*.json)
 #   mpi: the MPI tests on CUDA and Vulkan (MOTES_MPI_BACKENDS) at 1, 2 and 4 ranks (sharing the
 #     machine's GPUs), and W1 over 1, 2, 4 ranks (motes_mpi_bench, MOTES_MPI_SIZES; empty: none),
 #     into mpi.txt
@@ -143,7 +144,7 @@ if want scenes; then
   } >"$table"
   scenes_status=0 deadline=$((SECONDS + ${LIMIT_SCENES:-540}))
   for backend in ${MOTES_SCENE_BACKENDS:-cuda vulkan}; do
-    for scene in examples/scenes/*.json; do
+    for scene in ${MOTES_SCENES:-examples/scenes/*.json}; do
       name=$(basename "$scene" .json)
       full=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["settings"]["duration"])' "$scene")
       limit=$((deadline - SECONDS))

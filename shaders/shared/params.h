@@ -58,6 +58,12 @@ MOTES_SHARED_BEGIN
 /// BodyAngMom (the corrected velocities), which then take BodyVelPush and BodyAngMomPush (the
 /// relaxed ones) back (shared/body_math.h: body_split_pose).
 #define MOTES_FLAG_IMPULSE_SPLIT 8192u
+/// With MOTES_FLAG_POSITION and MOTES_FLAG_IMPULSE_COUNT (the counting pass before the last
+/// projection sweep): impulses_compute gives each particle the sum of n n^T over its contacts
+/// (ParticleForce.xyz its diagonal, w the count; ParticleMoment.xyz the rest), and impulses_apply
+/// sums them over each body into the bound of its contacts' Gram matrix that the velocity pass
+/// steps by (shared/contact_gram.h), in BodyAngVelStart.w.
+#define MOTES_FLAG_POSITION_GRAM 16384u
 
 /// Launch parameters of every kernel family; travels with the launch (push constants).
 struct StepParams {

@@ -87,6 +87,18 @@ MOTES_FN float stack_side_scale(float s, bool side_b) {
   return side_b ? (s > 0.0f ? s : 1.0f) : (s < 0.0f ? -s : 1.0f);
 }
 
+/// The inverse mass the velocity pass's normal step meets at body b (arm r, normal n): the bound
+/// of its contacts' Gram matrix (shared/contact_gram.h; BodyAngVelStart.w, made by the counting
+/// pass with MOTES_FLAG_POSITION_GRAM), never less than the contact's own 1/m + (r x n) . I^-1
+/// (r x n) (a contact the count did not see); mass splitting where no bound was made. 0 for a
+/// wall or a static body.
+MOTES_FN float position_velocity_inverse_mass(MOTES_IN(ImpulseBody) b, vec3 r, vec3 n) {
+  if (b.com.w == 0.0f) return 0.0f;
+  if (!(b.angvel0.w > 0.0f)) return impulse_inverse_mass(b, r, n);
+  vec3 rn = cross(r, n);
+  return max(b.angvel0.w, b.com.w + dot(rn, impulse_inverse_inertia(b, rn)));
+}
+
 /// What a position contact does to each of its two bodies (xyz: the impulse, w: 1 for a contact
 /// that overlaps, else 0).
 struct PositionPair {
@@ -157,8 +169,11 @@ MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(Impulse
     acc = vec4(0.0f);
     return res;
   }
-  res.a = vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  res.b = vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  // Counted; with MOTES_FLAG_POSITION_GRAM the normal goes with the count, for its n n^T
+  // (shared/contact_gram.h: the velocity pass's step).
+  vec3 gram = (flags & MOTES_FLAG_POSITION_GRAM) != 0u ? n : vec3(0.0f);
+  res.a = vec4(gram, 1.0f);
+  res.b = vec4(gram, 1.0f);
   if ((flags & MOTES_FLAG_IMPULSE_COUNT) != 0u ||
       (!overlaps && (flags & MOTES_FLAG_POSITION_VELOCITY) == 0u)) {
     return res;
@@ -183,7 +198,11 @@ MOTES_FN PositionPair contact_position(MOTES_IN(ImpulseBody) a, MOTES_IN(Impulse
     // Bounce; else neither approach nor separation (Müller et al. 2020's rule: a contact that
     // is still overlapping after it bounced loses what separation speed it has left).
     float target = vn0 < -bounce_speed ? -law.restitution * vn0 : 0.0f;
-    vec3 j = n * ((target - dot(u, n)) / kn);
+    // The normal step by the bodies' Gram bounds (shared/contact_gram.h), which converges where
+    // mass splitting's does not (a flat face's contacts).
+    float kv = sa * position_velocity_inverse_mass(a, ra, n) +
+               sb * position_velocity_inverse_mass(b, rb, n);
+    vec3 j = n * ((target - dot(u, n)) / kv);
     // A contact the projection kept stuck (acc.w > 0; the projection's Coulomb test passed) ends
     // the substep without tangential speed: its return to an anchor some substeps old is not
     // kept as speed past it. Müller et al. 2020 anchor at the substep's start, so the velocity

@@ -29,7 +29,8 @@
 // the grid and their contacts keep no memory. PositionsComputeThenApply runs the same worlds
 // through a substep of position contacts (shared/position.h): two sweeps of a counting pass and
 // a projection (which moves the bodies: BodyPos and BodyQuat read back too; the first flagged
-// MOTES_FLAG_POSITION_FIRST) and the velocity pass, each a compute and an apply.
+// MOTES_FLAG_POSITION_FIRST, the second count MOTES_FLAG_POSITION_GRAM: each body's Gram bound,
+// which the velocity pass steps by) and the velocity pass, each a compute and an apply.
 //
 // Tolerance: NMSE 1e-7. The terms come from the same shared functions and floats, summed in float
 // in the contract's order (list order, then particle order per body), so openmp matches bitwise
@@ -121,7 +122,7 @@ class ImpulsesComputeThenApply : public DeviceTest {
       // (the contacts the first projected are kept, overlapping or not), the velocity pass.
       pass(MOTES_FLAG_POSITION | MOTES_FLAG_POSITION_FIRST | MOTES_FLAG_IMPULSE_COUNT);
       pass(MOTES_FLAG_POSITION | MOTES_FLAG_POSITION_FIRST);
-      pass(MOTES_FLAG_POSITION | MOTES_FLAG_IMPULSE_COUNT);
+      pass(MOTES_FLAG_POSITION | MOTES_FLAG_IMPULSE_COUNT | MOTES_FLAG_POSITION_GRAM);
       pass(MOTES_FLAG_POSITION);
       pass(MOTES_FLAG_POSITION | MOTES_FLAG_POSITION_VELOCITY);
     } else {
@@ -137,7 +138,7 @@ class ImpulsesComputeThenApply : public DeviceTest {
     motes_ref::Bodies want = w.bodies;
     for (const StepParams& q : passes) {
       motes_ref::impulses_compute(w.particles, want, nb, w.laws, w.planes, q, s);
-      motes_ref::impulses_apply(want, q, s);
+      motes_ref::impulses_apply(want, q, s, w.particles.pos);
     }
 
     ASSERT_NO_FATAL_FAILURE(allocate(w.sizes));

@@ -69,7 +69,7 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
                                       particle(particles, bodies, j, p.flags), i < j, margin,
                                       laws[law], p.gravity_dt, p.flags, a, arm);
       if (slotted) keep(at, a);
-      motes::shared::impulse_add(sum, moment, r, arm);
+      motes::shared::impulse_add(sum, moment, r, arm, p.flags);
     }
     for (std::size_t k = 0; k < planes.size(); ++k) {
       const PlaneData& pl = planes[k];
@@ -81,7 +81,7 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
           laws[std::size_t{particles.material[i]} * p.material_count + pl.material], p.gravity_dt,
           p.flags, a, arm);
       keep(at, a);
-      motes::shared::impulse_add(sum, moment, r, arm);
+      motes::shared::impulse_add(sum, moment, r, arm, p.flags);
     }
     s.impulse[i] = sum;
     s.moment[i] = vec4(moment, 0.0f);

@@ -232,13 +232,17 @@ void impulses_compute(const Particles& particles, const Bodies& bodies, const Ne
                       const StepParams& p, ImpulseState& s);
 
 /// impulses_apply: each dynamic body's particles' impulses, counts and moments summed in float in
-/// particle order; the counting pass first keeps vel0 = (vel, count) and angvel0 = angvel (a
-/// position contacts' counting pass after the first keeps their velocities:
-/// shared::impulse_start_velocity) and
-/// stamps the dynamic bodies' particles with builds; then
-/// shared::body_apply_impulse (static bodies: angvel from angmom only); with
-/// MOTES_FLAG_IMPULSE_PUSH, vel_push and angmom_push = what it leaves.
-void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s);
+/// chunks of MOTES_BODY_CHUNK particles from its first (each chunk in particle order from zero,
+/// then the chunks' sums in order from zero: plain particle order for a body of up to 64); the
+/// counting pass first keeps vel0 = (vel, count) and angvel0 = angvel (a position contacts'
+/// counting pass after the first keeps their velocities: shared::impulse_start_velocity) and stamps
+/// the dynamic bodies' particles with builds; then shared::body_apply_impulse (static bodies:
+/// angvel from angmom only); with MOTES_FLAG_IMPULSE_PUSH, vel_push and angmom_push = what it
+/// leaves. With MOTES_FLAG_POSITION_GRAM the sums are n n^T (shared::impulse_add), angvel0.w =
+/// shared:: gram_bound of shared::gram_add over the body's particles in particle order (arms from
+/// pos, the particles' positions), and nothing is applied.
+void impulses_apply(Bodies& bodies, const StepParams& p, ImpulseState& s,
+                    const std::vector<vec4>& pos = {});
 
 /// What neighbours_build does to ImpulseStamp (impulse contacts): each rigid particle i whose
 /// stamp is `built` (the last build's count) and whose new list `now` equals its old one

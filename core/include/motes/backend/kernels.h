@@ -64,11 +64,15 @@
 //   zeroed): the counting pass, the projection, or (MOTES_FLAG_POSITION_VELOCITY) the velocity
 //   pass, which may follow a projection that moved the poses.
 // impulses_apply: every dynamic body sums its particles' ParticleForce and ParticleMoment in
-//   particle order, then shared/impulse.h: body_apply_impulse (BodyVel, BodyAngMom, BodyAngVel).
+//   chunks of 64 particles (each in particle order, then the chunks in order: shared/impulse.h,
+//   MOTES_BODY_CHUNK), then shared/impulse.h: body_apply_impulse (BodyVel, BodyAngMom, BodyAngVel).
 //   With MOTES_FLAG_IMPULSE_COUNT instead: BodyVelStart = (BodyVel xyz, the summed count),
 //   BodyAngVelStart = BodyAngVel; with MOTES_FLAG_IMPULSE_PUSH the pushed velocities. With
 //   MOTES_FLAG_POSITION alone (the projection of position contacts), shared/impulse.h:
-//   body_apply_contacts moves BodyPos and BodyQuat too (shared/position.h).
+//   body_apply_contacts moves BodyPos and BodyQuat too (shared/position.h). With
+//   MOTES_FLAG_POSITION_GRAM (a counting pass) the sums are each particle's n n^T, and
+//   BodyAngVelStart.w gets the body's contact Gram bound from them and ParticlePos
+//   (shared/contact_gram.h); nothing is applied.
 // particles_check (not part of a step: the motion guard): MotionCheck gets the largest
 //   (|v| / d)^2 of a finite particle of [0, particle_count), the first particle with it and its
 //   |v|^2, and the first particle whose position or velocity is not finite
@@ -139,7 +143,7 @@
   X(ImpulsesApply, impulses_apply,                                                               \
     (ParticleForce, ParticleMoment, BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel,          \
      BodyInvInertia, BodyFirst, BodyVelStart, BodyAngVelStart, NeighbourState, ImpulseStamp,     \
-     BodyVelPush, BodyAngMomPush),                                                               \
+     BodyVelPush, BodyAngMomPush, ParticlePos),                                                  \
     (BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel, BodyVelStart, BodyAngVelStart,          \
      ImpulseStamp, BodyVelPush, BodyAngMomPush))                                                 \
   X(ParticlesCheck, particles_check, (ParticlePos, ParticleVel), (MotionCheck))                  \
