@@ -51,49 +51,40 @@ MOTES_FN void gram_merge(MOTES_INOUT(ContactGram) total, MOTES_IN(ContactGram) p
   for (int i = 0; i < 36; ++i) total.k[i] += part.k[i];
 }
 
+/// Adds the 3 x 3 block of rows a0, a1, a2 to K at (row, col).
+MOTES_FN void gram_block_add(MOTES_INOUT(ContactGram) g, int row, int col, vec3 a0, vec3 a1,
+                             vec3 a2) {
+  g.k[row * 6 + col] += a0.x;
+  g.k[row * 6 + col + 1] += a0.y;
+  g.k[row * 6 + col + 2] += a0.z;
+  g.k[(row + 1) * 6 + col] += a1.x;
+  g.k[(row + 1) * 6 + col + 1] += a1.y;
+  g.k[(row + 1) * 6 + col + 2] += a1.z;
+  g.k[(row + 2) * 6 + col] += a2.x;
+  g.k[(row + 2) * 6 + col + 1] += a2.y;
+  g.k[(row + 2) * 6 + col + 2] += a2.z;
+}
+
 /// Adds a particle's contacts to its body's K: nn_diag.xyz and nn_off.xyz are the diagonal (xx,
 /// yy, zz) and off-diagonal (xy, xz, yz) of S = sum of n n^T over its contacts, r its centre from
 /// the body's centre. Nothing for a particle without contacts.
 MOTES_FN void gram_add(MOTES_INOUT(ContactGram) g, vec4 nn_diag, vec4 nn_off, vec3 r) {
   if (nn_diag.x == 0.0f && nn_diag.y == 0.0f && nn_diag.z == 0.0f) return;
-  float s[9];
-  s[0] = nn_diag.x;
-  s[1] = nn_off.x;
-  s[2] = nn_off.y;
-  s[3] = nn_off.x;
-  s[4] = nn_diag.y;
-  s[5] = nn_off.z;
-  s[6] = nn_off.y;
-  s[7] = nn_off.z;
-  s[8] = nn_diag.z;
-  // R = [r]x: R v = r x v.
-  float rx[9];
-  rx[0] = 0.0f;
-  rx[1] = -r.z;
-  rx[2] = r.y;
-  rx[3] = r.z;
-  rx[4] = 0.0f;
-  rx[5] = -r.x;
-  rx[6] = -r.y;
-  rx[7] = r.x;
-  rx[8] = 0.0f;
-  // P = S R^T (the linear-angular block), Q = R P (the angular block).
-  float pm[9];
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      pm[i * 3 + j] =
-          s[i * 3] * rx[j * 3] + s[i * 3 + 1] * rx[j * 3 + 1] + s[i * 3 + 2] * rx[j * 3 + 2];
-    }
-  }
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      float q = rx[i * 3] * pm[j] + rx[i * 3 + 1] * pm[3 + j] + rx[i * 3 + 2] * pm[6 + j];
-      g.k[i * 6 + j] += s[i * 3 + j];
-      g.k[i * 6 + 3 + j] += pm[i * 3 + j];
-      g.k[(3 + j) * 6 + i] += pm[i * 3 + j];
-      g.k[(3 + i) * 6 + 3 + j] += q;
-    }
-  }
+  // With R = [r]x (R v = r x v): the rows of S, of S R^T (row i: r x s_i), of its transpose R S
+  // (the columns of S R^T) and of R S R^T (symmetric; row j: r x (column j of S R^T)).
+  vec3 s0 = vec3(nn_diag.x, nn_off.x, nn_off.y);
+  vec3 s1 = vec3(nn_off.x, nn_diag.y, nn_off.z);
+  vec3 s2 = vec3(nn_off.y, nn_off.z, nn_diag.z);
+  vec3 p0 = cross(r, s0);
+  vec3 p1 = cross(r, s1);
+  vec3 p2 = cross(r, s2);
+  vec3 c0 = vec3(p0.x, p1.x, p2.x);
+  vec3 c1 = vec3(p0.y, p1.y, p2.y);
+  vec3 c2 = vec3(p0.z, p1.z, p2.z);
+  gram_block_add(g, 0, 0, s0, s1, s2);
+  gram_block_add(g, 0, 3, p0, p1, p2);
+  gram_block_add(g, 3, 0, c0, c1, c2);
+  gram_block_add(g, 3, 3, cross(r, c0), cross(r, c1), cross(r, c2));
 }
 
 /// An upper bound of the largest eigenvalue of M^-1/2 K M^-1/2 for a body (com.w: inverse mass,
