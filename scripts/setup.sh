@@ -13,6 +13,7 @@ packages=(build-essential cmake ninja-build pkg-config git
   clang libclang-rt-14-dev
   glslang-tools spirv-tools libvulkan-dev libvulkan-volk-dev libvulkan1 mesa-vulkan-drivers
   vulkan-validationlayers libstb-dev ffmpeg python3-dev python3-pybind11 python3-numpy python3-scipy
+  libglfw3-dev xvfb xdotool
   python3-pytest libopenmpi-dev openmpi-bin)
 
 if [ "${MOTES_SKIP_INSTALL:-0}" != 1 ]; then

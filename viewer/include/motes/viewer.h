@@ -1,0 +1,112 @@
+// The interactive viewer's drawing (docs/viewer.md): particles as lit sphere impostors and the
+// ground with its grid, drawn by a Vulkan graphics pipeline into an offscreen picture or a GLFW
+// window, in the headless renderer's picture conventions (motes/render.h) so that both pictures
+// of one state line up. Errors are thrown as std::runtime_error with a one-line message (Vulkan
+// validation messages, when MOTES_VULKAN_VALIDATION is set, are errors too).
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "motes/render.h"
+#include "motes/simulation.h"
+
+namespace motes::viewer {
+
+/// What the pictures show besides the particles' positions, and how particles are coloured.
+struct Style {
+  render::SceneLook look;
+  render::ColorBy color_by = render::ColorBy::Body;
+};
+
+/// Draws into an offscreen colour and depth image and reads the picture back.
+class Offscreen {
+ public:
+  /// The ground's extent and grid, and the height colours, come from `first_frame` (as the
+  /// headless renderer takes them from the first frame it draws).
+  Offscreen(render::Size size, const Style& style, const Snapshot& first_frame);
+  ~Offscreen();
+  Offscreen(const Offscreen&) = delete;
+  Offscreen& operator=(const Offscreen&) = delete;
+
+  /// Draws `frame` seen by `camera`; the reference stays valid until the next call.
+  const render::Image& draw(const render::Camera& camera, const Snapshot& frame);
+  /// The Vulkan device that draws.
+  [[nodiscard]] const std::string& device_name() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// No window can be opened: no display, or GLFW could not start. Its message is one line.
+struct NoDisplay : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// What the person did since the last poll.
+struct Input {
+  float orbit_x = 0.0f;  ///< pixels dragged with the left button
+  float orbit_y = 0.0f;
+  float pan_x = 0.0f;  ///< pixels dragged with the right or middle button
+  float pan_y = 0.0f;
+  float zoom = 0.0f;         ///< wheel steps (positive: towards the target)
+  bool pause = false;        ///< Space
+  bool step = false;         ///< .
+  bool reset = false;        ///< R
+  bool slow_motion = false;  ///< S
+  bool screenshot = false;   ///< P
+  bool quit = false;         ///< Esc, Q or the window closed
+};
+
+/// A GLFW window with a Vulkan swapchain.
+class Window {
+ public:
+  /// Opens a window of `size` pixels; throws NoDisplay when there is no display.
+  Window(render::Size size, const std::string& title, const Style& style,
+         const Snapshot& first_frame);
+  ~Window();
+  Window(const Window&) = delete;
+  Window& operator=(const Window&) = delete;
+
+  /// Handles the window system's events and returns what the person did.
+  Input poll();
+  void set_title(const std::string& title);
+  /// The drawable size in pixels (changes when the window is resized).
+  [[nodiscard]] render::Size size() const;
+  /// Draws `frame` and shows it; with `screenshot`, also reads the shown picture back into it.
+  void draw(const render::Camera& camera, const Snapshot& frame, render::Image* screenshot);
+  /// New colours and extent after a reset (a reloaded scene).
+  void restyle(const Style& style, const Snapshot& first_frame);
+  [[nodiscard]] const std::string& device_name() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Mouse camera control around a target: orbit about `up`, pan across the view, zoom in and out.
+/// Until moved, camera() is the starting camera exactly.
+class Orbit {
+ public:
+  explicit Orbit(const render::Camera& start);
+  void orbit(float dx_pixels, float dy_pixels);
+  void pan(float dx_pixels, float dy_pixels, render::Size size);
+  void zoom(float steps);
+  [[nodiscard]] render::Camera camera() const;
+
+ private:
+  render::Camera start_;
+  bool moved_ = false;
+  Eigen::Vector3f target_;
+  Eigen::Vector3f up_;
+  float distance_ = 1.0f;
+  float azimuth_ = 0.0f;    ///< radians about up, from the ground's z axis towards its x axis
+  float elevation_ = 0.0f;  ///< radians above the ground
+  float fov_degrees_ = 40.0f;
+};
+
+}  // namespace motes::viewer

@@ -1,0 +1,56 @@
+// The render pass and the two pipelines (backdrop: sky and ground; spheres: one quad per
+// particle), the particles' instance buffer, and the copy of a drawn picture to the host.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "gpu.h"
+#include "motes/render.h"
+#include "style.h"
+
+namespace motes::viewer {
+
+class Painter {
+ public:
+  /// For colour attachments of `color_format`, left in `final_layout` after the pass.
+  Painter(const Gpu& gpu, VkFormat color_format, VkImageLayout final_layout);
+  ~Painter();
+  Painter(const Painter&) = delete;
+  Painter& operator=(const Painter&) = delete;
+
+  /// Copies the particles into the instance buffer (grown as needed). The previous draw must be
+  /// done.
+  void upload(const std::vector<Instance>& instances);
+  /// Records the pass: clear, backdrop, spheres.
+  void record(VkCommandBuffer cmd, VkFramebuffer framebuffer, VkExtent2D extent,
+              const ViewConstants& constants) const;
+
+  [[nodiscard]] VkRenderPass render_pass() const { return render_pass_; }
+  [[nodiscard]] VkFormat depth_format() const { return depth_format_; }
+
+ private:
+  VkPipeline make_pipeline(const char* vert, const char* frag, bool spheres) const;
+
+  const Gpu& gpu_;
+  VkFormat depth_format_ = VK_FORMAT_UNDEFINED;
+  VkRenderPass render_pass_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline backdrop_ = VK_NULL_HANDLE;
+  VkPipeline spheres_ = VK_NULL_HANDLE;
+  std::unique_ptr<HostBuffer> instances_;
+  std::uint32_t instance_count_ = 0;
+};
+
+/// A framebuffer of a colour view and a depth view.
+VkFramebuffer make_framebuffer(const Gpu& gpu, VkRenderPass pass, VkImageView color,
+                               VkImageView depth, VkExtent2D extent);
+
+/// Records the copy of `image` (in `layout`, left in `layout`) into `buffer`, tightly packed
+/// 4 bytes a pixel, and makes it visible to the host.
+void record_readback(const Gpu& gpu, VkCommandBuffer cmd, VkImage image, VkImageLayout layout,
+                     VkExtent2D extent, VkBuffer buffer);
+/// The picture in `mapped` (4 bytes a pixel, RGBA or with `bgra` BGRA) as an RGB image.
+void unpack_rgb(const void* mapped, VkExtent2D extent, bool bgra, render::Image& out);
+
+}  // namespace motes::viewer
