@@ -17,6 +17,8 @@ void add_voxelize_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 /// `motes render RESULTS`: pictures and video of frames written by motes run (cmd_render.cpp).
 void add_render_command(CLI::App& app);
+/// `motes view SCENE`: the scene in a window, stepped in real time (cmd_view.cpp).
+void add_view_command(CLI::App& app);
 /// `motes render-bench`: times the renderer on a block of particles (cmd_render_bench.cpp).
 void add_render_bench_command(CLI::App& app);
 

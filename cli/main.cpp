@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   motes::cli::add_bench_command(app);
   motes::cli::add_render_command(app);
   motes::cli::add_render_bench_command(app);
+  motes::cli::add_view_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
