@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -38,6 +39,8 @@ struct ViewArgs {
   std::string screenshot;
   bool offscreen = false;
   std::string color_by = "body";
+  std::string input;
+  std::string save_state;
 };
 
 #ifdef MOTES_HAVE_VIEWER
@@ -89,62 +92,85 @@ std::uint64_t frame_steps(double dt) {
   return static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / (kFrameRate * dt))));
 }
 
-void view_offscreen(const ViewArgs& args, const Scene& scene, render::Size size,
-                    const viewer::Style& style, const render::Camera& camera,
-                    std::unique_ptr<Simulation> sim, const Snapshot& first) {
-  if (args.frames == 0) fail("--offscreen needs --frames N (how many frames to draw)");
-  viewer::Offscreen out(size, style, first);
-  const std::uint64_t steps = frame_steps(scene.settings.dt);
-  double step_s = 0.0, draw_s = 0.0;
-  const render::Image* image = nullptr;
-  for (std::uint64_t f = 0; f < args.frames && g_stop == 0; ++f) {
-    const auto t0 = Clock::now();
-    must_step(*sim, steps);
-    const Snapshot frame = must_snapshot(*sim);
-    const auto t1 = Clock::now();
-    image = &out.draw(camera, frame);
-    step_s += std::chrono::duration<double>(t1 - t0).count();
-    draw_s += seconds_since(t1);
-  }
-  if (image != nullptr && !args.screenshot.empty()) must_write(args.screenshot, *image);
-  const double frames = static_cast<double>(args.frames);
-  fmt::print(
-      "motes view: {} frames of {} steps, {} particles on {}, drawn offscreen on {}: {:.2f} ms "
-      "step and {:.2f} ms draw a frame{}\n",
-      args.frames, steps, sim->particle_count(), sim->device().info().backend, out.device_name(),
-      1e3 * step_s / frames, 1e3 * draw_s / frames,
-      args.screenshot.empty() ? "" : fmt::format("; picture {}", args.screenshot));
-  std::fflush(stdout);
-}
+/// Where frames go: a window (with the person's input) or an offscreen picture (no input but the
+/// script's). One loop drives both, so scripted input does the same offscreen as in a window.
+class Surface {
+ public:
+  virtual ~Surface() = default;
+  virtual viewer::Input poll() = 0;
+  [[nodiscard]] virtual render::Size size() const = 0;
+  virtual void draw(const render::Camera& camera, const Snapshot& frame, render::Image* shot) = 0;
+  virtual void restyle(const viewer::Style& style, const Snapshot& first) = 0;
+  virtual void set_title(const std::string& title) = 0;
+  [[nodiscard]] virtual const std::string& device_name() const = 0;
+  [[nodiscard]] virtual bool real_time() const = 0;
+};
 
-void view_window(const ViewArgs& args, render::Size size, viewer::Style style,
-                 const render::Camera& camera, std::unique_ptr<Simulation> sim, Snapshot frame) {
-  const std::string name = std::filesystem::path(args.scene).filename().string();
-  std::unique_ptr<viewer::Window> window;
-  try {
-    window = std::make_unique<viewer::Window>(size, "motes view: " + name, style, frame);
-  } catch (const viewer::NoDisplay& e) {
-    sim.reset();  // the compute device goes before the exit handlers
-    fmt::print(stderr, "motes view: no display ({}); use --offscreen\n", e.what());
-    std::fflush(stderr);
-    std::exit(1);
+class WindowSurface final : public Surface {
+ public:
+  explicit WindowSurface(std::unique_ptr<viewer::Window> w) : window_(std::move(w)) {}
+  viewer::Input poll() override { return window_->poll(); }
+  [[nodiscard]] render::Size size() const override { return window_->size(); }
+  void draw(const render::Camera& camera, const Snapshot& frame, render::Image* shot) override {
+    window_->draw(camera, frame, shot);
   }
+  void restyle(const viewer::Style& style, const Snapshot& first) override {
+    window_->restyle(style, first);
+  }
+  void set_title(const std::string& title) override { window_->set_title(title); }
+  [[nodiscard]] const std::string& device_name() const override { return window_->device_name(); }
+  [[nodiscard]] bool real_time() const override { return true; }
+
+ private:
+  std::unique_ptr<viewer::Window> window_;
+};
+
+class OffscreenSurface final : public Surface {
+ public:
+  OffscreenSurface(render::Size size, const viewer::Style& style, const Snapshot& first)
+      : size_(size), out_(std::make_unique<viewer::Offscreen>(size, style, first)) {}
+  viewer::Input poll() override { return {}; }
+  [[nodiscard]] render::Size size() const override { return size_; }
+  void draw(const render::Camera& camera, const Snapshot& frame, render::Image* shot) override {
+    const render::Image& image = out_->draw(camera, frame);
+    if (shot != nullptr) *shot = image;
+  }
+  void restyle(const viewer::Style& style, const Snapshot& first) override {
+    out_.reset();  // one Vulkan device at a time
+    out_ = std::make_unique<viewer::Offscreen>(size_, style, first);
+  }
+  void set_title(const std::string& /*title*/) override {}
+  [[nodiscard]] const std::string& device_name() const override { return out_->device_name(); }
+  [[nodiscard]] bool real_time() const override { return false; }
+
+ private:
+  render::Size size_;
+  std::unique_ptr<viewer::Offscreen> out_;
+};
+
+void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
+              const render::Camera& camera, std::unique_ptr<Simulation>& sim, Snapshot frame,
+              const std::optional<viewer::Script>& script) {
+  const std::string name = std::filesystem::path(args.scene).filename().string();
   const std::string backend = sim->device().info().backend;
   viewer::Orbit orbit(camera);
   std::uint64_t steps = frame_steps(sim->settings().dt);
   bool paused = false, slow = false;
   double owed_steps = 0.0;
   std::uint64_t shown = 0;
+  double total_step = 0.0, total_draw = 0.0;
   // Title statistics over about half a second.
   auto window_start = Clock::now();
   int window_frames = 0;
   double window_step = 0.0, window_draw = 0.0, window_simulated = 0.0;
+  render::Image last_picture;
   for (;;) {
     const auto frame_start = Clock::now();
-    const viewer::Input in = window->poll();
+    viewer::Input in = surface.poll();
+    if (script) in.merge(script->at(shown));
     if (in.quit || g_stop != 0) break;
     orbit.orbit(in.orbit_x, in.orbit_y);
-    orbit.pan(in.pan_x, in.pan_y, window->size());
+    orbit.pan(in.pan_x, in.pan_y, surface.size());
     orbit.zoom(in.zoom);
     if (in.pause) paused = !paused;
     if (in.slow_motion) slow = !slow;
@@ -160,7 +186,7 @@ void view_window(const ViewArgs& args, render::Size size, viewer::Style style,
         steps = frame_steps(sim->settings().dt);
         frame = must_snapshot(*sim);
         style.look = render::look_from_scene(reloaded.value());
-        window->restyle(style, frame);
+        surface.restyle(style, frame);
         owed_steps = 0.0;
       }
     }
@@ -176,27 +202,32 @@ void view_window(const ViewArgs& args, render::Size size, viewer::Style style,
       frame = must_snapshot(*sim);
     }
     const auto t1 = Clock::now();
+    const bool last = args.frames > 0 && shown + 1 >= args.frames;
+    const bool keep = in.screenshot || (last && !args.screenshot.empty());
     render::Image picture;
-    window->draw(orbit.camera(), frame, in.screenshot ? &picture : nullptr);
+    surface.draw(orbit.camera(), frame, keep ? &picture : nullptr);
     if (in.screenshot) {
       const std::string file = numbered_screenshot();
       must_write(file, picture);
       fmt::print("motes view: picture {}\n", file);
       std::fflush(stdout);
     }
+    if (keep) last_picture = std::move(picture);
     const double step_s = std::chrono::duration<double>(t1 - t0).count();
     const double draw_s = seconds_since(t1);
     ++shown;
+    total_step += step_s;
+    total_draw += draw_s;
     ++window_frames;
     window_step += step_s;
     window_draw += draw_s;
     window_simulated += static_cast<double>(advance) * sim->settings().dt;
     const double elapsed = seconds_since(window_start);
-    if (elapsed >= 0.5 || shown == 1) {
+    if (surface.real_time() && (elapsed >= 0.5 || shown == 1)) {
       const double fps = window_frames / elapsed;
       const double factor = window_simulated / elapsed;
       const bool behind = !paused && window_step / window_frames > 1.0 / kFrameRate;
-      window->set_title(fmt::format(
+      surface.set_title(fmt::format(
           "motes view: {} | {:.0f} fps | step {:.1f} ms, draw {:.1f} ms | {:.2f}x real time{} | "
           "{} particles | {}{}{}",
           name, fps, 1e3 * window_step / window_frames, 1e3 * window_draw / window_frames, factor,
@@ -206,22 +237,30 @@ void view_window(const ViewArgs& args, render::Size size, viewer::Style style,
       window_frames = 0;
       window_step = window_draw = window_simulated = 0.0;
     }
-    if (args.frames > 0 && shown >= args.frames) break;
+    if (last) break;
     // Real time: a frame lasts at least 1/60 s (longer when stepping and drawing take longer).
-    std::this_thread::sleep_until(frame_start +
-                                  std::chrono::duration_cast<Clock::duration>(
-                                      std::chrono::duration<double>(1.0 / kFrameRate)));
+    if (surface.real_time()) {
+      std::this_thread::sleep_until(frame_start +
+                                    std::chrono::duration_cast<Clock::duration>(
+                                        std::chrono::duration<double>(1.0 / kFrameRate)));
+    }
   }
   if (!args.screenshot.empty()) {
-    render::Image picture;
-    window->draw(orbit.camera(), frame, &picture);
-    must_write(args.screenshot, picture);
+    if (last_picture.rgb.empty()) surface.draw(orbit.camera(), frame, &last_picture);
+    must_write(args.screenshot, last_picture);
   }
-  fmt::print("motes view: {} frames shown, {} particles on {}, drawn on {}{}\n", shown,
-             sim->particle_count(), backend, window->device_name(),
-             args.screenshot.empty() ? "" : fmt::format("; picture {}", args.screenshot));
+  if (!args.save_state.empty()) {
+    if (Status s = sim->save_state(args.save_state); !s) fail(s.message());
+  }
+  const double n = static_cast<double>(std::max<std::uint64_t>(shown, 1));
+  fmt::print(
+      "motes view: {} frames shown, {} particles on {}, drawn {}on {}: {:.2f} ms step and {:.2f} "
+      "ms draw a frame{}{}\n",
+      shown, sim->particle_count(), backend, surface.real_time() ? "" : "offscreen ",
+      surface.device_name(), 1e3 * total_step / n, 1e3 * total_draw / n,
+      args.screenshot.empty() ? "" : fmt::format("; picture {}", args.screenshot),
+      args.save_state.empty() ? "" : fmt::format("; state {}", args.save_state));
   std::fflush(stdout);
-  window.reset();
 }
 
 void view(const ViewArgs& args) {
@@ -238,6 +277,14 @@ void view(const ViewArgs& args) {
       std::exit(1);
     }
   }
+  std::optional<viewer::Script> script;
+  if (!args.input.empty()) {
+    try {
+      script = viewer::Script::load(args.input);
+    } catch (const std::runtime_error& e) {
+      fail(e.what());
+    }
+  }
   Result<Scene> scene = load_scene_file(args.scene);
   if (!scene) fail(scene.message());
   std::unique_ptr<Simulation> sim = make_simulation(scene.value(), args);
@@ -251,11 +298,26 @@ void view(const ViewArgs& args) {
                                          style.look.ground_height);
   std::signal(SIGTERM, on_stop_signal);
   std::signal(SIGINT, on_stop_signal);
+  std::unique_ptr<Surface> surface;
   if (args.offscreen) {
-    view_offscreen(args, scene.value(), size.value(), style, camera, std::move(sim), first);
+    if (args.frames == 0 && !(script && script->quits())) {
+      fail("--offscreen needs --frames N, or an --input script that quits (when to stop)");
+    }
+    surface = std::make_unique<OffscreenSurface>(size.value(), style, first);
   } else {
-    view_window(args, size.value(), style, camera, std::move(sim), std::move(first));
+    const std::string name = std::filesystem::path(args.scene).filename().string();
+    try {
+      surface = std::make_unique<WindowSurface>(
+          std::make_unique<viewer::Window>(size.value(), "motes view: " + name, style, first));
+    } catch (const viewer::NoDisplay& e) {
+      sim.reset();  // the compute device goes before the exit handlers
+      fmt::print(stderr, "motes view: no display ({}); use --offscreen\n", e.what());
+      std::fflush(stderr);
+      std::exit(1);
+    }
   }
+  run_view(args, *surface, style, camera, sim, std::move(first), script);
+  surface.reset();
 }
 
 #else
@@ -287,8 +349,15 @@ void add_view_command(CLI::App& app) {
   sub->add_option("--frames", args->frames, "stop after this many frames (default: until closed)")
       ->check(whole_number(1));
   sub->add_option("--screenshot", args->screenshot, "write the last frame's picture as a PNG file");
-  sub->add_flag("--offscreen", args->offscreen,
-                "draw without a window (needs --frames; for machines without a display)");
+  sub->add_option("--input", args->input,
+                  "scripted input: timed key, drag, wheel and quit events by frame "
+                  "(docs/viewer.md)");
+  sub->add_option("--save-state", args->save_state,
+                  "at the end, write the state as a checkpoint (motes resume, "
+                  "Simulation::load_state)");
+  sub->add_flag(
+      "--offscreen", args->offscreen,
+      "draw without a window (needs --frames or --input; for machines without a display)");
   sub->add_option("--color-by", args->color_by,
                   fmt::format("particle colours: {}", render::color_by_names()))
       ->capture_default_str();

@@ -274,4 +274,120 @@ TEST(ViewWindow, ClosedMidRunLeavesNoProcess) {
   EXPECT_NE(kill(pid, 0), 0);  // gone, and reaped
 }
 
+// Scripted input (--input): the same Input as keys and mouse, offscreen too.
+
+/// Writes `text` to the scratch file `name`.
+fs::path write_file(const std::string& name, const std::string& text) {
+  const fs::path path = scratch(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+/// The state a `--save-state` run left.
+motes::Snapshot saved_state(const fs::path& path) {
+  motes::Scene scene = motes::load_scene_file(kScene).value();
+  auto sim = motes::Simulation::create(scene, motes::open_device("openmp").value()).value();
+  EXPECT_TRUE(sim->load_state(path.string()));
+  return sim->snapshot().value();
+}
+
+std::uint64_t steps_per_frame() {
+  const double dt = motes::load_scene_file(kScene).value().settings.dt;
+  return static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / (60.0 * dt))));
+}
+
+/// Runs `motes view` offscreen on openmp for `frames` frames with the script `script` (none when
+/// empty) and returns the state it saved.
+motes::Snapshot scripted_run(const std::string& tag, int frames, const std::string& script) {
+  const fs::path state = scratch(tag + ".state");
+  std::string command = std::string(MOTES_CLI_PATH) + " view " + kScene +
+                        " --backend openmp --offscreen --size 320x240 --frames " +
+                        std::to_string(frames) + " --save-state " + state.string();
+  if (!script.empty()) command += " --input " + write_file(tag + ".txt", script).string();
+  EXPECT_EQ(shell(command), 0) << command;
+  return saved_state(state);
+}
+
+bool same_positions(const motes::Snapshot& a, const motes::Snapshot& b) {
+  if (a.particle_pos.size() != b.particle_pos.size()) return false;
+  for (std::size_t i = 0; i < a.particle_pos.size(); ++i) {
+    if (a.particle_pos[i].x != b.particle_pos[i].x || a.particle_pos[i].y != b.particle_pos[i].y ||
+        a.particle_pos[i].z != b.particle_pos[i].z) {
+      return false;
+    }
+  }
+  return true;
+}
+
+TEST(ViewScript, SpacePausesAndResetStartsAgain) {
+  const std::uint64_t steps = steps_per_frame();
+  const motes::Snapshot five = scripted_run("five", 5, "");
+  const motes::Snapshot two = scripted_run("two", 2, "");
+  const motes::Snapshot fifteen = scripted_run("fifteen", 15, "");
+  EXPECT_EQ(five.step, 5 * steps);
+  EXPECT_EQ(fifteen.step, 15 * steps);
+  EXPECT_FALSE(same_positions(five, fifteen));  // the bodies move, so a pause shows
+  // Paused from frame 5 on: the state of frame 5, 10 frames later.
+  const motes::Snapshot paused = scripted_run("paused", 15, "5 key space  # pause\n");
+  EXPECT_EQ(paused.step, 5 * steps);
+  EXPECT_TRUE(same_positions(paused, five));
+  // Paused, one frame's steps with '.', then on again.
+  const motes::Snapshot stepped = scripted_run("stepped", 8, "2 key space\n4 key .\n6 key space\n");
+  EXPECT_EQ(stepped.step, 5 * steps);  // frames 0, 1, 4, 6, 7
+  EXPECT_TRUE(same_positions(stepped, five));
+  // Reset at frame 10 of 12: the scene from the start, then frames 10 and 11.
+  const motes::Snapshot reset = scripted_run("reset", 12, "10 key r\n");
+  EXPECT_EQ(reset.step, 2 * steps);
+  EXPECT_TRUE(same_positions(reset, two));
+}
+
+TEST(ViewScript, QuitEndsARunWithoutAFrameLimit) {
+  const fs::path script = write_file("quit.txt", "3 quit\n");
+  const fs::path state = scratch("quit.state");
+  ASSERT_EQ(shell(std::string(MOTES_CLI_PATH) + " view " + kScene +
+                  " --backend openmp --offscreen --size 320x240 --input " + script.string() +
+                  " --save-state " + state.string()),
+            0);
+  EXPECT_EQ(saved_state(state).step, 3 * steps_per_frame());
+}
+
+TEST(ViewScript, DragOrbitsTheCamera) {
+  const fs::path still = scratch("still.png"), dragged = scratch("dragged.png");
+  const std::string base = std::string(MOTES_CLI_PATH) + " view " + kScene +
+                           " --backend openmp --offscreen --size 320x240 --frames 6 ";
+  ASSERT_EQ(shell(base + "--screenshot " + still.string()), 0);
+  const fs::path script = write_file("orbit.txt", "1 drag 100 120 160 120 3\n");
+  ASSERT_EQ(shell(base + "--input " + script.string() + " --screenshot " + dragged.string()), 0);
+  const double d = difference(load_png(still), load_png(dragged));
+  std::printf("orbit drag changed the picture by %.2f\n", d);
+  EXPECT_GT(d, kSameBelow);
+}
+
+TEST(ViewScript, BadLinesAreOneLineErrorsNamingFileAndLine) {
+  const struct {
+    const char* text;
+    const char* reason;
+  } cases[] = {
+      {"1 key space\n3 key x\n", ":2: unknown key 'x'"},
+      {"# fine\nten key r\n", ":2: frame 'ten' is not a number"},
+      {"4 drag 1 2 3\n", ":1: expected 'FRAME drag"},
+      {"4 jump\n", ":1: unknown event 'jump'"},
+      {"4 drag 1 2 3 4 0\n", ":1: a drag lasts at least 1 frame"},
+  };
+  int n = 0;
+  for (const auto& c : cases) {
+    const fs::path script = write_file("bad" + std::to_string(n) + ".txt", c.text);
+    const fs::path err = scratch("bad" + std::to_string(n++) + ".err");
+    const int rc =
+        shell(std::string(MOTES_CLI_PATH) + " view " + kScene + " --offscreen --frames 2 --input " +
+              script.string() + " 2> " + err.string());
+    EXPECT_NE(rc, 0);
+    std::ifstream in(err);
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    ASSERT_EQ(lines.size(), 1u) << c.text;
+    EXPECT_NE(lines[0].find(script.string() + c.reason), std::string::npos) << lines[0];
+  }
+}
+
 }  // namespace

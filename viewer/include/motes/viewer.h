@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -60,6 +61,33 @@ struct Input {
   bool slow_motion = false;  ///< S
   bool screenshot = false;   ///< P
   bool quit = false;         ///< Esc, Q or the window closed
+
+  /// Adds `other`'s movements and presses to these (a script's events to the window's).
+  void merge(const Input& other);
+};
+
+/// Scripted input (`motes view --input FILE`, docs/viewer.md): timed events by frame number, one
+/// a line, turned into the same Input a person's keys and mouse give. Lines: `FRAME key NAME`
+/// (space, period or ., r, s, p, q, escape), `FRAME wheel STEPS`, `FRAME drag X0 Y0 X1 Y1 N
+/// [left|right|middle]` (pressed at pixel (X0, Y0), moved evenly to (X1, Y1) over the N frames
+/// after FRAME, released at FRAME + N), `FRAME quit`; `#` starts a comment.
+class Script {
+ public:
+  /// Reads `path`; throws std::runtime_error "FILE:LINE: reason" for a bad line.
+  static Script load(const std::string& path);
+  /// Parses `text` (named `name` in error messages).
+  static Script parse(const std::string& text, const std::string& name);
+  /// The input of frame `frame` (0 is the first frame shown).
+  [[nodiscard]] Input at(std::uint64_t frame) const;
+  /// Whether some event quits (so that a run needs no frame limit).
+  [[nodiscard]] bool quits() const;
+
+ private:
+  struct Event {
+    std::uint64_t frame = 0;
+    Input input;
+  };
+  std::vector<Event> events_;
 };
 
 /// A GLFW window with a Vulkan swapchain.
