@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -92,6 +93,101 @@ std::uint64_t frame_steps(double dt) {
   return static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / (kFrameRate * dt))));
 }
 
+/// The ray from the camera through drawable pixel (x, y) (pixel centres at i + 0.5), as the
+/// viewer's shaders and the headless renderer cast it; not normalized: its component along the
+/// camera's forward axis is 1.
+Eigen::Vector3f pixel_ray(const render::Camera& camera, render::Size size, float x, float y) {
+  const Eigen::Vector3f forward = (camera.target - camera.position).normalized();
+  const Eigen::Vector3f right = forward.cross(camera.up).normalized();
+  const Eigen::Vector3f view_up = right.cross(forward);
+  const float half_w = 0.5f * static_cast<float>(size.width);
+  const float half_h = 0.5f * static_cast<float>(size.height);
+  const float focal = half_h / std::tan(0.5f * camera.fov_degrees * 3.14159265f / 180.0f);
+  return forward + (right * (x - half_w) - view_up * (y - half_h)) / focal;
+}
+
+/// Pick and drag (Shift + left button, docs/viewer.md): the nearest sphere of a dynamic body
+/// under the cursor, tested against every particle of the last snapshot on the host, is pulled
+/// towards the point under the cursor on the plane through it that faces the camera.
+class Grab {
+ public:
+  /// Seconds in which the pull would close the gap, and the fastest pull (m/s).
+  static constexpr float kPullTime = 0.1f;
+  static constexpr float kMaxSpeed = 5.0f;
+
+  /// Picks at the cursor; false when the ray meets no dynamic particle.
+  bool start(const Simulation& sim, const Snapshot& frame, const render::Camera& camera,
+             render::Size size, float x, float y) {
+    active_ = false;
+    const Eigen::Vector3f eye = camera.position;
+    const Eigen::Vector3f d = pixel_ray(camera, size, x, y);
+    const float dd = d.squaredNorm();
+    float best = std::numeric_limits<float>::infinity();
+    for (std::size_t i = 0; i < frame.particle_pos.size(); ++i) {
+      const std::uint32_t body = frame.particle_body[i];
+      if (body >= sim.bodies().size() || sim.bodies()[body].kind == BodyKind::Static) continue;
+      const shared::vec4& p = frame.particle_pos[i];
+      const Eigen::Vector3f c(p.x, p.y, p.z);
+      // |eye + t d - c| = r: the nearer root, in units where t = distance along forward.
+      const Eigen::Vector3f oc = eye - c;
+      const float b = oc.dot(d), q = oc.squaredNorm() - p.w * p.w;
+      const float disc = b * b - dd * q;
+      if (disc < 0.0f) continue;
+      const float t = (-b - std::sqrt(disc)) / dd;
+      if (t > 0.0f && t < best) {
+        best = t;
+        particle_ = static_cast<std::uint32_t>(i);
+        body_ = body;
+      }
+    }
+    if (!std::isfinite(best)) return false;
+    const shared::vec4& p = frame.particle_pos[particle_];
+    depth_ = (Eigen::Vector3f(p.x, p.y, p.z) - eye).dot((camera.target - eye).normalized());
+    active_ = true;
+    return true;
+  }
+
+  void stop() { active_ = false; }
+  [[nodiscard]] bool active() const { return active_; }
+  [[nodiscard]] std::uint32_t body() const { return body_; }
+
+  /// Before a step: the velocity that pulls the grabbed point towards the cursor's point, given
+  /// to the whole rigid body (set_body_velocities: its spin is left as it is) or to the grabbed
+  /// particle alone (a soft body's, cloth's or rope's: write_state).
+  void pull(Simulation& sim, const Snapshot& frame, const render::Camera& camera, render::Size size,
+            float x, float y) const {
+    if (!active_) return;
+    const Eigen::Vector3f eye = camera.position;
+    const Eigen::Vector3f target = eye + depth_ * pixel_ray(camera, size, x, y);
+    const shared::vec4& p = frame.particle_pos[particle_];
+    Eigen::Vector3f v = (target - Eigen::Vector3f(p.x, p.y, p.z)) / kPullTime;
+    if (v.norm() > kMaxSpeed) v *= kMaxSpeed / v.norm();
+    const BodyInfo& info = sim.bodies()[body_];
+    if (info.has_body_state() || info.free_sphere) {
+      std::vector<Eigen::Vector3d> velocity(frame.body_vel.size());
+      for (std::size_t b = 0; b < velocity.size(); ++b) {
+        const shared::vec4& u = frame.body_vel[b];
+        velocity[b] = sim.bodies()[b].kind == BodyKind::Static ? Eigen::Vector3d::Zero()
+                                                               : Eigen::Vector3d(u.x, u.y, u.z);
+      }
+      velocity[body_] = v.cast<double>();
+      if (Status s = sim.set_body_velocities(velocity); !s) fail(s.message());
+    } else {
+      Snapshot state = frame;
+      state.particle_vel[particle_].x = v.x();
+      state.particle_vel[particle_].y = v.y();
+      state.particle_vel[particle_].z = v.z();
+      if (Status s = sim.write_state(state); !s) fail(s.message());
+    }
+  }
+
+ private:
+  bool active_ = false;
+  std::uint32_t particle_ = 0;
+  std::uint32_t body_ = 0;
+  float depth_ = 0.0f;  ///< the grabbed point's distance along the camera's forward axis
+};
+
 /// Where frames go: a window (with the person's input) or an offscreen picture (no input but the
 /// script's). One loop drives both, so scripted input does the same offscreen as in a window.
 class Surface {
@@ -164,6 +260,7 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
   int window_frames = 0;
   double window_step = 0.0, window_draw = 0.0, window_simulated = 0.0;
   render::Image last_picture;
+  Grab grab;
   for (;;) {
     const auto frame_start = Clock::now();
     viewer::Input in = surface.poll();
@@ -188,8 +285,18 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
         style.look = render::look_from_scene(reloaded.value());
         surface.restyle(style, frame);
         owed_steps = 0.0;
+        grab.stop();
       }
     }
+    if (in.grab_start) {
+      if (grab.start(*sim, frame, orbit.camera(), surface.size(), in.cursor_x, in.cursor_y)) {
+        fmt::print("motes view: grabbed {}\n", sim->bodies()[grab.body()].name);
+      } else {
+        fmt::print("motes view: nothing to grab at ({:.0f}, {:.0f})\n", in.cursor_x, in.cursor_y);
+      }
+      std::fflush(stdout);
+    }
+    if (!in.grabbing) grab.stop();
     std::uint64_t advance = 0;
     if (!paused || in.step) {
       owed_steps += static_cast<double>(steps) * (slow && !in.step ? 0.25 : 1.0);
@@ -198,9 +305,13 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     }
     const auto t0 = Clock::now();
     if (advance > 0) {
+      if (grab.active()) {
+        grab.pull(*sim, frame, orbit.camera(), surface.size(), in.cursor_x, in.cursor_y);
+      }
       must_step(*sim, advance);
       frame = must_snapshot(*sim);
     }
+    if (in.grab_end) grab.stop();
     const auto t1 = Clock::now();
     const bool last = args.frames > 0 && shown + 1 >= args.frames;
     const bool keep = in.screenshot || (last && !args.screenshot.empty());

@@ -390,4 +390,61 @@ TEST(ViewScript, BadLinesAreOneLineErrorsNamingFileAndLine) {
   }
 }
 
+// Pick and drag (Shift + left drag) through scripted input, offscreen.
+
+// One 4 cm box of 64 particles resting on the floor, seen from the front: the camera looks along
+// -z at the box's centre, so that a drag to the right pulls the box towards +x.
+constexpr const char* kBoxScene = R"({
+  "settings": { "dt": 0.016666666666666666, "substeps": 16, "contact_model": "position",
+                "gravity": [0.0, -9.81, 0.0], "particle_diameter": 0.01 },
+  "materials": { "plastic": { "density": 1200.0, "friction": 0.4, "restitution": 0.3 } },
+  "bodies": [ { "name": "box", "material": "plastic",
+                "shape": { "type": "box", "particles": [4, 4, 4] }, "position": [0.0, 0.02, 0.0] } ],
+  "camera": { "position": [0.0, 0.1, 0.4], "target": [0.0, 0.02, 0.0], "fov": 40.0 },
+  "planes": [ { "name": "floor", "normal": [0.0, 1.0, 0.0], "point": [0.0, 0.0, 0.0] } ]
+})";
+
+/// The box's centre after 30 frames with the script `script` (none when empty).
+Eigen::Vector3d box_after(const std::string& tag, const std::string& script) {
+  const fs::path scene_path = write_file("box.json", kBoxScene);
+  const fs::path state = scratch(tag + ".state");
+  std::string command = std::string(MOTES_CLI_PATH) + " view " + scene_path.string() +
+                        " --backend openmp --offscreen --size 320x240 --frames 30 --save-state " +
+                        state.string();
+  if (!script.empty()) command += " --input " + write_file(tag + ".txt", script).string();
+  EXPECT_EQ(shell(command), 0) << command;
+  motes::Scene scene = motes::load_scene_file(scene_path.string()).value();
+  auto sim = motes::Simulation::create(scene, motes::open_device("openmp").value()).value();
+  EXPECT_TRUE(sim->load_state(state.string()));
+  const motes::Snapshot s = sim->snapshot().value();
+  return {s.body_pos.at(0).x, s.body_pos.at(0).y, s.body_pos.at(0).z};
+}
+
+TEST(ViewGrab, ShiftDragPullsTheBoxSideways) {
+  const Eigen::Vector3d start(0.0, 0.02, 0.0);
+  const Eigen::Vector3d still = box_after("box-still", "");
+  std::printf("left alone: (%.4f, %.4f, %.4f)\n", still.x(), still.y(), still.z());
+  EXPECT_LT(std::abs(still.x() - start.x()), 1e-3);
+  EXPECT_LT(std::abs(still.z() - start.z()), 1e-3);
+  // 60 pixels to the right at the box's depth (0.408 m; focal length 120 / tan 20 degrees =
+  // 330 pixels): 7.4 cm. The pull closes the gap in about 0.1 s and lets go with the drag's end,
+  // so the box lags the cursor: it must move the right way by a good part of that distance.
+  const double expected = 60.0 * std::sqrt(0.08 * 0.08 + 0.4 * 0.4) /
+                          (120.0 / std::tan(20.0 * 3.14159265358979 / 180.0));
+  const Eigen::Vector3d dragged = box_after("box-dragged", "5 drag 165 117 225 117 10 shift\n");
+  const double dx = dragged.x() - still.x();
+  std::printf("dragged 60 px right: moved %.4f m along x (cursor %.4f m), %.4f along z\n", dx,
+              expected, dragged.z() - still.z());
+  EXPECT_GT(dx, 0.3 * expected);
+  EXPECT_LT(dx, 1.5 * expected);
+  EXPECT_LT(std::abs(dragged.z() - still.z()), 0.3 * dx);
+  EXPECT_GT(dragged.y(), 0.0);  // still above the floor
+  // A plain left drag orbits the camera and leaves the box alone, and a grab that misses every
+  // particle pulls nothing.
+  const Eigen::Vector3d orbited = box_after("box-orbited", "5 drag 165 117 225 117 10\n");
+  EXPECT_LT((orbited - still).norm(), 1e-3);
+  const Eigen::Vector3d missed = box_after("box-missed", "5 drag 20 20 80 20 10 shift\n");
+  EXPECT_LT((missed - still).norm(), 1e-3);
+}
+
 }  // namespace

@@ -23,6 +23,13 @@ void Input::merge(const Input& o) {
   slow_motion = slow_motion || o.slow_motion;
   screenshot = screenshot || o.screenshot;
   quit = quit || o.quit;
+  if (o.grab_start || o.grabbing || o.grab_end) {
+    cursor_x = o.cursor_x;
+    cursor_y = o.cursor_y;
+  }
+  grab_start = grab_start || o.grab_start;
+  grabbing = grabbing || o.grabbing;
+  grab_end = grab_end || o.grab_end;
 }
 
 namespace {
@@ -109,15 +116,23 @@ Script Script::parse(const std::string& text, const std::string& name) {
         e.input.zoom = number<float>(w[2], "wheel steps");
         script.events_.push_back(e);
       } else if (what == "drag") {
-        const char* form = "FRAME drag X0 Y0 X1 Y1 FRAMES [left|right|middle]";
+        const char* form = "FRAME drag X0 Y0 X1 Y1 FRAMES [left|right|middle|shift]";
         expect_words(7, 8, form);
         const auto x0 = number<float>(w[2], "x0"), y0 = number<float>(w[3], "y0");
         const auto x1 = number<float>(w[4], "x1"), y1 = number<float>(w[5], "y1");
         const auto n = number<std::uint64_t>(w[6], "frame count");
         if (n == 0) throw BadLine("a drag lasts at least 1 frame");
         const std::string button = w.size() == 8 ? w[7] : "left";
-        if (button != "left" && button != "right" && button != "middle") {
-          throw BadLine(fmt::format("unknown button '{}' (left, right, middle)", button));
+        if (button != "left" && button != "right" && button != "middle" && button != "shift") {
+          throw BadLine(fmt::format("unknown button '{}' (left, right, middle, shift)", button));
+        }
+        if (button == "shift") {
+          Event press;
+          press.frame = frame;
+          press.input.grab_start = press.input.grabbing = true;
+          press.input.cursor_x = x0;
+          press.input.cursor_y = y0;
+          script.events_.push_back(press);
         }
         // Pressed at frame, moved by equal steps over the next n frames (released at the last).
         for (std::uint64_t k = 1; k <= n; ++k) {
@@ -126,7 +141,12 @@ Script Script::parse(const std::string& text, const std::string& name) {
           Event m;
           m.frame = frame + k;
           const float dx = (x1 - x0) * (b - a), dy = (y1 - y0) * (b - a);
-          if (button == "left") {
+          if (button == "shift") {
+            m.input.grabbing = true;
+            m.input.grab_end = k == n;
+            m.input.cursor_x = x0 + (x1 - x0) * b;
+            m.input.cursor_y = y0 + (y1 - y0) * b;
+          } else if (button == "left") {
             m.input.orbit_x = dx;
             m.input.orbit_y = dy;
           } else {

@@ -307,6 +307,8 @@ struct Window::Impl {
   Input input;
   double last_x = 0.0, last_y = 0.0;
   bool have_cursor = false;
+  bool left_down = false;
+  bool grabbing = false;
 };
 
 Window::Window(render::Size size, const std::string& title, const Style& style,
@@ -320,9 +322,27 @@ Input Window::poll() {
   glfwPollEvents();
   double x = 0.0, y = 0.0;
   glfwGetCursorPos(m.window, &x, &y);
-  if (m.have_cursor) {
+  const bool left = glfwGetMouseButton(m.window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+  const bool shift = glfwGetKey(m.window, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
+                     glfwGetKey(m.window, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
+  // The cursor in drawable pixels (window coordinates scaled where they differ).
+  int win_w = 0, win_h = 0, fb_w = 0, fb_h = 0;
+  glfwGetWindowSize(m.window, &win_w, &win_h);
+  glfwGetFramebufferSize(m.window, &fb_w, &fb_h);
+  m.input.cursor_x = static_cast<float>(win_w > 0 ? x * fb_w / win_w : x);
+  m.input.cursor_y = static_cast<float>(win_h > 0 ? y * fb_h / win_h : y);
+  if (m.grabbing) {
+    m.input.grabbing = true;
+    if (!left) {
+      m.input.grab_end = true;
+      m.grabbing = false;
+    }
+  } else if (left && shift && !m.left_down) {
+    m.grabbing = true;
+    m.input.grab_start = m.input.grabbing = true;
+  } else if (m.have_cursor) {
     const auto dx = static_cast<float>(x - m.last_x), dy = static_cast<float>(y - m.last_y);
-    if (glfwGetMouseButton(m.window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) {
+    if (left) {
       m.input.orbit_x += dx;
       m.input.orbit_y += dy;
     } else if (glfwGetMouseButton(m.window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS ||
@@ -331,6 +351,7 @@ Input Window::poll() {
       m.input.pan_y += dy;
     }
   }
+  m.left_down = left;
   m.last_x = x;
   m.last_y = y;
   m.have_cursor = true;

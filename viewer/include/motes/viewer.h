@@ -61,6 +61,14 @@ struct Input {
   bool slow_motion = false;  ///< S
   bool screenshot = false;   ///< P
   bool quit = false;         ///< Esc, Q or the window closed
+  /// Shift + left button: grab (pick and drag). grab_start on the press, grabbing while held
+  /// (the press's frame too), grab_end on the release; the cursor in drawable pixels (x right, y
+  /// down, as the pictures' pixel centres at i + 0.5).
+  bool grab_start = false;
+  bool grabbing = false;
+  bool grab_end = false;
+  float cursor_x = 0.0f;
+  float cursor_y = 0.0f;
 
   /// Adds `other`'s movements and presses to these (a script's events to the window's).
   void merge(const Input& other);
@@ -69,8 +77,9 @@ struct Input {
 /// Scripted input (`motes view --input FILE`, docs/viewer.md): timed events by frame number, one
 /// a line, turned into the same Input a person's keys and mouse give. Lines: `FRAME key NAME`
 /// (space, period or ., r, s, p, q, escape), `FRAME wheel STEPS`, `FRAME drag X0 Y0 X1 Y1 N
-/// [left|right|middle]` (pressed at pixel (X0, Y0), moved evenly to (X1, Y1) over the N frames
-/// after FRAME, released at FRAME + N), `FRAME quit`; `#` starts a comment.
+/// [left|right|middle|shift]` (pressed at pixel (X0, Y0), moved evenly to (X1, Y1) over the N
+/// frames after FRAME, released at FRAME + N; shift: Shift + left, a grab), `FRAME quit`; `#`
+/// starts a comment.
 class Script {
  public:
   /// Reads `path`; throws std::runtime_error "FILE:LINE: reason" for a bad line.
