@@ -20,6 +20,7 @@
 #include "commands.h"
 #include "motes/devices.h"
 #include "motes/render.h"
+#include "motes/render_output.h"
 #include "motes/scene.h"
 #include "motes/simulation.h"
 #ifdef MOTES_HAVE_VIEWER
@@ -42,6 +43,7 @@ struct ViewArgs {
   std::string color_by = "body";
   std::string input;
   std::string save_state;
+  std::string record;
 };
 
 #ifdef MOTES_HAVE_VIEWER
@@ -78,10 +80,10 @@ void must_write(const std::string& path, const render::Image& image) {
   if (Status s = render::write_png(path, image); !s) fail(s.message());
 }
 
-/// The next free motes-view-NNN.png in the current directory.
-std::string numbered_screenshot() {
+/// The next free motes-view-NNN.EXT (png, mp4) in the current directory.
+std::string numbered_file(const char* ext) {
   for (int i = 1;; ++i) {
-    std::string name = fmt::format("motes-view-{:03d}.png", i);
+    std::string name = fmt::format("motes-view-{:03d}.{}", i, ext);
     std::error_code ec;
     if (!std::filesystem::exists(name, ec)) return name;
   }
@@ -188,6 +190,70 @@ class Grab {
   float depth_ = 0.0f;  ///< the grabbed point's distance along the camera's forward axis
 };
 
+/// Video of the displayed frames (V, --record FILE) through ffmpeg, as `motes render` writes its
+/// videos (render::VideoEncoder), at 60 frames per second: the frame rate of real time.
+class Recorder {
+ public:
+  [[nodiscard]] bool on() const { return video_ != nullptr; }
+
+  /// Starts recording into `path`; without ffmpeg, says so and records nothing (`must`: fails).
+  void start(const std::string& path, render::Size size, bool must) {
+    const std::optional<std::string> ffmpeg = render::find_ffmpeg();
+    if (!ffmpeg) {
+      const std::string why = "cannot record: no ffmpeg (Debian: apt-get install ffmpeg)";
+      if (must) fail(why);
+      fmt::print(stderr, "motes view: {}\n", why);
+      return;
+    }
+    Result<std::unique_ptr<render::VideoEncoder>> v =
+        render::VideoEncoder::open(*ffmpeg, path, size, kFrameRate);
+    if (!v) {
+      if (must) fail(v.message());
+      fmt::print(stderr, "motes view: {}\n", v.message());
+      return;
+    }
+    video_ = std::move(v.value());
+    size_ = size;
+    fmt::print("motes view: recording {}\n", path);
+    std::fflush(stdout);
+  }
+
+  /// Adds a displayed frame; a window resized while recording ends the recording.
+  void add(const render::Image& picture) {
+    if (!video_) return;
+    if (picture.width != size_.width || picture.height != size_.height) {
+      fmt::print(stderr, "motes view: the window changed size; recording stopped\n");
+      stop();
+      return;
+    }
+    if (Status s = video_->add_frame(picture); !s) {
+      fmt::print(stderr, "motes view: {}\n", s.message());
+      stop();
+    }
+  }
+
+  void stop() {
+    if (!video_) return;
+    const Status s = video_->finish();
+    if (!s) {
+      fmt::print(stderr, "motes view: {}\n", s.message());
+    } else {
+      fmt::print("motes view: video {} ({} frames)\n", video_->path(), video_->frames());
+    }
+    std::fflush(stdout);
+    video_.reset();
+  }
+
+  ~Recorder() { stop(); }
+  Recorder() = default;
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+
+ private:
+  std::unique_ptr<render::VideoEncoder> video_;
+  render::Size size_;
+};
+
 /// Where frames go: a window (with the person's input) or an offscreen picture (no input but the
 /// script's). One loop drives both, so scripted input does the same offscreen as in a window.
 class Surface {
@@ -261,6 +327,8 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
   double window_step = 0.0, window_draw = 0.0, window_simulated = 0.0;
   render::Image last_picture;
   Grab grab;
+  Recorder recorder;
+  if (!args.record.empty()) recorder.start(args.record, surface.size(), true);
   for (;;) {
     const auto frame_start = Clock::now();
     viewer::Input in = surface.poll();
@@ -269,6 +337,13 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     orbit.orbit(in.orbit_x, in.orbit_y);
     orbit.pan(in.pan_x, in.pan_y, surface.size());
     orbit.zoom(in.zoom);
+    if (in.record) {
+      if (recorder.on()) {
+        recorder.stop();
+      } else {
+        recorder.start(numbered_file("mp4"), surface.size(), false);
+      }
+    }
     if (in.pause) paused = !paused;
     if (in.slow_motion) slow = !slow;
     if (in.reset) {
@@ -314,15 +389,16 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     if (in.grab_end) grab.stop();
     const auto t1 = Clock::now();
     const bool last = args.frames > 0 && shown + 1 >= args.frames;
-    const bool keep = in.screenshot || (last && !args.screenshot.empty());
+    const bool keep = in.screenshot || (last && !args.screenshot.empty()) || recorder.on();
     render::Image picture;
     surface.draw(orbit.camera(), frame, keep ? &picture : nullptr);
     if (in.screenshot) {
-      const std::string file = numbered_screenshot();
+      const std::string file = numbered_file("png");
       must_write(file, picture);
       fmt::print("motes view: picture {}\n", file);
       std::fflush(stdout);
     }
+    recorder.add(picture);
     if (keep) last_picture = std::move(picture);
     const double step_s = std::chrono::duration<double>(t1 - t0).count();
     const double draw_s = seconds_since(t1);
@@ -360,6 +436,7 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     if (last_picture.rgb.empty()) surface.draw(orbit.camera(), frame, &last_picture);
     must_write(args.screenshot, last_picture);
   }
+  recorder.stop();
   if (!args.save_state.empty()) {
     if (Status s = sim->save_state(args.save_state); !s) fail(s.message());
   }
@@ -466,6 +543,8 @@ void add_view_command(CLI::App& app) {
   sub->add_option("--save-state", args->save_state,
                   "at the end, write the state as a checkpoint (motes resume, "
                   "Simulation::load_state)");
+  sub->add_option("--record", args->record,
+                  "record the displayed frames from the start as an MP4 video (ffmpeg; V stops)");
   sub->add_flag(
       "--offscreen", args->offscreen,
       "draw without a window (needs --frames or --input; for machines without a display)");

@@ -447,4 +447,51 @@ TEST(ViewGrab, ShiftDragPullsTheBoxSideways) {
   EXPECT_LT((missed - still).norm(), 1e-3);
 }
 
+// Recording (V, --record FILE) through ffmpeg, offscreen.
+
+/// ffprobe's count of the video frames in `path` (-1 when it reads no video stream).
+int video_frames(const fs::path& path) {
+  const fs::path out = scratch(path.filename().string() + ".frames");
+  if (shell("ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+            "stream=nb_read_frames -of csv=p=0 " +
+            path.string() + " > " + out.string()) != 0) {
+    return -1;
+  }
+  std::ifstream in(out);
+  int frames = -1;
+  in >> frames;
+  return frames;
+}
+
+TEST(ViewRecord, KeyVAndRecordWriteTheDisplayedFrames) {
+  if (shell("command -v ffmpeg > /dev/null && command -v ffprobe > /dev/null") != 0) {
+    GTEST_SKIP() << "skipped: no ffmpeg or ffprobe (Debian: ffmpeg)";
+  }
+  const fs::path dir = scratch("record");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path script = write_file("record.txt", "2 key v\n8 key v\n");
+  const std::string base = std::string(MOTES_CLI_PATH) + " view " + kScene +
+                           " --backend openmp --offscreen --size 320x240 ";
+  // V at frame 2 and again at frame 8: frames 2 to 7 in the current directory's first free name.
+  ASSERT_EQ(shell("cd " + dir.string() + " && " + base + "--frames 10 --input " + script.string()),
+            0);
+  EXPECT_EQ(video_frames(dir / "motes-view-001.mp4"), 6);
+  EXPECT_FALSE(fs::exists(dir / "motes-view-002.mp4"));
+  // --record FILE: every frame from the start.
+  const fs::path mp4 = dir / "whole.mp4";
+  ASSERT_EQ(shell(base + "--frames 4 --record " + mp4.string()), 0);
+  EXPECT_EQ(video_frames(mp4), 4);
+  // Without ffmpeg, --record is refused with one line.
+  const fs::path err = scratch("record.err");
+  EXPECT_NE(shell("MOTES_FFMPEG= " + base + "--frames 2 --record " + (dir / "no.mp4").string() +
+                  " 2> " + err.string()),
+            0);
+  std::ifstream in(err);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_NE(line.find("no ffmpeg"), std::string::npos) << line;
+  EXPECT_FALSE(fs::exists(dir / "no.mp4"));
+}
+
 }  // namespace

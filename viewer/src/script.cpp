@@ -22,6 +22,7 @@ void Input::merge(const Input& o) {
   reset = reset || o.reset;
   slow_motion = slow_motion || o.slow_motion;
   screenshot = screenshot || o.screenshot;
+  record = record || o.record;
   quit = quit || o.quit;
   if (o.grab_start || o.grabbing || o.grab_end) {
     cursor_x = o.cursor_x;
@@ -63,6 +64,8 @@ bool press_key(const std::string& key, Input& in) {
     in.slow_motion = true;
   } else if (k == "p") {
     in.screenshot = true;
+  } else if (k == "v") {
+    in.record = true;
   } else if (k == "q" || k == "escape" || k == "esc") {
     in.quit = true;
   } else {
@@ -104,7 +107,8 @@ Script Script::parse(const std::string& text, const std::string& name) {
       if (what == "key") {
         expect_words(3, 3, "FRAME key NAME");
         if (!press_key(w[2], e.input)) {
-          throw BadLine(fmt::format("unknown key '{}' (space, period, r, s, p, q, escape)", w[2]));
+          throw BadLine(
+              fmt::format("unknown key '{}' (space, period, r, s, p, v, q, escape)", w[2]));
         }
         script.events_.push_back(e);
       } else if (what == "quit") {

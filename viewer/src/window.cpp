@@ -61,6 +61,9 @@ struct Window::Impl {
                            case GLFW_KEY_P:
                              in.screenshot = true;
                              break;
+                           case GLFW_KEY_V:
+                             in.record = true;
+                             break;
                            case GLFW_KEY_ESCAPE:
                            case GLFW_KEY_Q:
                              in.quit = true;

@@ -60,6 +60,7 @@ struct Input {
   bool reset = false;        ///< R
   bool slow_motion = false;  ///< S
   bool screenshot = false;   ///< P
+  bool record = false;       ///< V: start or stop recording a video
   bool quit = false;         ///< Esc, Q or the window closed
   /// Shift + left button: grab (pick and drag). grab_start on the press, grabbing while held
   /// (the press's frame too), grab_end on the release; the cursor in drawable pixels (x right, y
@@ -76,7 +77,7 @@ struct Input {
 
 /// Scripted input (`motes view --input FILE`, docs/viewer.md): timed events by frame number, one
 /// a line, turned into the same Input a person's keys and mouse give. Lines: `FRAME key NAME`
-/// (space, period or ., r, s, p, q, escape), `FRAME wheel STEPS`, `FRAME drag X0 Y0 X1 Y1 N
+/// (space, period or ., r, s, p, v, q, escape), `FRAME wheel STEPS`, `FRAME drag X0 Y0 X1 Y1 N
 /// [left|right|middle|shift]` (pressed at pixel (X0, Y0), moved evenly to (X1, Y1) over the N
 /// frames after FRAME, released at FRAME + N; shift: Shift + left, a grab), `FRAME quit`; `#`
 /// starts a comment.
