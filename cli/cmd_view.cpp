@@ -128,6 +128,8 @@ class Grab {
     for (std::size_t i = 0; i < frame.particle_pos.size(); ++i) {
       const std::uint32_t body = frame.particle_body[i];
       if (body >= sim.bodies().size() || sim.bodies()[body].kind == BodyKind::Static) continue;
+      // A pinned particle of a cloth or rope (inverse mass 0) stays where it is.
+      if (!sim.bodies()[body].has_body_state() && frame.particle_vel[i].w == 0.0f) continue;
       const shared::vec4& p = frame.particle_pos[i];
       const Eigen::Vector3f c(p.x, p.y, p.z);
       // |eye + t d - c| = r: the nearer root, in units where t = distance along forward.
@@ -144,20 +146,31 @@ class Grab {
     }
     if (!std::isfinite(best)) return false;
     const shared::vec4& p = frame.particle_pos[particle_];
+    inverse_mass_ = frame.particle_vel[particle_].w;
     depth_ = (Eigen::Vector3f(p.x, p.y, p.z) - eye).dot((camera.target - eye).normalized());
     active_ = true;
     return true;
   }
 
-  void stop() { active_ = false; }
+  /// Lets go. A held soft-body, cloth or rope particle gets its mass back (`sim`: the simulation
+  /// it was grabbed in; null after a reset, which made a new one).
+  void stop(Simulation* sim) {
+    if (active_ && pinned_ && sim != nullptr) {
+      Snapshot state = must_snapshot(*sim);
+      state.particle_vel[particle_].w = inverse_mass_;
+      if (Status s = sim->write_state(state); !s) fail(s.message());
+    }
+    active_ = pinned_ = false;
+  }
   [[nodiscard]] bool active() const { return active_; }
   [[nodiscard]] std::uint32_t body() const { return body_; }
 
   /// Before a step: the velocity that pulls the grabbed point towards the cursor's point, given
   /// to the whole rigid body (set_body_velocities: its spin is left as it is) or to the grabbed
-  /// particle alone (a soft body's, cloth's or rope's: write_state).
+  /// particle alone, which is also moved by what that velocity covers in the frame (a soft
+  /// body's, cloth's or rope's: write_state).
   void pull(Simulation& sim, const Snapshot& frame, const render::Camera& camera, render::Size size,
-            float x, float y) const {
+            float x, float y, double frame_seconds) {
     if (!active_) return;
     const Eigen::Vector3f eye = camera.position;
     const Eigen::Vector3f target = eye + depth_ * pixel_ray(camera, size, x, y);
@@ -175,7 +188,16 @@ class Grab {
       velocity[body_] = v.cast<double>();
       if (Status s = sim.set_body_velocities(velocity); !s) fail(s.message());
     } else {
+      // Held like a pinned particle (inverse mass 0, so that its links cannot pull it back) and
+      // moved by what the velocity covers in the coming frame: its links drag the others.
       Snapshot state = frame;
+      state.particle_vel[particle_].w = 0.0f;
+      pinned_ = true;
+      const Eigen::Vector3f moved = v * static_cast<float>(frame_seconds);
+      shared::vec4& q = state.particle_pos[particle_];
+      q.x += moved.x();
+      q.y += moved.y();
+      q.z += moved.z();
       state.particle_vel[particle_].x = v.x();
       state.particle_vel[particle_].y = v.y();
       state.particle_vel[particle_].z = v.z();
@@ -185,6 +207,8 @@ class Grab {
 
  private:
   bool active_ = false;
+  bool pinned_ = false;        ///< a soft-body, cloth or rope particle made massless while held
+  float inverse_mass_ = 0.0f;  ///< its own
   std::uint32_t particle_ = 0;
   std::uint32_t body_ = 0;
   float depth_ = 0.0f;  ///< the grabbed point's distance along the camera's forward axis
@@ -360,7 +384,7 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
         style.look = render::look_from_scene(reloaded.value());
         surface.restyle(style, frame);
         owed_steps = 0.0;
-        grab.stop();
+        grab.stop(nullptr);
       }
     }
     if (in.grab_start) {
@@ -371,7 +395,7 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
       }
       std::fflush(stdout);
     }
-    if (!in.grabbing) grab.stop();
+    if (!in.grabbing) grab.stop(sim.get());
     std::uint64_t advance = 0;
     if (!paused || in.step) {
       owed_steps += static_cast<double>(steps) * (slow && !in.step ? 0.25 : 1.0);
@@ -381,12 +405,16 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     const auto t0 = Clock::now();
     if (advance > 0) {
       if (grab.active()) {
-        grab.pull(*sim, frame, orbit.camera(), surface.size(), in.cursor_x, in.cursor_y);
+        grab.pull(*sim, frame, orbit.camera(), surface.size(), in.cursor_x, in.cursor_y,
+                  static_cast<double>(advance) * sim->settings().dt);
       }
       must_step(*sim, advance);
       frame = must_snapshot(*sim);
     }
-    if (in.grab_end) grab.stop();
+    if (in.grab_end) {
+      grab.stop(sim.get());
+      frame = must_snapshot(*sim);
+    }
     const auto t1 = Clock::now();
     const bool last = args.frames > 0 && shown + 1 >= args.frames;
     const bool keep = in.screenshot || (last && !args.screenshot.empty()) || recorder.on();
@@ -437,6 +465,7 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     must_write(args.screenshot, last_picture);
   }
   recorder.stop();
+  grab.stop(sim.get());  // the saved state has every particle's own mass
   if (!args.save_state.empty()) {
     if (Status s = sim->save_state(args.save_state); !s) fail(s.message());
   }

@@ -404,19 +404,26 @@ constexpr const char* kBoxScene = R"({
   "planes": [ { "name": "floor", "normal": [0.0, 1.0, 0.0], "point": [0.0, 0.0, 0.0] } ]
 })";
 
-/// The box's centre after 30 frames with the script `script` (none when empty).
-Eigen::Vector3d box_after(const std::string& tag, const std::string& script) {
-  const fs::path scene_path = write_file("box.json", kBoxScene);
+/// The state after `frames` frames of the scene `scene_text` with the script `script` (none when
+/// empty).
+motes::Snapshot state_after(const std::string& scene_text, const std::string& tag, int frames,
+                            const std::string& script) {
+  const fs::path scene_path = write_file(tag + ".json", scene_text);
   const fs::path state = scratch(tag + ".state");
   std::string command = std::string(MOTES_CLI_PATH) + " view " + scene_path.string() +
-                        " --backend openmp --offscreen --size 320x240 --frames 30 --save-state " +
-                        state.string();
+                        " --backend openmp --offscreen --size 320x240 --frames " +
+                        std::to_string(frames) + " --save-state " + state.string();
   if (!script.empty()) command += " --input " + write_file(tag + ".txt", script).string();
   EXPECT_EQ(shell(command), 0) << command;
   motes::Scene scene = motes::load_scene_file(scene_path.string()).value();
   auto sim = motes::Simulation::create(scene, motes::open_device("openmp").value()).value();
   EXPECT_TRUE(sim->load_state(state.string()));
-  const motes::Snapshot s = sim->snapshot().value();
+  return sim->snapshot().value();
+}
+
+/// The box's centre after 30 frames with the script `script` (none when empty).
+Eigen::Vector3d box_after(const std::string& tag, const std::string& script) {
+  const motes::Snapshot s = state_after(kBoxScene, tag, 30, script);
   return {s.body_pos.at(0).x, s.body_pos.at(0).y, s.body_pos.at(0).z};
 }
 
@@ -492,6 +499,35 @@ TEST(ViewRecord, KeyVAndRecordWriteTheDisplayedFrames) {
   std::getline(in, line);
   EXPECT_NE(line.find("no ffmpeg"), std::string::npos) << line;
   EXPECT_FALSE(fs::exists(dir / "no.mp4"));
+}
+
+// A rope of 41 particles, 40 cm long, pinned at its left end and let fall, seen from the front
+// with its middle particle at the picture's centre.
+constexpr const char* kRopeScene = R"({
+  "settings": { "dt": 0.016666666666666666, "substeps": 30, "contact_model": "position",
+                "gravity": [0.0, -9.81, 0.0], "particle_diameter": 0.01,
+                "constraint_iterations": 4, "link_damping": 0.5 },
+  "materials": { "rope": { "density": 1000.0, "friction": 0.8 } },
+  "bodies": [ { "name": "rope", "kind": "rope", "material": "rope",
+                "rope": { "from": [-0.2, 0.1, 0.0], "to": [0.2, 0.1, 0.0], "particles": 41,
+                          "pin": [0] } } ],
+  "camera": { "position": [0.0, 0.1, 0.5], "target": [0.0, 0.1, 0.0], "fov": 40.0 },
+  "planes": [ { "name": "floor", "normal": [0.0, 1.0, 0.0], "point": [0.0, 0.0, 0.0] } ]
+})";
+
+TEST(ViewGrab, ShiftDragHoldsUpARopePoint) {
+  // Grabbed at frame 1 by its middle particle and dragged 40 pixels up (6 cm at its depth) over
+  // 10 frames: at frame 12 the middle particle is well above where the falling rope leaves it.
+  const motes::Snapshot fallen = state_after(kRopeScene, "rope-fallen", 12, "");
+  const motes::Snapshot held =
+      state_after(kRopeScene, "rope-held", 12, "1 drag 160 121 160 81 10 shift\n");
+  const double y_fallen = fallen.particle_pos.at(20).y, y_held = held.particle_pos.at(20).y;
+  std::printf("rope middle at frame 12: %.4f m left alone, %.4f m held up\n", y_fallen, y_held);
+  EXPECT_GT(y_held, y_fallen + 0.02);
+  EXPECT_LT(y_held, 0.1 + 0.06 + 0.01);  // not past the cursor's point
+  // The pinned end stays pinned, and a grab at the pin picks nothing that moves it.
+  EXPECT_EQ(held.particle_pos.at(0).x, fallen.particle_pos.at(0).x);
+  EXPECT_EQ(held.particle_pos.at(0).y, fallen.particle_pos.at(0).y);
 }
 
 }  // namespace
