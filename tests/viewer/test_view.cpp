@@ -404,6 +404,14 @@ constexpr const char* kBoxScene = R"({
   "planes": [ { "name": "floor", "normal": [0.0, 1.0, 0.0], "point": [0.0, 0.0, 0.0] } ]
 })";
 
+/// The state `--save-state` wrote for the scene file `scene_path`.
+motes::Snapshot load_saved(const fs::path& scene_path, const fs::path& state) {
+  motes::Scene scene = motes::load_scene_file(scene_path.string()).value();
+  auto sim = motes::Simulation::create(scene, motes::open_device("openmp").value()).value();
+  EXPECT_TRUE(sim->load_state(state.string()));
+  return sim->snapshot().value();
+}
+
 /// The state after `frames` frames of the scene `scene_text` with the script `script` (none when
 /// empty).
 motes::Snapshot state_after(const std::string& scene_text, const std::string& tag, int frames,
@@ -415,10 +423,7 @@ motes::Snapshot state_after(const std::string& scene_text, const std::string& ta
                         std::to_string(frames) + " --save-state " + state.string();
   if (!script.empty()) command += " --input " + write_file(tag + ".txt", script).string();
   EXPECT_EQ(shell(command), 0) << command;
-  motes::Scene scene = motes::load_scene_file(scene_path.string()).value();
-  auto sim = motes::Simulation::create(scene, motes::open_device("openmp").value()).value();
-  EXPECT_TRUE(sim->load_state(state.string()));
-  return sim->snapshot().value();
+  return load_saved(scene_path, state);
 }
 
 /// The box's centre after 30 frames with the script `script` (none when empty).
@@ -528,6 +533,38 @@ TEST(ViewGrab, ShiftDragHoldsUpARopePoint) {
   // The pinned end stays pinned, and a grab at the pin picks nothing that moves it.
   EXPECT_EQ(held.particle_pos.at(0).x, fallen.particle_pos.at(0).x);
   EXPECT_EQ(held.particle_pos.at(0).y, fallen.particle_pos.at(0).y);
+}
+
+TEST(ViewGrab, ShiftDragInAWindowUnderXvfb) {
+  Xvfb x;
+  if (!x.ready()) GTEST_SKIP() << "skipped: no Xvfb (Debian: xvfb)";
+  if (shell("command -v xdotool > /dev/null") != 0) {
+    GTEST_SKIP() << "skipped: no xdotool (Debian: xdotool)";
+  }
+  const fs::path scene_path = write_file("window-box.json", kBoxScene);
+  // The real mouse and keyboard through the X server: press at (165, 117), move 60 pixels to
+  // the right in 10 moves, release; with Shift held (a grab) or without (an orbit).
+  auto drag = [&](const std::string& tag, bool shift) {
+    const fs::path state = scratch(tag + ".state");
+    const std::string view = std::string(MOTES_CLI_PATH) + " view " + scene_path.string() +
+                             " --backend openmp --size 320x240 --frames 150 --save-state " +
+                             state.string();
+    const std::string script =
+        "DISPLAY=" + x.display() + " sh -c '" + view + " > /dev/null & p=$!; " +
+        "w=$(xdotool search --sync --name \"motes view\" | head -1); sleep 0.5; " +
+        "xdotool mousemove --window $w 165 117 " + (shift ? "keydown shift " : "") +
+        "mousedown 1; for i in 1 2 3 4 5 6 7 8 9 10; do xdotool mousemove --window $w " +
+        "$((165 + 6 * i)) 117; sleep 0.03; done; xdotool mouseup 1" +
+        (shift ? " keyup shift" : "") + "; wait $p'";
+    EXPECT_EQ(shell(script), 0) << script;
+    const motes::Snapshot s = load_saved(scene_path, state);
+    return s.body_pos.at(0).x;
+  };
+  const double grabbed = drag("window-grab", true);
+  const double orbited = drag("window-orbit", false);
+  std::printf("box x after a Shift-drag %.4f m, after a plain drag %.4f m\n", grabbed, orbited);
+  EXPECT_GT(grabbed, 0.02);
+  EXPECT_LT(std::abs(orbited), 1e-3);
 }
 
 }  // namespace
