@@ -570,13 +570,14 @@ void add_view_command(CLI::App& app) {
                   "scripted input: timed key, drag, wheel and quit events by frame "
                   "(docs/viewer.md)");
   sub->add_option("--save-state", args->save_state,
-                  "at the end, write the state as a checkpoint (motes resume, "
-                  "Simulation::load_state)");
+                  "at the end, write the state as a checkpoint (Simulation::load_state reads "
+                  "it; it has no run description for motes resume)");
   sub->add_option("--record", args->record,
                   "record the displayed frames from the start as an MP4 video (ffmpeg; V stops)");
   sub->add_flag(
       "--offscreen", args->offscreen,
-      "draw without a window (needs --frames or --input; for machines without a display)");
+      "draw without a window (needs --frames, or an --input script that quits; for machines "
+      "without a display)");
   sub->add_option("--color-by", args->color_by,
                   fmt::format("particle colours: {}", render::color_by_names()))
       ->capture_default_str();
