@@ -543,11 +543,13 @@ TEST(ViewGrab, ShiftDragInAWindowUnderXvfb) {
   }
   const fs::path scene_path = write_file("window-box.json", kBoxScene);
   // The real mouse and keyboard through the X server: press at (165, 117), move 60 pixels to
-  // the right in 10 moves, release; with Shift held (a grab) or without (an orbit).
+  // the right in 10 moves, release; with Shift held (a grab) or without (an orbit); then Q ends
+  // the run (the frame cap only bounds a run whose window never gets the key), so a slow machine
+  // cannot end the run before the drag is done.
   auto drag = [&](const std::string& tag, bool shift) {
     const fs::path state = scratch(tag + ".state");
     const std::string view = std::string(MOTES_CLI_PATH) + " view " + scene_path.string() +
-                             " --backend openmp --size 320x240 --frames 150 --save-state " +
+                             " --backend openmp --size 320x240 --frames 3000 --save-state " +
                              state.string();
     const std::string script =
         "DISPLAY=" + x.display() + " sh -c '" + view + " > /dev/null & p=$!; " +
@@ -555,7 +557,7 @@ TEST(ViewGrab, ShiftDragInAWindowUnderXvfb) {
         "xdotool mousemove --window $w 165 117 " + (shift ? "keydown shift " : "") +
         "mousedown 1; for i in 1 2 3 4 5 6 7 8 9 10; do xdotool mousemove --window $w " +
         "$((165 + 6 * i)) 117; sleep 0.03; done; xdotool mouseup 1" +
-        (shift ? " keyup shift" : "") + "; wait $p'";
+        (shift ? " keyup shift" : "") + "; sleep 0.3; xdotool key q; wait $p'";
     EXPECT_EQ(shell(script), 0) << script;
     const motes::Snapshot s = load_saved(scene_path, state);
     return s.body_pos.at(0).x;
