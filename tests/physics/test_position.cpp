@@ -464,7 +464,7 @@ Stand stand(const std::vector<Eigen::Vector3d>& centres, double seconds) {
 // projection sweeps, columns of five or more fell within a second.
 TEST(PositionContact, ColumnsOfTenBoxesLaidOffCentreStand) {
   constexpr double kD = 0.01;
-  for (const std::uint32_t seed : {1u, 2u, 3u, 4u, 5u, 6u}) {
+  for (std::uint32_t seed = 1; seed <= motes_test::seeds_to_run(6); ++seed) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> off(-0.1 * kD, 0.1 * kD);
     std::vector<Eigen::Vector3d> centres;
@@ -486,7 +486,7 @@ TEST(PositionContact, ColumnsOfTenBoxesLaidOffCentreStand) {
 // of two below, every box laid up to 10% of a diameter off its place (seeded), stands for 10 s.
 TEST(PositionContact, PyramidOfFiveRowsLaidOffCentreStands) {
   constexpr double kD = 0.01;
-  for (const std::uint32_t seed : {1u, 2u}) {
+  for (std::uint32_t seed = 1; seed <= motes_test::seeds_to_run(2); ++seed) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> off(-0.1 * kD, 0.1 * kD);
     std::vector<Eigen::Vector3d> centres;

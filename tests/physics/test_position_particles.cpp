@@ -405,7 +405,7 @@ TEST(PositionMixed, RandomDropsOntoAHeldClothKeepEnergyAndStayUnderTheGuard) {
   // 30 substeps: a body that bounces off the cloth and leaves over its edge falls onto the floor
   // from up to 0.5 m (3.1 m/s: 0.17 d a substep; at 20 substeps 0.27 d, past the guard's 0.25).
   constexpr int kSubsteps = 30;
-  for (std::uint32_t seed = 1; seed <= 6; ++seed) {
+  for (std::uint32_t seed = 1; seed <= motes_test::seeds_to_run(6, 2); ++seed) {
     std::mt19937 rng(seed);
     const auto uniform = [&](double lo, double hi) {
       return std::uniform_real_distribution<double>(lo, hi)(rng);
