@@ -3,11 +3,17 @@
 # ranks write the same frames as one process, bit for bit (also with --halo host); a wrong
 # --decomposition is refused once, with exit 2, and --halo in one process or with a wrong value;
 # the motion guard warns over ranks.
-# Usage: cli_test.sh MPIEXEC MOTES SOURCE_DIR WORK_DIR
+# Usage: cli_test.sh MPIEXEC MOTES SOURCE_DIR WORK_DIR [quick]
+#   quick (the sanitizer build, tests/CMakeLists.txt): a quarter of the steps, the same runs and
+#   comparisons (that stage looks for memory errors along the paths; it took 125 s in full)
 set -eu
-mpiexec=$1 motes=$2 src=$3 work=$4
+mpiexec=$1 motes=$2 src=$3 work=$4 quick=${5:-}
 rm -rf "$work" && mkdir -p "$work"
-args="run $src/examples/scenes/dominoes.json --backend openmp --steps 3000 --every 1000 --format csv"
+chain_steps=3000 chain_every=1000 scene_steps=400 scene_every=200 frames=60 frames_every=30
+if [ "$quick" = quick ]; then
+  chain_steps=750 chain_every=250 scene_steps=100 scene_every=50 frames=16 frames_every=8
+fi
+args="run $src/examples/scenes/dominoes.json --backend openmp --steps $chain_steps --every $chain_every --format csv"
 # shellcheck disable=SC2086
 "$motes" $args --out "$work/one" > "$work/one.log"
 shift_np() { n=$1; shift; "$mpiexec" -np "$n" --oversubscribe --bind-to none "$motes" "$@"; }
@@ -40,11 +46,11 @@ done
 for scene in "$src"/examples/scenes/*.json; do
   name=$(basename "$scene" .json)
   # A step of position contacts is a frame of 10 to 16 substeps: 60 of them (1 s) for those.
-  steps=400
-  every=200
+  steps=$scene_steps
+  every=$scene_every
   if grep -qE '"contact_model": "position"' "$scene"; then
-    steps=60
-    every=30
+    steps=$frames
+    every=$frames_every
   fi
   each="run $scene --backend openmp --steps $steps --every $every --format csv"
   # Runs over ranks drop the impulse and position contacts' memory at list builds
