@@ -88,7 +88,9 @@ void raster_spheres(const View& view, Size size, const std::vector<shared::vec4>
 }  // namespace
 
 FrameRenderer::FrameRenderer(RenderSettings settings)
-    : settings_(std::move(settings)), buffers_(std::make_unique<Buffers>()) {
+    : settings_(std::move(settings)),
+      buffers_(std::make_unique<Buffers>()),
+      colors_(settings_.color_by, settings_.look) {
   Buffers& b = *buffers_;
   b.view = detail::make_view(settings_.camera, settings_.size);
   const Eigen::Vector3f up = settings_.look.up.normalized();
@@ -108,7 +110,6 @@ const Image& FrameRenderer::render(const Snapshot& frame) {
   Buffers& b = *buffers_;
   const std::vector<shared::vec4>& pos = frame.particle_pos;
   const Size size = settings_.size;
-  const Eigen::Vector3f up = settings_.look.up.normalized();
 
   if (!b.have_extent && !pos.empty()) {
     const detail::Bounds bounds = detail::particle_bounds(pos);
@@ -118,22 +119,8 @@ const Image& FrameRenderer::render(const Snapshot& frame) {
     b.radius = std::max(0.5f * (bounds.hi - bounds.lo).norm() + bounds.max_radius,
                         10.0f * b.particle_radius);
     b.grid = detail::nice_spacing(b.radius / 5.0f);
-    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-    for (const shared::vec4& p : pos) {
-      if (!detail::is_finite(p)) continue;
-      const float h = up.dot(Eigen::Vector3f(p.x, p.y, p.z));
-      lo = std::min(lo, h);
-      hi = std::max(hi, h);
-    }
-    height_range_ = Eigen::Vector2f(lo, hi);
   }
-  if (settings_.color_by == ColorBy::Speed) {
-    float vmax2 = speed_max_ * speed_max_;
-    for (const shared::vec4& v : frame.particle_vel) {
-      vmax2 = std::max(vmax2, v.x * v.x + v.y * v.y + v.z * v.z);
-    }
-    speed_max_ = std::sqrt(vmax2);
-  }
+  colors_.observe(frame);
 
   if (settings_.shadows) {
     b.shadow.build(pos, b.light);

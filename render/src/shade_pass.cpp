@@ -12,8 +12,6 @@ namespace motes::render {
 
 namespace {
 
-const Eigen::Vector3f kDynamicColor(0.95f, 0.55f, 0.20f);
-const Eigen::Vector3f kStaticColor(0.62f, 0.63f, 0.66f);
 const Eigen::Vector3f kGroundColor(0.86f, 0.85f, 0.82f);
 const Eigen::Vector3f kGridColor(0.50f, 0.52f, 0.56f);
 
@@ -32,35 +30,6 @@ float line_coverage(float a, float grid, float footprint) {
 }
 
 }  // namespace
-
-Eigen::Vector3f FrameRenderer::particle_color(const Snapshot& frame, std::size_t index) const {
-  const std::uint32_t body = index < frame.particle_body.size() ? frame.particle_body[index] : 0;
-  switch (settings_.color_by) {
-    case ColorBy::Body: {
-      const std::vector<std::optional<Eigen::Vector3f>>& own = settings_.look.body_colors;
-      return body < own.size() && own[body] ? *own[body] : body_color(body);
-    }
-    case ColorBy::Kind: {
-      const std::vector<std::uint8_t>& is_static = settings_.look.body_static;
-      return body < is_static.size() && is_static[body] != 0 ? kStaticColor : kDynamicColor;
-    }
-    case ColorBy::Speed: {
-      if (index >= frame.particle_vel.size() || !(speed_max_ > 0.0f)) return detail::colormap(0);
-      const shared::vec4& v = frame.particle_vel[index];
-      return detail::colormap(std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z) / speed_max_);
-    }
-    case ColorBy::Height: {
-      const shared::vec4& p = frame.particle_pos[index];
-      const float h = settings_.look.up.normalized().dot(Eigen::Vector3f(p.x, p.y, p.z));
-      if (!height_range_ || !((*height_range_)[1] > (*height_range_)[0])) {
-        return detail::colormap(0.5f);
-      }
-      return detail::colormap((h - (*height_range_)[0]) /
-                              ((*height_range_)[1] - (*height_range_)[0]));
-    }
-  }
-  return kDynamicColor;
-}
 
 void FrameRenderer::shade_row(const Snapshot& frame, int y) {
   Buffers& b = *buffers_;
@@ -108,7 +77,7 @@ void FrameRenderer::shade_row(const Snapshot& frame, int y) {
       const Eigen::Vector3f half = (b.light + to_eye).normalized();
       const float specular =
           diffuse > 0.0f ? 0.3f * lit * std::pow(std::max(0.0f, n.dot(half)), 48.0f) : 0.0f;
-      const Eigen::Vector3f base = detail::to_linear(particle_color(frame, index));
+      const Eigen::Vector3f base = detail::to_linear(colors_(frame, index));
       color = base * (ambient * rim + 0.8f * diffuse * lit) + Eigen::Vector3f::Constant(specular);
     } else if (t_ground < inf) {
       const Eigen::Vector3f hit = view.eye + t_ground * d;

@@ -1,5 +1,5 @@
-// Particle colours as the headless renderer picks them (render/src/shade_pass.cpp), the first
-// frame's extent (render/src/rasterizer.cpp) and the shaders' constants.
+// Particle colours by the headless renderer's rule (render::ParticleColors), the first frame's
+// extent (as render/src/rasterizer.cpp takes it) and the shaders' constants.
 #include "style.h"
 
 #include <algorithm>
@@ -11,25 +11,8 @@ namespace motes::viewer {
 
 namespace {
 
-const Eigen::Vector3f kDynamicColor(0.95f, 0.55f, 0.20f);
-const Eigen::Vector3f kStaticColor(0.62f, 0.63f, 0.66f);
-
 bool finite(const shared::vec4& p) {
   return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w);
-}
-
-/// viridis, sRGB, t clamped to [0, 1].
-Eigen::Vector3f colormap(float t) {
-  static const std::array<Eigen::Vector3f, 5> stops = {
-      Eigen::Vector3f(0.267f, 0.005f, 0.329f), Eigen::Vector3f(0.229f, 0.322f, 0.546f),
-      Eigen::Vector3f(0.128f, 0.567f, 0.551f), Eigen::Vector3f(0.369f, 0.789f, 0.383f),
-      Eigen::Vector3f(0.993f, 0.906f, 0.144f)};
-  if (!(t > 0.0f)) return stops[0];
-  if (t >= 1.0f) return stops[4];
-  const float x = t * 4.0f;
-  const auto i = static_cast<std::size_t>(x);
-  const float f = x - static_cast<float>(i);
-  return stops[i] * (1.0f - f) + stops[i + 1] * f;
 }
 
 /// 1, 2 or 5 times a power of ten near `approx`.
@@ -50,12 +33,14 @@ void put(ViewConstants& c, int slot, const Eigen::Vector3f& v, float w) {
 
 }  // namespace
 
-Styler::Styler(const Style& style, const Snapshot& first_frame) : style_(style) {
+Styler::Styler(const Style& style, const Snapshot& first_frame)
+    : style_(style), colors_(style.color_by, style.look) {
   style_.look.up =
       style.look.up.norm() > 0.0f ? style.look.up.normalized() : Eigen::Vector3f::UnitY();
+  colors_.observe(first_frame);  // the height colours' range
   const float inf = std::numeric_limits<float>::infinity();
   Eigen::Vector3f lo = Eigen::Vector3f::Constant(inf), hi = Eigen::Vector3f::Constant(-inf);
-  float max_radius = 0.0f, h_lo = inf, h_hi = -inf;
+  float max_radius = 0.0f;
   double radius_sum = 0.0;
   std::size_t counted = 0;
   for (const shared::vec4& p : first_frame.particle_pos) {
@@ -66,9 +51,6 @@ Styler::Styler(const Style& style, const Snapshot& first_frame) : style_(style) 
     max_radius = std::max(max_radius, p.w);
     radius_sum += static_cast<double>(p.w);
     ++counted;
-    const float h = style_.look.up.dot(c);
-    h_lo = std::min(h_lo, h);
-    h_hi = std::max(h_hi, h);
   }
   if (counted == 0) return;
   const float particle_radius =
@@ -76,49 +58,16 @@ Styler::Styler(const Style& style, const Snapshot& first_frame) : style_(style) 
   centre_ = 0.5f * (lo + hi);
   radius_ = std::max(0.5f * (hi - lo).norm() + max_radius, 10.0f * particle_radius);
   grid_ = nice_spacing(radius_ / 5.0f);
-  height_range_ = Eigen::Vector2f(h_lo, h_hi);
-}
-
-Eigen::Vector3f Styler::color(const Snapshot& frame, std::size_t index) const {
-  const std::uint32_t body = index < frame.particle_body.size() ? frame.particle_body[index] : 0;
-  switch (style_.color_by) {
-    case render::ColorBy::Body: {
-      const auto& own = style_.look.body_colors;
-      return body < own.size() && own[body] ? *own[body] : render::body_color(body);
-    }
-    case render::ColorBy::Kind: {
-      const auto& is_static = style_.look.body_static;
-      return body < is_static.size() && is_static[body] != 0 ? kStaticColor : kDynamicColor;
-    }
-    case render::ColorBy::Speed: {
-      if (index >= frame.particle_vel.size() || !(speed_max_ > 0.0f)) return colormap(0.0f);
-      const shared::vec4& v = frame.particle_vel[index];
-      return colormap(std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z) / speed_max_);
-    }
-    case render::ColorBy::Height: {
-      const shared::vec4& p = frame.particle_pos[index];
-      if (!height_range_ || !((*height_range_)[1] > (*height_range_)[0])) return colormap(0.5f);
-      const float h = style_.look.up.dot(Eigen::Vector3f(p.x, p.y, p.z));
-      return colormap((h - (*height_range_)[0]) / ((*height_range_)[1] - (*height_range_)[0]));
-    }
-  }
-  return kDynamicColor;
 }
 
 void Styler::instances(const Snapshot& frame, std::vector<Instance>& out) {
-  if (style_.color_by == render::ColorBy::Speed) {
-    float vmax2 = speed_max_ * speed_max_;
-    for (const shared::vec4& v : frame.particle_vel) {
-      vmax2 = std::max(vmax2, v.x * v.x + v.y * v.y + v.z * v.z);
-    }
-    speed_max_ = std::sqrt(vmax2);
-  }
+  colors_.observe(frame);
   out.clear();
   out.reserve(frame.particle_pos.size());
   for (std::size_t i = 0; i < frame.particle_pos.size(); ++i) {
     const shared::vec4& p = frame.particle_pos[i];
     if (!finite(p)) continue;
-    const Eigen::Vector3f c = color(frame, i);
+    const Eigen::Vector3f c = colors_(frame, i);
     const Eigen::Vector3f linear = c.cwiseProduct(c);  // gamma 2, as the headless renderer
     out.push_back({{p.x, p.y, p.z, p.w}, {linear.x(), linear.y(), linear.z(), 1.0f}});
   }

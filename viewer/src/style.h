@@ -2,7 +2,6 @@
 #pragma once
 
 #include <array>
-#include <optional>
 #include <vector>
 
 #include "motes/viewer.h"
@@ -29,14 +28,11 @@ class Styler {
   [[nodiscard]] ViewConstants constants(const render::Camera& camera, render::Size size) const;
 
  private:
-  [[nodiscard]] Eigen::Vector3f color(const Snapshot& frame, std::size_t index) const;
-
   Style style_;
+  render::ParticleColors colors_;  ///< the headless renderer's colour rule
   Eigen::Vector3f centre_{0.0f, 0.0f, 0.0f};
   float radius_ = 1.0f;
   float grid_ = 0.1f;
-  float speed_max_ = 0.0f;
-  std::optional<Eigen::Vector2f> height_range_;
 };
 
 }  // namespace motes::viewer

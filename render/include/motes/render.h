@@ -104,6 +104,26 @@ struct RenderSettings {
 /// The palette colour of body `index` (sRGB, 0..1).
 Eigen::Vector3f body_color(std::uint32_t index);
 
+/// A particle's colour in pictures (sRGB, 0..1) by `color_by`: the rule the headless renderer and
+/// `motes view` share. Speed colours scale by the fastest speed observed so far, height colours
+/// by the first observed frame's range along the look's up.
+class ParticleColors {
+ public:
+  ParticleColors(ColorBy color_by, SceneLook look);
+  /// Takes `frame`'s fastest speed (when colouring by speed) and, the first time a frame has
+  /// particles, its height range.
+  void observe(const Snapshot& frame);
+  /// The colour of particle `index` of `frame`.
+  [[nodiscard]] Eigen::Vector3f operator()(const Snapshot& frame, std::size_t index) const;
+  [[nodiscard]] ColorBy color_by() const { return color_by_; }
+
+ private:
+  ColorBy color_by_;
+  SceneLook look_;
+  float speed_max_ = 0.0f;
+  std::optional<Eigen::Vector2f> height_range_;
+};
+
 /// Renders frames with fixed settings; buffers are kept between frames.
 class FrameRenderer {
  public:
@@ -122,12 +142,10 @@ class FrameRenderer {
   struct Buffers;
   /// Colours row y of the picture from the depth buffer (shade_pass.cpp).
   void shade_row(const Snapshot& frame, int y);
-  [[nodiscard]] Eigen::Vector3f particle_color(const Snapshot& frame, std::size_t index) const;
 
   RenderSettings settings_;
   std::unique_ptr<Buffers> buffers_;
-  float speed_max_ = 0.0f;
-  std::optional<Eigen::Vector2f> height_range_;
+  ParticleColors colors_;
 };
 
 /// Writes `image` as a PNG file; the error names the file.
