@@ -31,7 +31,8 @@ namespace motes::vulkan {
   X(GridBuildScanAdd, grid_build_scan_add)        \
   X(GridBuildScatter, grid_build_scatter)         \
   X(NeighboursBuildBegin, neighbours_build_begin) \
-  X(ImpulsesApplyWide, impulses_apply_wide)
+  X(ImpulsesApplyWide, impulses_apply_wide)       \
+  X(ContactsComputeShift, contacts_compute_shift)
 
 /// The compute pipelines: one per kernel family (motes/backend/kernels.h), whose shader is
 /// shaders/NAME.comp, then the extra passes.
