@@ -14,6 +14,10 @@
 #include "link_exclusions.glsl"
 
 #if MOTES_CONTACT_SHIFTS
+// A term: the shift (xyz) and whether the contact counts (w).
+#define Term vec4
+vec4 stored(vec4 f) { return f; }
+
 // Position contacts: the shift particle i asks of itself for its contact with particle j
 // (shared/particle_shift.h), or for a rigid body's particle the reaction of its contact with
 // another kind's particle; both particles' contacts within reach (ni, nj) for mass splitting.
@@ -37,19 +41,21 @@ vec4 plane_term(vec3 xi, vec3 ui, float ri, float wi, float ni, PlaneData pl, ui
                              p.gravity_dt.w);
 }
 #else
+// A term: a force, summed in three components (a fourth would cost an addition a contact).
+#define Term vec3
+vec4 stored(vec3 f) { return vec4(f, 0.0f); }
+
 // The force law: the force of particle j on i (zero unless they overlap).
-vec4 contact_term(uint i, uint j, vec3 xi, vec3 ui, float ri, float wi, float ni, uint law_base) {
+vec3 contact_term(uint i, uint j, vec3 xi, vec3 ui, float ri, float wi, float ni, uint law_base) {
   vec4 pj = particle_pos[j];
   vec4 vj = particle_vel[j];
-  return vec4(particle_contact_force(xi, ui, ri, wi, xyz(pj), xyz(vj), pj.w, vj.w,
-                                     contact_laws[law_base + particle_material[j]], p.flags),
-              0.0f);
+  return particle_contact_force(xi, ui, ri, wi, xyz(pj), xyz(vj), pj.w, vj.w,
+                                contact_laws[law_base + particle_material[j]], p.flags);
 }
 
-vec4 plane_term(vec3 xi, vec3 ui, float ri, float wi, float ni, PlaneData pl, uint law_base) {
-  return vec4(plane_contact_force(xi, ui, ri, wi, pl.normal_offset,
-                                  contact_laws[law_base + pl.material], p.flags),
-              0.0f);
+vec3 plane_term(vec3 xi, vec3 ui, float ri, float wi, float ni, PlaneData pl, uint law_base) {
+  return plane_contact_force(xi, ui, ri, wi, pl.normal_offset,
+                             contact_laws[law_base + pl.material], p.flags);
 }
 #endif
 
@@ -65,7 +71,7 @@ void main() {
   vec3 xi = xyz(pi);
   vec3 ui = xyz(vi);
   uint law_base = particle_material[i] * p.material_count;
-  vec4 f = vec4(0.0f);
+  Term f = Term(0.0f);
   bool by_impulse = impulse_particle(p.flags, i, p.rigid_particle_count);
   uint c = neighbour_count[i];
 #if MOTES_CONTACT_SHIFTS
@@ -96,5 +102,5 @@ void main() {
   for (uint k = 0u; k < (by_impulse ? 0u : p.plane_count); ++k) {
     f += plane_term(xi, ui, pi.w, vi.w, ni, planes[k], law_base);
   }
-  particle_force[i] = f;
+  particle_force[i] = stored(f);
 }
