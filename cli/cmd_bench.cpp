@@ -85,34 +85,12 @@ void must(const motes::Status& s) {
   if (!s) fail(s.message());
 }
 
-std::unique_ptr<motes::Device> open_bench_device(const BenchOptions& o) {
+std::unique_ptr<motes::Simulation> make_sim(const motes::Scene& scene, const BenchOptions& o) {
   motes::DeviceOptions dopt;
   dopt.cpu_threads = o.threads;
-  return must(motes::open_device(o.backend, o.device, dopt));
+  auto device = must(motes::open_device(o.backend, o.device, dopt));
+  return must(motes::Simulation::create(scene, std::move(device)));
 }
-
-std::unique_ptr<motes::Simulation> make_sim(const motes::Scene& scene, const BenchOptions& o) {
-  return must(motes::Simulation::create(scene, open_bench_device(o)));
-}
-
-/// The one device of a measurement's runs: each run's simulation is made on it and hands it on
-/// (Simulation::take_device), so that one-time work (a CUDA module loaded at its first launch, a
-/// Vulkan pipeline compiled at its first use: about 4 ms of an H200's W2 run, 2 us a step) falls
-/// in the warm-up, not in a timed run, as an interactive program opens its device once. Each run
-/// still allocates its buffers and records or captures its step anew.
-class BenchDevice {
- public:
-  explicit BenchDevice(const BenchOptions& o) : device_(open_bench_device(o)) {}
-  std::unique_ptr<motes::Simulation> sim(const motes::Scene& scene) {
-    return must(motes::Simulation::create(scene, std::move(device_)));
-  }
-  void give_back(std::unique_ptr<motes::Simulation> sim) {
-    device_ = motes::Simulation::take_device(std::move(sim));
-  }
-
- private:
-  std::unique_ptr<motes::Device> device_;
-};
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -120,23 +98,20 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-/// Runs `steps` steps `repeats` times, each from a fresh simulation (on the one BenchDevice)
-/// prepared by `prepare`, with
+/// Runs `steps` steps `repeats` times, each from a fresh simulation prepared by `prepare`, with
 /// kernel timing off (timing may synchronize per kernel and keeps GPU backends from replaying a
 /// captured step); then once more with timing on, for the time of every kernel family.
 template <typename Prepare>
 Measurement measure(const motes::Scene& scene, const BenchOptions& o, std::uint64_t steps,
                     Prepare prepare) {
   Measurement m;
-  BenchDevice device(o);
-  {  // Warm-up: first touch of memory, thread pool start, kernels and pipelines loaded.
-    auto sim = device.sim(scene);
+  {  // Warm-up: first touch of memory, thread pool start, graph capture.
+    auto sim = make_sim(scene, o);
     prepare(*sim);
     must(sim->step(std::min<std::uint64_t>(steps, 50)));
-    device.give_back(std::move(sim));
   }
   for (int r = 0; r < o.repeats; ++r) {
-    auto sim = device.sim(scene);
+    auto sim = make_sim(scene, o);
     prepare(*sim);
     const auto t0 = std::chrono::steady_clock::now();
     must(sim->step(steps));
@@ -168,9 +143,8 @@ Measurement measure(const motes::Scene& scene, const BenchOptions& o, std::uint6
       m.skin = sim->step_params().neighbour_skin;
       m.capacity = sim->step_params().neighbour_capacity;
     }
-    device.give_back(std::move(sim));
   }
-  auto sim = device.sim(scene);
+  auto sim = make_sim(scene, o);
   prepare(*sim);
   m.kernel_steps = std::min<std::uint64_t>(steps, 500);
   sim->device().set_timing(true);
@@ -403,16 +377,14 @@ void run_realtime_scene(const std::string& path, const BenchOptions& o, nlohmann
   const auto frames = static_cast<std::uint64_t>(std::max<long long>(
       1, std::llround(o.realtime_seconds / (static_cast<double>(frame_steps) * dt))));
   const double simulated = static_cast<double>(frames * frame_steps) * dt;
-  BenchDevice device(o);
-  {  // Warm-up: first touch of memory, thread pool start, kernels and pipelines loaded.
-    auto sim = device.sim(scene);
+  {  // Warm-up: first touch of memory, thread pool start, graph capture.
+    auto sim = make_sim(scene, o);
     must(sim->step(std::min<std::uint64_t>(frame_steps, 50)));
-    device.give_back(std::move(sim));
   }
   std::vector<double> seconds;
   std::uint32_t particles = 0;
   for (int r = 0; r < o.repeats; ++r) {
-    auto sim = device.sim(scene);
+    auto sim = make_sim(scene, o);
     particles = sim->particle_count();
     double wall = 0.0;
     for (std::uint64_t f = 0; f < frames; ++f) {
@@ -421,7 +393,6 @@ void run_realtime_scene(const std::string& path, const BenchOptions& o, nlohmann
       wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     seconds.push_back(wall);
-    device.give_back(std::move(sim));
   }
   const double med = median(seconds);
   const std::string name = std::filesystem::path(path).stem().string();

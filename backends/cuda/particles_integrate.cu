@@ -15,9 +15,6 @@ using shared::vec4;
 
 namespace {
 
-/// kShift: MOTES_FLAG_PARTICLE_SHIFT, a kernel of its own so that the integration's keeps its
-/// registers and loads (as contacts_compute's kShifts).
-template <bool kShift>
 __global__ void particles_integrate_kernel(shared::StepParams p, vec4* __restrict__ pos,
                                            vec4* __restrict__ vel, const vec4* __restrict__ force,
                                            const vec4* __restrict__ ref, uint* __restrict__ state) {
@@ -27,7 +24,7 @@ __global__ void particles_integrate_kernel(shared::StepParams p, vec4* __restric
   if (i < p.particle_count) {
     vec4 x = pos[i];
     vec4 v = vel[i];
-    if constexpr (kShift) {
+    if ((p.flags & MOTES_FLAG_PARTICLE_SHIFT) != 0u) {
       shared::particle_shift_apply(x, v, force[i], p.gravity_dt.w);
     } else {
       v = shared::linked_damped(v, static_cast<uint>(i), p.linked_first, p.linked_damping);
@@ -44,10 +41,8 @@ __global__ void particles_integrate_kernel(shared::StepParams p, vec4* __restric
 
 void CudaDevice::launch_particles_integrate(const shared::StepParams& p) {
   if (p.particle_count <= p.rigid_particle_count) return;
-  const auto kernel = (p.flags & MOTES_FLAG_PARTICLE_SHIFT) != 0u
-                          ? particles_integrate_kernel<true>
-                          : particles_integrate_kernel<false>;
-  kernel<<<blocks_for(p.particle_count - p.rigid_particle_count), kBlock, 0, stream_>>>(
+  particles_integrate_kernel<<<blocks_for(p.particle_count - p.rigid_particle_count), kBlock, 0,
+                               stream_>>>(
       p, buf<vec4>(Buffer::ParticlePos), buf<vec4>(Buffer::ParticleVel),
       buf<vec4>(Buffer::ParticleForce), buf<vec4>(Buffer::NeighbourRefPos),
       buf<uint>(Buffer::NeighbourState));

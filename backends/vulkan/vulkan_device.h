@@ -191,8 +191,9 @@ class VulkanDevice final : public Device {
   std::array<VkPipelineLayout, kPipelineCount> pipeline_layouts_{};
   std::array<VkDescriptorSet, kPipelineCount> sets_{};
   VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
-  /// Created at a pipeline's first bind (pipeline_at()): a run compiles only the shaders it uses
-  /// (lavapipe took 0.3 to 0.4 s to compile all of them, most of a conformance case's time).
+  /// On a CPU device created at a pipeline's first bind (pipeline_at()): a run compiles only the
+  /// shaders it uses (lavapipe took 0.3 to 0.4 s to compile all of them, most of a conformance
+  /// case's time); on a GPU all when the device opens (create_pipelines), so no step waits.
   mutable std::array<VkPipeline, kPipelineCount> pipelines_{};
   std::array<const Shader*, kPipelineCount> shaders_{};
   /// The first failure to create one while recording (record() and run_once() return it).
