@@ -44,6 +44,7 @@ struct ViewArgs {
   std::string input;
   std::string save_state;
   std::string record;
+  bool staged = false;
 };
 
 #ifdef MOTES_HAVE_VIEWER
@@ -54,16 +55,6 @@ volatile std::sig_atomic_t g_stop = 0;
 extern "C" void on_stop_signal(int /*signal*/) { g_stop = 1; }
 
 using Clock = std::chrono::steady_clock;
-
-std::unique_ptr<Simulation> make_simulation(const Scene& scene, const ViewArgs& args) {
-  DeviceOptions options;
-  options.cpu_threads = args.threads;
-  Result<std::unique_ptr<Device>> device = open_device(args.backend, args.device, options);
-  if (!device) fail(device.message());
-  Result<std::unique_ptr<Simulation>> sim = Simulation::create(scene, std::move(device.value()));
-  if (!sim) fail(sim.message());
-  return std::move(sim.value());
-}
 
 Snapshot must_snapshot(Simulation& sim) {
   Result<Snapshot> s = sim.snapshot();
@@ -280,58 +271,71 @@ class Recorder {
 
 /// Where frames go: a window (with the person's input) or an offscreen picture (no input but the
 /// script's). One loop drives both, so scripted input does the same offscreen as in a window.
+/// Both draw staged (a snapshot each frame) or, attached to a simulation on their own Vulkan
+/// device, zero copy (docs/viewer.md); restyle (a new scene) goes back to staged.
 class Surface {
  public:
   virtual ~Surface() = default;
   virtual viewer::Input poll() = 0;
   [[nodiscard]] virtual render::Size size() const = 0;
-  virtual void draw(const render::Camera& camera, const Snapshot& frame, render::Image* shot) = 0;
+  /// `frame`: the particles on the staged path; ignored (may be null) when attached.
+  virtual void draw(const render::Camera& camera, const Snapshot* frame, render::Image* shot) = 0;
   virtual void restyle(const viewer::Style& style, const Snapshot& first) = 0;
+  [[nodiscard]] virtual Result<std::unique_ptr<Device>> open_compute_device() const = 0;
+  virtual void attach(Simulation& sim, const Snapshot& first) = 0;
+  [[nodiscard]] virtual bool attached() const = 0;
   virtual void set_title(const std::string& title) = 0;
   [[nodiscard]] virtual const std::string& device_name() const = 0;
+  [[nodiscard]] virtual int device_index() const = 0;
   [[nodiscard]] virtual bool real_time() const = 0;
 };
 
-class WindowSurface final : public Surface {
+/// Surface over a viewer::Window or viewer::Offscreen (the same calls).
+template <class Target, bool kRealTime>
+class TargetSurface : public Surface {
  public:
-  explicit WindowSurface(std::unique_ptr<viewer::Window> w) : window_(std::move(w)) {}
-  viewer::Input poll() override { return window_->poll(); }
-  [[nodiscard]] render::Size size() const override { return window_->size(); }
-  void draw(const render::Camera& camera, const Snapshot& frame, render::Image* shot) override {
-    window_->draw(camera, frame, shot);
-  }
+  explicit TargetSurface(std::unique_ptr<Target> target) : target_(std::move(target)) {}
   void restyle(const viewer::Style& style, const Snapshot& first) override {
-    window_->restyle(style, first);
+    target_->restyle(style, first);
   }
-  void set_title(const std::string& title) override { window_->set_title(title); }
-  [[nodiscard]] const std::string& device_name() const override { return window_->device_name(); }
-  [[nodiscard]] bool real_time() const override { return true; }
+  [[nodiscard]] Result<std::unique_ptr<Device>> open_compute_device() const override {
+    return target_->open_compute_device();
+  }
+  void attach(Simulation& sim, const Snapshot& first) override { target_->attach(sim, first); }
+  [[nodiscard]] bool attached() const override { return target_->attached(); }
+  [[nodiscard]] const std::string& device_name() const override { return target_->device_name(); }
+  [[nodiscard]] int device_index() const override { return target_->device_index(); }
+  [[nodiscard]] bool real_time() const override { return kRealTime; }
 
- private:
-  std::unique_ptr<viewer::Window> window_;
+ protected:
+  std::unique_ptr<Target> target_;
 };
 
-class OffscreenSurface final : public Surface {
+class WindowSurface final : public TargetSurface<viewer::Window, true> {
  public:
-  OffscreenSurface(render::Size size, const viewer::Style& style, const Snapshot& first)
-      : size_(size), out_(std::make_unique<viewer::Offscreen>(size, style, first)) {}
+  using TargetSurface::TargetSurface;
+  viewer::Input poll() override { return target_->poll(); }
+  [[nodiscard]] render::Size size() const override { return target_->size(); }
+  void draw(const render::Camera& camera, const Snapshot* frame, render::Image* shot) override {
+    target_->draw(camera, frame, shot);
+  }
+  void set_title(const std::string& title) override { target_->set_title(title); }
+};
+
+class OffscreenSurface final : public TargetSurface<viewer::Offscreen, false> {
+ public:
+  OffscreenSurface(render::Size size, int wanted_device)
+      : TargetSurface(std::make_unique<viewer::Offscreen>(size, wanted_device)), size_(size) {}
   viewer::Input poll() override { return {}; }
   [[nodiscard]] render::Size size() const override { return size_; }
-  void draw(const render::Camera& camera, const Snapshot& frame, render::Image* shot) override {
-    const render::Image& image = out_->draw(camera, frame);
+  void draw(const render::Camera& camera, const Snapshot* frame, render::Image* shot) override {
+    const render::Image& image = target_->draw(camera, frame);
     if (shot != nullptr) *shot = image;
   }
-  void restyle(const viewer::Style& style, const Snapshot& first) override {
-    out_.reset();  // one Vulkan device at a time
-    out_ = std::make_unique<viewer::Offscreen>(size_, style, first);
-  }
   void set_title(const std::string& /*title*/) override {}
-  [[nodiscard]] const std::string& device_name() const override { return out_->device_name(); }
-  [[nodiscard]] bool real_time() const override { return false; }
 
  private:
   render::Size size_;
-  std::unique_ptr<viewer::Offscreen> out_;
 };
 
 void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
@@ -339,12 +343,22 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
               const std::optional<viewer::Script>& script) {
   const std::string name = std::filesystem::path(args.scene).filename().string();
   const std::string backend = sim->device().info().backend;
+  // Zero copy: the picture comes from the simulation's buffers; `frame` is read back only when
+  // the host needs it (picking and pulling), and is stale in between.
+  const bool zero_copy = surface.attached();
+  const char* path = zero_copy ? "zero copy" : "staged";
+  bool frame_current = true;
+  auto current_frame = [&]() -> const Snapshot& {
+    if (!frame_current) frame = must_snapshot(*sim);
+    frame_current = true;
+    return frame;
+  };
   viewer::Orbit orbit(camera);
   std::uint64_t steps = frame_steps(sim->settings().dt);
   bool paused = false, slow = false;
   double owed_steps = 0.0;
   std::uint64_t shown = 0;
-  double total_step = 0.0, total_draw = 0.0;
+  double total_step = 0.0, total_copy = 0.0, total_draw = 0.0;
   // Title statistics over about half a second.
   auto window_start = Clock::now();
   int window_frames = 0;
@@ -381,14 +395,17 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
         sim = std::move(made.value());
         steps = frame_steps(sim->settings().dt);
         frame = must_snapshot(*sim);
+        frame_current = true;
         style.look = render::look_from_scene(reloaded.value());
         surface.restyle(style, frame);
+        if (zero_copy) surface.attach(*sim, frame);  // the new simulation's buffers
         owed_steps = 0.0;
         grab.stop(nullptr);
       }
     }
     if (in.grab_start) {
-      if (grab.start(*sim, frame, orbit.camera(), surface.size(), in.cursor_x, in.cursor_y)) {
+      if (grab.start(*sim, current_frame(), orbit.camera(), surface.size(), in.cursor_x,
+                     in.cursor_y)) {
         fmt::print("motes view: grabbed {}\n", sim->bodies()[grab.body()].name);
       } else {
         fmt::print("motes view: nothing to grab at ({:.0f}, {:.0f})\n", in.cursor_x, in.cursor_y);
@@ -405,21 +422,25 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     const auto t0 = Clock::now();
     if (advance > 0) {
       if (grab.active()) {
-        grab.pull(*sim, frame, orbit.camera(), surface.size(), in.cursor_x, in.cursor_y,
+        grab.pull(*sim, current_frame(), orbit.camera(), surface.size(), in.cursor_x, in.cursor_y,
                   static_cast<double>(advance) * sim->settings().dt);
       }
       must_step(*sim, advance);
-      frame = must_snapshot(*sim);
+      // Stepping alone (a backend may queue steps and return before they are done).
+      if (Status s = sim->device().synchronize(); !s) fail(s.message());
+      frame_current = false;
     }
     if (in.grab_end) {
       grab.stop(sim.get());
-      frame = must_snapshot(*sim);
+      frame_current = false;
     }
     const auto t1 = Clock::now();
+    if (!zero_copy) current_frame();  // the staged path draws from the host's copy
+    const auto t2 = Clock::now();
     const bool last = args.frames > 0 && shown + 1 >= args.frames;
     const bool keep = in.screenshot || (last && !args.screenshot.empty()) || recorder.on();
     render::Image picture;
-    surface.draw(orbit.camera(), frame, keep ? &picture : nullptr);
+    surface.draw(orbit.camera(), zero_copy ? nullptr : &frame, keep ? &picture : nullptr);
     if (in.screenshot) {
       const std::string file = numbered_file("png");
       must_write(file, picture);
@@ -429,13 +450,15 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     recorder.add(picture);
     if (keep) last_picture = std::move(picture);
     const double step_s = std::chrono::duration<double>(t1 - t0).count();
-    const double draw_s = seconds_since(t1);
+    const double copy_s = std::chrono::duration<double>(t2 - t1).count();
+    const double draw_s = seconds_since(t2);
     ++shown;
     total_step += step_s;
+    total_copy += copy_s;
     total_draw += draw_s;
     ++window_frames;
     window_step += step_s;
-    window_draw += draw_s;
+    window_draw += copy_s + draw_s;
     window_simulated += static_cast<double>(advance) * sim->settings().dt;
     const double elapsed = seconds_since(window_start);
     if (surface.real_time() && (elapsed >= 0.5 || shown == 1)) {
@@ -443,10 +466,10 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
       const double factor = window_simulated / elapsed;
       const bool behind = !paused && window_step / window_frames > 1.0 / kFrameRate;
       surface.set_title(fmt::format(
-          "motes view: {} | {:.0f} fps | step {:.1f} ms, draw {:.1f} ms | {:.2f}x real time{} | "
-          "{} particles | {}{}{}",
-          name, fps, 1e3 * window_step / window_frames, 1e3 * window_draw / window_frames, factor,
-          behind ? " (slower than real time)" : "", sim->particle_count(), backend,
+          "motes view: {} | {:.0f} fps | step {:.1f} ms, draw {:.1f} ms ({}) | {:.2f}x real time{} "
+          "| {} particles | {}{}{}",
+          name, fps, 1e3 * window_step / window_frames, 1e3 * window_draw / window_frames, path,
+          factor, behind ? " (slower than real time)" : "", sim->particle_count(), backend,
           paused ? " | paused" : "", slow ? " | slow motion x0.25" : ""));
       window_start = Clock::now();
       window_frames = 0;
@@ -461,7 +484,9 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     }
   }
   if (!args.screenshot.empty()) {
-    if (last_picture.rgb.empty()) surface.draw(orbit.camera(), frame, &last_picture);
+    if (last_picture.rgb.empty()) {
+      surface.draw(orbit.camera(), zero_copy ? nullptr : &current_frame(), &last_picture);
+    }
     must_write(args.screenshot, last_picture);
   }
   recorder.stop();
@@ -471,10 +496,10 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
   }
   const double n = static_cast<double>(std::max<std::uint64_t>(shown, 1));
   fmt::print(
-      "motes view: {} frames shown, {} particles on {}, drawn {}on {}: {:.2f} ms step and {:.2f} "
-      "ms draw a frame{}{}\n",
-      shown, sim->particle_count(), backend, surface.real_time() ? "" : "offscreen ",
-      surface.device_name(), 1e3 * total_step / n, 1e3 * total_draw / n,
+      "motes view: {} frames shown, {} particles on {}, drawn {} {}on {}: {:.2f} ms step, {:.2f} "
+      "ms copy to the host and {:.2f} ms draw a frame{}{}\n",
+      shown, sim->particle_count(), backend, path, surface.real_time() ? "" : "offscreen ",
+      surface.device_name(), 1e3 * total_step / n, 1e3 * total_copy / n, 1e3 * total_draw / n,
       args.screenshot.empty() ? "" : fmt::format("; picture {}", args.screenshot),
       args.save_state.empty() ? "" : fmt::format("; state {}", args.save_state));
   std::fflush(stdout);
@@ -504,36 +529,74 @@ void view(const ViewArgs& args) {
   }
   Result<Scene> scene = load_scene_file(args.scene);
   if (!scene) fail(scene.message());
-  std::unique_ptr<Simulation> sim = make_simulation(scene.value(), args);
-  Snapshot first = must_snapshot(*sim);
-  viewer::Style style;
-  style.look = render::look_from_scene(scene.value());
-  style.color_by = color_by.value();
-  const render::Camera camera =
-      scene->camera ? render::camera_from_spec(*scene->camera)
-                    : render::fit_camera(first.particle_pos, style.look.up, size.value(), 35.0f,
-                                         style.look.ground_height);
+  DeviceOptions options;
+  options.cpu_threads = args.threads;
+  Result<std::unique_ptr<Device>> device = open_device(args.backend, args.device, options);
+  if (!device) fail(device.message());
+  const DeviceInfo compute = device.value()->info();
   std::signal(SIGTERM, on_stop_signal);
   std::signal(SIGINT, on_stop_signal);
+  if (args.offscreen && args.frames == 0 && !(script && script->quits())) {
+    fail("--offscreen needs --frames N, or an --input script that quits (when to stop)");
+  }
+  // The viewer draws on the compute backend's Vulkan device when it can (zero copy needs one).
+  const int wanted = compute.backend == "vulkan" ? compute.index : -1;
   std::unique_ptr<Surface> surface;
   if (args.offscreen) {
-    if (args.frames == 0 && !(script && script->quits())) {
-      fail("--offscreen needs --frames N, or an --input script that quits (when to stop)");
-    }
-    surface = std::make_unique<OffscreenSurface>(size.value(), style, first);
+    surface = std::make_unique<OffscreenSurface>(size.value(), wanted);
   } else {
     const std::string name = std::filesystem::path(args.scene).filename().string();
     try {
       surface = std::make_unique<WindowSurface>(
-          std::make_unique<viewer::Window>(size.value(), "motes view: " + name, style, first));
+          std::make_unique<viewer::Window>(size.value(), "motes view: " + name, wanted));
     } catch (const viewer::NoDisplay& e) {
-      sim.reset();  // the compute device goes before the exit handlers
+      device.value().reset();  // the compute device goes before the exit handlers
       fmt::print(stderr, "motes view: no display ({}); use --offscreen\n", e.what());
       std::fflush(stderr);
       std::exit(1);
     }
   }
+  // Zero copy (docs/viewer.md): the simulation on the viewer's own device, motes' Vulkan device
+  // made on it (motes/vulkan_interop.h), so that the sphere pipeline reads its buffers.
+  std::string staged_why = fmt::format("the {} backend", compute.backend);
+  bool zero_copy = false;
+  if (compute.backend == "vulkan") {
+    if (args.staged) {
+      staged_why = "--staged";
+    } else if (surface->device_index() != compute.index) {
+      staged_why = fmt::format("the simulation's Vulkan device {} cannot draw", compute.name);
+    } else {
+      // motes' own device goes first: volk's device functions are one device's at a time.
+      device.value().reset();
+      device = surface->open_compute_device();
+      zero_copy = device.is_ok();
+      if (!zero_copy) {
+        staged_why = device.message();
+        device = open_device(args.backend, args.device, options);
+        if (!device) fail(device.message());
+      }
+    }
+  }
+  Result<std::unique_ptr<Simulation>> made =
+      Simulation::create(scene.value(), std::move(device.value()));
+  if (!made) fail(made.message());
+  std::unique_ptr<Simulation> sim = std::move(made.value());
+  Snapshot first = must_snapshot(*sim);
+  viewer::Style style;
+  style.look = render::look_from_scene(scene.value());
+  style.color_by = color_by.value();
+  surface->restyle(style, first);
+  if (zero_copy) surface->attach(*sim, first);
+  fmt::print("motes view: drawing {}\n",
+             zero_copy ? "zero copy, from the simulation's own Vulkan buffers"
+                       : fmt::format("staged, through the host ({})", staged_why));
+  std::fflush(stdout);
+  const render::Camera camera =
+      scene->camera ? render::camera_from_spec(*scene->camera)
+                    : render::fit_camera(first.particle_pos, style.look.up, size.value(), 35.0f,
+                                         style.look.ground_height);
   run_view(args, *surface, style, camera, sim, std::move(first), script);
+  sim.reset();  // zero copy: motes' device is on the viewer's, which goes next
   surface.reset();
 }
 
@@ -574,6 +637,9 @@ void add_view_command(CLI::App& app) {
                   "it; it has no run description for motes resume)");
   sub->add_option("--record", args->record,
                   "record the displayed frames from the start as an MP4 video (ffmpeg; V stops)");
+  sub->add_flag("--staged", args->staged,
+                "draw from a copy of the particles through the host even where the Vulkan "
+                "backend's buffers could be drawn as they are (zero copy; docs/viewer.md)");
   sub->add_flag(
       "--offscreen", args->offscreen,
       "draw without a window (needs --frames, or an --input script that quits; for machines "

@@ -22,6 +22,10 @@ install(FILES
         core/include/motes/status.h core/include/motes/workloads.h
         render/include/motes/render.h render/include/motes/render_output.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/motes)
+if(MOTES_VULKAN)
+  install(FILES backends/vulkan/include/motes/vulkan_interop.h
+          DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/motes)
+endif()
 install(FILES core/include/motes/backend/device.h core/include/motes/backend/kernels.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/motes/backend)
 file(GLOB MOTES_SHARED_HEADERS CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/shaders/shared/*.h)

@@ -42,6 +42,45 @@ check() {  # check NAME PREFIX
     return 1
   }
   echo "== package ($name): examples/embed built with find_package(motes) and with pkg-config, ran"
+  check_vulkan "$name" "$prefix"
+}
+
+# examples/embed_vulkan: a program with its own Vulkan device that runs motes on it and draws
+# motes' buffers itself, under the validation layer (synchronization validation on) when it is
+# installed: any message fails, and the picture must show the particles (not the clear colour in
+# a plausible share of its 640 x 480 pixels).
+check_vulkan() {  # check_vulkan NAME PREFIX
+  local name=$1 prefix=$2
+  if ! grep -q 'motes_WITH_VULKAN ON' "$prefix/lib/cmake/motes/motesConfig.cmake"; then
+    echo "== package ($name): built without Vulkan, examples/embed_vulkan skipped"
+    return 0
+  fi
+  cmake -S "$root/examples/embed_vulkan" -B "$work/embed-vulkan-$name" -G Ninja \
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" >/dev/null
+  cmake --build "$work/embed-vulkan-$name" >/dev/null
+  local layers=()
+  if ls /usr/share/vulkan/explicit_layer.d/*khronos_validation* >/dev/null 2>&1; then
+    layers=(VK_INSTANCE_LAYERS=VK_LAYER_KHRONOS_validation
+      VK_LAYER_ENABLES=VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT)
+  fi
+  local out=$work/vulkan-$name.txt
+  env "${layers[@]}" "$work/embed-vulkan-$name/motes_embed_vulkan" \
+    "$root/examples/scenes/position_dice.json" "$work/vulkan-$name.ppm" 5 >"$out" 2>&1 || {
+    echo "check-package: FAILED: examples/embed_vulkan ($name) printed:" >&2
+    cat "$out" >&2
+    return 1
+  }
+  local drawn
+  drawn=$(sed -n 's/.*: \([0-9]*\) of 307200 pixels drawn.*/\1/p' "$out")
+  if grep -q -e 'Validation Error' -e 'SYNC-HAZARD' "$out" || [ -z "$drawn" ] ||
+    [ "$drawn" -lt 5000 ] || [ "$drawn" -gt 200000 ]; then
+    echo "check-package: FAILED: examples/embed_vulkan ($name): validation messages or an" \
+      "implausible picture ($drawn pixels drawn):" >&2
+    cat "$out" >&2
+    return 1
+  fi
+  echo "== package ($name): examples/embed_vulkan drew $drawn pixels of particles" \
+    "${layers:+under the validation layer}"
 }
 
 cmake --install "$build" --prefix "$work/static" >/dev/null

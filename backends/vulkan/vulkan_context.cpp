@@ -240,14 +240,32 @@ Result<std::unique_ptr<Instance>> Instance::create(bool validation) {
     }
   }
 
-  std::uint32_t count = 0;
-  vkEnumeratePhysicalDevices(inst->instance_, &count, nullptr);
-  std::vector<VkPhysicalDevice> handles(count);
-  vkEnumeratePhysicalDevices(inst->instance_, &count, handles.data());
-  for (std::uint32_t i = 0; i < count; ++i) {
-    inst->devices_.push_back(describe(handles[i], static_cast<int>(i)));
-  }
+  inst->describe_devices();
   return inst;
+}
+
+Result<std::unique_ptr<Instance>> Instance::adopt(VkInstance instance) {
+  if (VkResult r = volkInitialize(); r != VK_SUCCESS) {
+    return Status::error("no Vulkan loader (libvulkan.so.1 could not be loaded)");
+  }
+  std::unique_ptr<Instance> inst(new Instance());
+  inst->instance_ = instance;
+  inst->owned_ = false;
+  // The instance-level functions are the loader's trampolines, the same for every instance, so
+  // loading them from the program's instance leaves motes' own instance (if any) working.
+  volkLoadInstanceOnly(instance);
+  inst->describe_devices();
+  return inst;
+}
+
+void Instance::describe_devices() {
+  std::uint32_t count = 0;
+  vkEnumeratePhysicalDevices(instance_, &count, nullptr);
+  std::vector<VkPhysicalDevice> handles(count);
+  vkEnumeratePhysicalDevices(instance_, &count, handles.data());
+  for (std::uint32_t i = 0; i < count; ++i) {
+    devices_.push_back(describe(handles[i], static_cast<int>(i)));
+  }
 }
 
 namespace {
@@ -294,6 +312,7 @@ int Instance::preferred() const {
 }
 
 Instance::~Instance() {
+  if (!owned_) return;
   if (messenger_ != VK_NULL_HANDLE) vkDestroyDebugUtilsMessengerEXT(instance_, messenger_, nullptr);
   if (instance_ != VK_NULL_HANDLE) vkDestroyInstance(instance_, nullptr);
 }

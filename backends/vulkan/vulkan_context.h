@@ -43,6 +43,9 @@ class Instance {
  public:
   /// Loads Vulkan, creates an instance (with validation when asked), lists physical devices.
   static Result<std::unique_ptr<Instance>> create(bool validation);
+  /// A program's instance (motes/vulkan_interop.h), described like one motes made; never
+  /// destroyed here. Loads Vulkan when motes has not yet.
+  static Result<std::unique_ptr<Instance>> adopt(VkInstance instance);
   ~Instance();
   Instance(const Instance&) = delete;
   Instance& operator=(const Instance&) = delete;
@@ -56,7 +59,10 @@ class Instance {
 
  private:
   Instance() = default;
+  /// Lists the physical devices of instance_.
+  void describe_devices();
   VkInstance instance_ = VK_NULL_HANDLE;
+  bool owned_ = true;  ///< false for a program's instance (adopt)
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
   std::unique_ptr<MessageLog> log_ = std::make_unique<MessageLog>();
   std::vector<PhysicalDevice> devices_;

@@ -178,12 +178,39 @@ Status VulkanDevice::init(std::shared_ptr<Instance> instance, int physical) {
       !s) {
     return s;
   }
+  return init_queue(0);
+}
+
+Result<std::unique_ptr<VulkanDevice>> VulkanDevice::adopt(std::shared_ptr<Instance> instance,
+                                                          int physical, VkDevice device,
+                                                          std::uint32_t family, std::uint32_t index,
+                                                          bool memory_budget) {
+  std::unique_ptr<VulkanDevice> d(new VulkanDevice());
+  d->instance_ = std::move(instance);
+  d->physical_ = d->instance_->devices()[static_cast<std::size_t>(physical)];
+  d->info_ = d->physical_.info;
+  d->info_.detail += ", the program's device";
+  std::uint32_t count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(d->physical_.handle, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  vkGetPhysicalDeviceQueueFamilyProperties(d->physical_.handle, &count, families.data());
+  d->physical_.compute_family = family;
+  d->physical_.timestamp_bits = families.at(family).timestampValidBits;
+  d->device_ = device;
+  d->owns_device_ = false;
+  d->begin_stages_ = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+  d->memory_budget_ = memory_budget;
+  if (Status s = d->init_queue(index); !s) return s;
+  return d;
+}
+
+Status VulkanDevice::init_queue(std::uint32_t queue_index) {
   volkLoadDevice(device_);
   if (const char* env = std::getenv("MOTES_VULKAN_MAX_GROUPS_X"); env != nullptr && *env != '\0') {
     const long v = std::strtol(env, nullptr, 10);
     if (v >= 1 && v < 65535) max_groups_x_ = static_cast<std::uint64_t>(v);
   }
-  vkGetDeviceQueue(device_, physical_.compute_family, 0, &queue_);
+  vkGetDeviceQueue(device_, physical_.compute_family, queue_index, &queue_);
   vkGetPhysicalDeviceMemoryProperties(physical_.handle, &memory_);
 
   VkCommandPoolCreateInfo pool{};
@@ -325,7 +352,9 @@ VkPipeline VulkanDevice::pipeline_at(std::size_t i) const {
 
 VulkanDevice::~VulkanDevice() {
   if (device_ != VK_NULL_HANDLE) {
-    vkDeviceWaitIdle(device_);
+    // Nothing of motes is in flight between calls (every submission is waited for); on a
+    // program's device, waiting for it idle would also wait for (and race with) its own work.
+    if (owns_device_) vkDeviceWaitIdle(device_);
     free_recordings();
     release_buffers();
     destroy_buffer(staging_);
@@ -344,7 +373,7 @@ VulkanDevice::~VulkanDevice() {
     }
     if (fence_ != VK_NULL_HANDLE) vkDestroyFence(device_, fence_, nullptr);
     if (pool_ != VK_NULL_HANDLE) vkDestroyCommandPool(device_, pool_, nullptr);
-    vkDestroyDevice(device_, nullptr);
+    if (owns_device_) vkDestroyDevice(device_, nullptr);
   }
 }
 
@@ -355,7 +384,9 @@ Status VulkanDevice::create_buffer(GpuBuffer& out, VkDeviceSize data_bytes, bool
   info.size = padded(data_bytes) + kGuardBytes;
   info.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   if (!host_visible) {
-    info.usage |= VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
+    // Vertex buffers too: a program drawing on the same device binds them (vulkan_interop.h).
+    info.usage |= VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                  VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
   }
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   if (info.size > physical_.max_allocation && physical_.max_allocation != 0) {

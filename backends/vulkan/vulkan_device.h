@@ -63,7 +63,23 @@ class VulkanDevice final : public Device {
   /// Creates the logical device on `physical` (an index into instance->devices()).
   static Result<std::unique_ptr<VulkanDevice>> create(std::shared_ptr<Instance> instance,
                                                       int physical);
+  /// On a program's device (motes/vulkan_interop.h: open_vulkan_device checked the handles):
+  /// its queue `index` of `family`; the program's device and instance are never destroyed here.
+  static Result<std::unique_ptr<VulkanDevice>> adopt(std::shared_ptr<Instance> instance,
+                                                     int physical, VkDevice device,
+                                                     std::uint32_t family, std::uint32_t index,
+                                                     bool memory_budget);
   ~VulkanDevice() override;
+
+  /// Made by adopt(): the buffers live on the program's device.
+  [[nodiscard]] bool on_program_device() const { return !owns_device_; }
+  /// The VkBuffer of `b` and the bytes of its data.
+  [[nodiscard]] VkBuffer buffer_handle(Buffer b) const {
+    return buffers_[static_cast<std::size_t>(b)].buffer;
+  }
+  [[nodiscard]] VkDeviceSize buffer_bytes(Buffer b) const {
+    return buffers_[static_cast<std::size_t>(b)].data_bytes;
+  }
 
   [[nodiscard]] const DeviceInfo& info() const override { return info_; }
   [[nodiscard]] std::uint64_t required_bytes(const Sizes& sizes) const override;
@@ -108,6 +124,8 @@ class VulkanDevice final : public Device {
 
   VulkanDevice() = default;
   Status init(std::shared_ptr<Instance> instance, int physical);
+  /// After device_ exists: the queue of physical_.compute_family, command pool, fence, pipelines.
+  Status init_queue(std::uint32_t queue_index);
   Status create_pipelines();
   void release_buffers();
   Status create_buffer(GpuBuffer& out, VkDeviceSize data_bytes, bool host_visible,
@@ -138,9 +156,9 @@ class VulkanDevice final : public Device {
   // Recording helpers shared by the kernel files.
   /// What a barrier makes visible: compute writes to the next dispatch (between passes), also to
   /// the indirect arguments read by the next dispatches (after neighbours_update.comp), or
-  /// everything to everything, transfers and the host included (where a command buffer starts and
-  /// ends).
-  enum class Sync { Compute, Indirect, All };
+  /// everything to everything, transfers and the host included (where a command buffer ends);
+  /// Begin is All after begin_stages_ (where a command buffer starts).
+  enum class Sync { Compute, Indirect, All, Begin };
   void barrier(VkCommandBuffer cb, Sync sync = Sync::Compute) const;
   /// Binds a pipeline, its descriptor set and the push constants.
   void bind(VkCommandBuffer cb, Pipeline pipeline, const PushConstants& push) const;
@@ -179,6 +197,12 @@ class VulkanDevice final : public Device {
   PhysicalDevice physical_;
   DeviceInfo info_;
   VkDevice device_ = VK_NULL_HANDLE;
+  bool owns_device_ = true;  ///< false: a program's device (adopt)
+  /// The first scope of the barrier that starts every command buffer: motes' own compute and
+  /// transfers; on a program's device every command before it on the queue, so that a program's
+  /// draw reading the particle buffers is done before a step writes them (vulkan_interop.h).
+  VkPipelineStageFlags begin_stages_ =
+      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
   VkQueue queue_ = VK_NULL_HANDLE;
   VkCommandPool pool_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;

@@ -66,7 +66,8 @@ void VulkanDevice::barrier(VkCommandBuffer cb, Sync sync) const {
   if (sync == Sync::Indirect) {
     b.dstAccessMask |= VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
     dst |= VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT;
-  } else if (sync == Sync::All) {
+  } else if (sync == Sync::All || sync == Sync::Begin) {
+    if (sync == Sync::Begin) src = begin_stages_;
     b.srcAccessMask |= VK_ACCESS_TRANSFER_WRITE_BIT;
     b.dstAccessMask |= VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT |
                        VK_ACCESS_HOST_READ_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
@@ -167,7 +168,7 @@ Result<VkCommandBuffer> VulkanDevice::record(const std::vector<Op>& ops, bool ti
   if (!began) return began;
   VkCommandBuffer cb = began.value();
   if (timing) vkCmdResetQueryPool(cb, queries_, 0, timestamps_for(ops));
-  barrier(cb, Sync::All);
+  barrier(cb, Sync::Begin);
   std::uint32_t q = 0;
   for (std::size_t i = 0; i < ops.size(); ++i) {
     const shared::StepParams& p = ops[i].params;
@@ -216,7 +217,7 @@ Status VulkanDevice::run_once(const std::function<void(VkCommandBuffer)>& fill) 
   Result<VkCommandBuffer> began = begin_commands(VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT);
   if (!began) return began.status();
   VkCommandBuffer cb = began.value();
-  barrier(cb, Sync::All);
+  barrier(cb, Sync::Begin);
   fill(cb);
   barrier(cb, Sync::All);
   Status s = end_recording(cb);

@@ -450,6 +450,21 @@ Status Simulation::clear_contact_history() {
   return s;
 }
 
+std::vector<std::uint32_t> Simulation::scene_particle_order() const {
+  // locate_particle's rule, body by body: O(N) where locate_particle is O(bodies) a particle.
+  std::vector<std::uint32_t> order(sizes_.particles);
+  for (std::uint32_t b = 0; b < bodies_.size(); ++b) {
+    const BodyInfo& info = bodies_[b];
+    const std::uint32_t at = device_index_[b];
+    const std::uint32_t first =
+        info.free_sphere || info.linked || info.soft ? at : rigid_first_[at];
+    for (std::uint32_t k = 0; k < info.particle_count; ++k) {
+      order[first + k] = info.first_particle + k;
+    }
+  }
+  return order;
+}
+
 Result<Snapshot> Simulation::snapshot() {
   Device& d = *device_;
   const std::size_t n = sizes_.particles;

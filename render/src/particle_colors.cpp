@@ -19,6 +19,15 @@ const Eigen::Vector3f kStaticColor(0.62f, 0.63f, 0.66f);
 
 }  // namespace
 
+const std::array<Eigen::Vector3f, ParticleColors::kMapStops>& ParticleColors::map_stops() {
+  // viridis at 0, 1/4, 1/2, 3/4, 1.
+  static const std::array<Eigen::Vector3f, kMapStops> stops = {
+      Eigen::Vector3f(0.267f, 0.005f, 0.329f), Eigen::Vector3f(0.229f, 0.322f, 0.546f),
+      Eigen::Vector3f(0.128f, 0.567f, 0.551f), Eigen::Vector3f(0.369f, 0.789f, 0.383f),
+      Eigen::Vector3f(0.993f, 0.906f, 0.144f)};
+  return stops;
+}
+
 ParticleColors::ParticleColors(ColorBy color_by, SceneLook look)
     : color_by_(color_by), look_(std::move(look)) {
   look_.up = look_.up.norm() > 0.0f ? look_.up.normalized() : Eigen::Vector3f::UnitY();

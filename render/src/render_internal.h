@@ -88,7 +88,7 @@ void atomic_min(std::uint32_t& slot, std::uint32_t value);
 Eigen::Vector3f to_linear(const Eigen::Vector3f& srgb);
 void store_srgb8(const Eigen::Vector3f& linear, std::uint8_t* out);
 
-/// The viridis colour map at t in [0, 1] (clamped), sRGB.
+/// The viridis colour map at t in [0, 1] (clamped), sRGB: ParticleColors::map_stops() interpolated.
 Eigen::Vector3f colormap(float t);
 /// Sky behind everything, by picture row fraction (0 top, 1 bottom), linear.
 Eigen::Vector3f background(float row_fraction);

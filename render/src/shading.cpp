@@ -54,11 +54,7 @@ void store_srgb8(const Eigen::Vector3f& linear, std::uint8_t* out) {
 }
 
 Eigen::Vector3f colormap(float t) {
-  // viridis at 0, 1/4, 1/2, 3/4, 1.
-  static const std::array<Eigen::Vector3f, 5> stops = {
-      Eigen::Vector3f(0.267f, 0.005f, 0.329f), Eigen::Vector3f(0.229f, 0.322f, 0.546f),
-      Eigen::Vector3f(0.128f, 0.567f, 0.551f), Eigen::Vector3f(0.369f, 0.789f, 0.383f),
-      Eigen::Vector3f(0.993f, 0.906f, 0.144f)};
+  const std::array<Eigen::Vector3f, ParticleColors::kMapStops>& stops = ParticleColors::map_stops();
   if (!(t > 0.0f)) return stops[0];
   if (t >= 1.0f) return stops[4];
   const float x = t * 4.0f;

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <thread>
 #include <vector>
@@ -133,9 +134,10 @@ int shell(const std::string& command) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-std::string view_command(const std::string& backend, const fs::path& png, bool offscreen) {
+std::string view_command(const std::string& backend, const fs::path& png, bool offscreen,
+                         int frames = kFrames) {
   return std::string(MOTES_CLI_PATH) + " view " + kScene + " --backend " + backend +
-         " --size 320x240 --frames " + std::to_string(kFrames) + " --screenshot " + png.string() +
+         " --size 320x240 --frames " + std::to_string(frames) + " --screenshot " + png.string() +
          (offscreen ? " --offscreen" : "");
 }
 
@@ -200,6 +202,12 @@ class Xvfb {
   std::string display_;
 };
 
+/// The text of the file at `path`.
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 class ViewOffscreen : public testing::TestWithParam<const char*> {};
 
 TEST_P(ViewOffscreen, MatchesTheHeadlessRenderer) {
@@ -208,7 +216,12 @@ TEST_P(ViewOffscreen, MatchesTheHeadlessRenderer) {
     GTEST_SKIP() << "skipped: no Vulkan device for the simulation";
   }
   const fs::path png = scratch("offscreen-" + backend + ".png");
-  ASSERT_EQ(shell(view_command(backend, png, true)), 0);
+  const fs::path out = scratch("offscreen-" + backend + ".txt");
+  ASSERT_EQ(shell(view_command(backend, png, true) + " > " + out.string()), 0);
+  // Vulkan draws zero copy, openmp staged (docs/viewer.md).
+  const std::string text = read_text(out);
+  EXPECT_NE(text.find(backend == "vulkan" ? "drawn zero copy" : "drawn staged"), std::string::npos)
+      << text;
   expect_matches(load_png(png), reference());
 }
 
@@ -219,7 +232,16 @@ TEST(ViewWindow, MatchesTheHeadlessRendererUnderXvfb) {
   if (!x.ready()) GTEST_SKIP() << "skipped: no Xvfb (Debian: xvfb)";
   const fs::path png = scratch("window.png");
   ASSERT_EQ(shell("DISPLAY=" + x.display() + " " + view_command("openmp", png, false)), 0);
-  expect_matches(load_png(png), reference());
+  const Reference ref = reference();
+  expect_matches(load_png(png), ref);
+  // A window's swapchain, zero copy from the Vulkan backend's buffers.
+  if (!motes::open_device("vulkan")) return;
+  const fs::path vulkan_png = scratch("window-vulkan.png"), out = scratch("window-vulkan.txt");
+  ASSERT_EQ(shell("DISPLAY=" + x.display() + " " + view_command("vulkan", vulkan_png, false) +
+                  " > " + out.string()),
+            0);
+  EXPECT_NE(read_text(out).find("drawn zero copy"), std::string::npos) << read_text(out);
+  expect_matches(load_png(vulkan_png), ref);
 }
 
 TEST(ViewWindow, NoDisplayIsAOneLineError) {
@@ -567,6 +589,56 @@ TEST(ViewGrab, ShiftDragInAWindowUnderXvfb) {
   std::printf("box x after a Shift-drag %.4f m, after a plain drag %.4f m\n", grabbed, orbited);
   EXPECT_GT(grabbed, 0.02);
   EXPECT_LT(std::abs(orbited), 1e-3);
+}
+
+bool has_vulkan() { return motes::open_device("vulkan").is_ok(); }
+
+// Zero copy (docs/viewer.md): on the Vulkan backend the viewer draws from the simulation's own
+// buffers (Backends/ViewOffscreen.MatchesTheHeadlessRenderer/1 compares that picture with the
+// headless renderer's); its pictures must be the staged path's, whatever the colours.
+TEST(ViewZeroCopy, PicturesMatchTheStagedPath) {
+  if (!has_vulkan()) GTEST_SKIP() << "skipped: no Vulkan device for the simulation";
+  for (const std::string color_by : {"body", "speed", "height"}) {
+    Image pictures[2];
+    for (int staged = 0; staged < 2; ++staged) {
+      const std::string tag = color_by + (staged != 0 ? "-staged" : "-zero-copy");
+      const fs::path png = scratch(tag + ".png"), out = scratch(tag + ".txt");
+      ASSERT_EQ(shell(view_command("vulkan", png, true, 8) + " --color-by " + color_by +
+                      (staged != 0 ? " --staged" : "") + " > " + out.string()),
+                0);
+      const std::string text = read_text(out);
+      EXPECT_NE(text.find(staged != 0 ? "drawn staged" : "drawn zero copy"), std::string::npos)
+          << text;
+      pictures[staged] = load_png(png);
+    }
+    const double d = difference(pictures[0], pictures[1]);
+    std::printf("colours by %s: zero copy against staged %.3f\n", color_by.c_str(), d);
+    EXPECT_LT(d, kSameBelow);
+  }
+}
+
+// Many frames zero copy under the validation layer (MOTES_VULKAN_VALIDATION=1 in ctest: any
+// message is an error that ends the run): speed colours (the compute pass), a grab (snapshots
+// and write_state between the frames) and a reset (the simulation made again on the viewer's
+// device). The reset's state is a fresh 3-frame run's.
+TEST(ViewZeroCopy, ManyFramesWithAGrabAndAReset) {
+  if (!has_vulkan()) GTEST_SKIP() << "skipped: no Vulkan device for the simulation";
+  const fs::path scene_path = write_file("zero-copy-box.json", kBoxScene);
+  auto run = [&](const std::string& tag, int frames, const std::string& script) {
+    const fs::path state = scratch(tag + ".state"), out = scratch(tag + ".txt");
+    std::string command = std::string(MOTES_CLI_PATH) + " view " + scene_path.string() +
+                          " --backend vulkan --offscreen --size 320x240 --color-by speed " +
+                          "--frames " + std::to_string(frames) + " --save-state " + state.string();
+    if (!script.empty()) command += " --input " + write_file(tag + "-input.txt", script).string();
+    EXPECT_EQ(shell(command + " > " + out.string() + " 2>&1"), 0) << read_text(out);
+    EXPECT_NE(read_text(out).find("drawn zero copy"), std::string::npos) << read_text(out);
+    return load_saved(scene_path, state);
+  };
+  const motes::Snapshot three = run("zero-copy-three", 3, "");
+  const motes::Snapshot reset =
+      run("zero-copy-reset", 100, "5 drag 165 117 225 117 10 shift\n97 key r\n");
+  EXPECT_EQ(reset.step, three.step);
+  EXPECT_TRUE(same_positions(reset, three));
 }
 
 }  // namespace

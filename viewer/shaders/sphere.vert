@@ -3,9 +3,10 @@
 // large enough to cover the sphere's outline; sphere.frag finds the sphere inside it.
 #extension GL_GOOGLE_include_directive : require
 #include "view.glsl"
+#include "colors.glsl"
 
 layout(location = 0) in vec4 sphere;  // per instance: centre, w = radius
-layout(location = 1) in vec4 color;   // per instance: linear RGB
+layout(location = 1) in vec4 extra;   // per instance: linear RGB, or a velocity (colors.glsl)
 
 layout(location = 0) out vec3 quad_point;
 layout(location = 1) flat out vec4 out_sphere;
@@ -13,11 +14,13 @@ layout(location = 2) flat out vec3 out_color;
 
 void main() {
   out_sphere = sphere;
-  out_color = color.rgb;
+  out_color = particle_color(sphere, extra);
   vec3 to_centre = sphere.xyz - view.eye.xyz;
   float d = length(to_centre);
   float r = sphere.w;
-  if (!(r > 0.0) || d <= 1.001 * r) {
+  // A particle that is not finite is not drawn (the staged path leaves it out).
+  bool finite = !any(isnan(sphere)) && !any(isinf(sphere));
+  if (!finite || !(r > 0.0) || d <= 1.001 * r) {
     // Not drawn: every vertex at the same point outside the view, a triangle of no area.
     quad_point = sphere.xyz;
     gl_Position = vec4(2.0, 2.0, 0.5, 1.0);

@@ -166,13 +166,14 @@ Gpu::Gpu(const std::vector<const char*>& extensions) : messages_(std::make_uniqu
   }
 }
 
-void Gpu::open(VkSurfaceKHR surface) {
+void Gpu::open(VkSurfaceKHR surface, int wanted) {
   std::uint32_t count = 0;
   vkEnumeratePhysicalDevices(instance, &count, nullptr);
   std::vector<VkPhysicalDevice> handles(count);
   vkEnumeratePhysicalDevices(instance, &count, handles.data());
   int best_rank = 1000;
-  for (VkPhysicalDevice h : handles) {
+  for (std::uint32_t d = 0; d < count; ++d) {
+    const VkPhysicalDevice h = handles[d];
     VkPhysicalDeviceProperties props{};
     vkGetPhysicalDeviceProperties(h, &props);
     if (props.apiVersion < VK_API_VERSION_1_2) continue;
@@ -180,6 +181,8 @@ void Gpu::open(VkSurfaceKHR surface) {
     vkGetPhysicalDeviceQueueFamilyProperties(h, &families, nullptr);
     std::vector<VkQueueFamilyProperties> fam(families);
     vkGetPhysicalDeviceQueueFamilyProperties(h, &families, fam.data());
+    // A graphics family that presents; one that computes too ranks first.
+    int chosen = -1;
     for (std::uint32_t f = 0; f < families; ++f) {
       if ((fam[f].queueFlags & VK_QUEUE_GRAPHICS_BIT) == 0) continue;
       if (surface != VK_NULL_HANDLE) {
@@ -187,14 +190,19 @@ void Gpu::open(VkSurfaceKHR surface) {
         vkGetPhysicalDeviceSurfaceSupportKHR(h, f, surface, &present);
         if (present != VK_TRUE) continue;
       }
-      const int rank = type_rank(props.deviceType);
-      if (rank < best_rank) {
-        best_rank = rank;
-        physical = h;
-        family = f;
-        name = props.deviceName;
-      }
-      break;
+      const bool computes = (fam[f].queueFlags & VK_QUEUE_COMPUTE_BIT) != 0;
+      if (chosen < 0 || computes) chosen = static_cast<int>(f);
+      if (computes) break;
+    }
+    if (chosen < 0) continue;
+    const int rank = static_cast<int>(d) == wanted ? -1 : type_rank(props.deviceType);
+    if (rank < best_rank) {
+      best_rank = rank;
+      physical = h;
+      family = static_cast<std::uint32_t>(chosen);
+      family_computes = (fam[family].queueFlags & VK_QUEUE_COMPUTE_BIT) != 0;
+      index = static_cast<int>(d);
+      name = props.deviceName;
     }
   }
   if (physical == VK_NULL_HANDLE) {
@@ -210,6 +218,17 @@ void Gpu::open(VkSurfaceKHR surface) {
   q.pQueuePriorities = &priority;
   std::vector<const char*> exts;
   if (surface != VK_NULL_HANDLE) exts.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+  // For motes' device on this one (handles()): how much memory is left, where the driver says.
+  std::uint32_t ext_count = 0;
+  vkEnumerateDeviceExtensionProperties(physical, nullptr, &ext_count, nullptr);
+  std::vector<VkExtensionProperties> available(ext_count);
+  vkEnumerateDeviceExtensionProperties(physical, nullptr, &ext_count, available.data());
+  for (const VkExtensionProperties& e : available) {
+    if (std::strcmp(e.extensionName, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME) == 0) {
+      memory_budget = true;
+      exts.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+    }
+  }
   VkDeviceCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
   info.queueCreateInfoCount = 1;
@@ -227,6 +246,24 @@ void Gpu::open(VkSurfaceKHR surface) {
   VkFenceCreateInfo fence_info{};
   fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
   check(vk.vkCreateFence(device, &fence_info, nullptr, &fence), "vkCreateFence");
+}
+
+motes::VulkanHandles Gpu::handles() const {
+  motes::VulkanHandles h;
+  h.instance = instance;
+  h.physical_device = physical;
+  h.device = device;
+  h.queue_family = family;
+  h.queue_index = 0;
+  h.memory_budget = memory_budget;
+  return h;
+}
+
+Result<std::unique_ptr<Device>> open_compute_device(const Gpu& gpu) {
+  if (!gpu.family_computes) {
+    return Status::error(fmt::format("the drawing queue of {} cannot compute", gpu.name));
+  }
+  return open_vulkan_device(gpu.handles());
 }
 
 void Gpu::check_messages() const {
@@ -310,6 +347,43 @@ HostBuffer::HostBuffer(const Gpu& g, VkDeviceSize bytes, VkBufferUsageFlags usag
 HostBuffer::~HostBuffer() {
   if (memory != VK_NULL_HANDLE) gpu.vk.vkFreeMemory(gpu.device, memory, nullptr);
   if (buffer != VK_NULL_HANDLE) gpu.vk.vkDestroyBuffer(gpu.device, buffer, nullptr);
+}
+
+DeviceBuffer::DeviceBuffer(const Gpu& g, const void* data, VkDeviceSize size,
+                           VkBufferUsageFlags usage)
+    : gpu(g) {
+  VkBufferCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+  info.size = size;
+  info.usage = usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  check(gpu.vk.vkCreateBuffer(gpu.device, &info, nullptr, &buffer), "vkCreateBuffer");
+  VkMemoryRequirements req{};
+  gpu.vk.vkGetBufferMemoryRequirements(gpu.device, buffer, &req);
+  VkMemoryAllocateInfo alloc{};
+  alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  alloc.allocationSize = req.size;
+  alloc.memoryTypeIndex = gpu.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  check(gpu.vk.vkAllocateMemory(gpu.device, &alloc, nullptr, &memory), "vkAllocateMemory");
+  check(gpu.vk.vkBindBufferMemory(gpu.device, buffer, memory, 0), "vkBindBufferMemory");
+  const HostBuffer staging(gpu, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  std::memcpy(staging.mapped, data, size);
+  VkCommandBuffer cmd = gpu.begin_commands();
+  const VkBufferCopy region{0, 0, size};
+  gpu.vk.vkCmdCopyBuffer(cmd, staging.buffer, buffer, 1, &region);
+  VkMemoryBarrier to_vertices{};
+  to_vertices.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  to_vertices.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  to_vertices.dstAccessMask = VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT;
+  gpu.vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                              VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, 0, 1, &to_vertices, 0, nullptr, 0,
+                              nullptr);
+  gpu.submit_and_wait(cmd);
+}
+
+DeviceBuffer::~DeviceBuffer() {
+  if (buffer != VK_NULL_HANDLE) gpu.vk.vkDestroyBuffer(gpu.device, buffer, nullptr);
+  if (memory != VK_NULL_HANDLE) gpu.vk.vkFreeMemory(gpu.device, memory, nullptr);
 }
 
 DeviceImage::DeviceImage(const Gpu& g, VkFormat format, VkExtent2D extent, VkImageUsageFlags usage,

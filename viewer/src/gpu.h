@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "motes/vulkan_interop.h"
+
 namespace motes::viewer {
 
 /// "VK_ERROR_DEVICE_LOST" and friends.
@@ -30,8 +32,13 @@ class Gpu {
   Gpu& operator=(const Gpu&) = delete;
 
   /// Picks a device with a graphics queue (that presents to `surface`, unless it is null):
-  /// discrete, integrated, virtual, then CPU; makes the device, queue and command pool.
-  void open(VkSurfaceKHR surface);
+  /// physical device `wanted` (in the loader's order) when it has one, else discrete,
+  /// integrated, virtual, then CPU; a family that also computes when there is one (so that
+  /// motes can run on the same queue); makes the device, queue and command pool.
+  void open(VkSurfaceKHR surface, int wanted = -1);
+
+  /// The instance, device and queue for motes::open_vulkan_device (motes/vulkan_interop.h).
+  [[nodiscard]] motes::VulkanHandles handles() const;
 
   /// Throws when the validation layer said anything since the last call (every message text).
   void check_messages() const;
@@ -48,6 +55,9 @@ class Gpu {
   VkDevice device = VK_NULL_HANDLE;
   VkQueue queue = VK_NULL_HANDLE;
   std::uint32_t family = 0;
+  bool family_computes = false;  ///< the queue's family has compute too
+  int index = -1;                ///< the physical device's place in the loader's order
+  bool memory_budget = false;    ///< VK_EXT_memory_budget is enabled (for motes' device)
   VkCommandPool pool = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
   VolkDeviceTable vk{};
@@ -57,6 +67,9 @@ class Gpu {
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
   std::unique_ptr<Messages> messages_;
 };
+
+/// motes' compute device on `gpu`'s device and queue (motes::open_vulkan_device), or why not.
+Result<std::unique_ptr<Device>> open_compute_device(const Gpu& gpu);
 
 /// A buffer in host-visible, coherent memory, mapped for its lifetime.
 struct HostBuffer {
@@ -70,6 +83,19 @@ struct HostBuffer {
   VkBuffer buffer = VK_NULL_HANDLE;
   VkDeviceMemory memory = VK_NULL_HANDLE;
   void* mapped = nullptr;
+};
+
+/// A buffer in device-local memory, filled once from the host through a staging copy that is
+/// made visible to vertex input.
+struct DeviceBuffer {
+  DeviceBuffer(const Gpu& gpu, const void* data, VkDeviceSize size, VkBufferUsageFlags usage);
+  ~DeviceBuffer();
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+
+  const Gpu& gpu;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
 };
 
 /// A 2D image in device memory with its view (a colour or depth attachment).

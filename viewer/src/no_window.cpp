@@ -5,20 +5,25 @@ namespace motes::viewer {
 
 struct Window::Impl {};
 
-Window::Window(render::Size /*size*/, const std::string& /*title*/, const Style& /*style*/,
-               const Snapshot& /*first_frame*/) {
+Window::Window(render::Size /*size*/, const std::string& /*title*/, int /*wanted_device*/) {
   throw NoDisplay("built without GLFW (Debian: libglfw3-dev)");
 }
 Window::~Window() = default;
 Input Window::poll() { return {}; }
 void Window::set_title(const std::string& /*title*/) {}
 render::Size Window::size() const { return {}; }
-void Window::draw(const render::Camera& /*camera*/, const Snapshot& /*frame*/,
+void Window::draw(const render::Camera& /*camera*/, const Snapshot* /*frame*/,
                   render::Image* /*screenshot*/) {}
 void Window::restyle(const Style& /*style*/, const Snapshot& /*first_frame*/) {}
+Result<std::unique_ptr<Device>> Window::open_compute_device() const {
+  return Status::error("built without GLFW");
+}
+void Window::attach(Simulation& /*sim*/, const Snapshot& /*first_frame*/) {}
+bool Window::attached() const { return false; }
 const std::string& Window::device_name() const {
   static const std::string none;
   return none;
 }
+int Window::device_index() const { return -1; }
 
 }  // namespace motes::viewer

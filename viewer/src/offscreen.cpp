@@ -1,5 +1,6 @@
 // Drawing without a window: a colour and a depth image, and the picture copied to the host.
 #include <optional>
+#include <stdexcept>
 
 #include "motes/viewer.h"
 #include "painter.h"
@@ -9,13 +10,13 @@ namespace motes::viewer {
 struct Offscreen::Impl {
   static constexpr VkFormat kFormat = VK_FORMAT_R8G8B8A8_UNORM;
 
-  Impl(render::Size s, const Style& style, const Snapshot& first)
+  Impl(render::Size s, int wanted)
       : size(s),
         extent{static_cast<std::uint32_t>(s.width), static_cast<std::uint32_t>(s.height)},
-        gpu({}),
-        styler(style, first) {
-    gpu.open(VK_NULL_HANDLE);
-    painter.emplace(gpu, kFormat, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+        gpu({}) {
+    gpu.open(VK_NULL_HANDLE, wanted);
+    particles.emplace(gpu);
+    painter.emplace(gpu, *particles, kFormat, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
     color.emplace(gpu, kFormat, extent,
                   VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
                   VK_IMAGE_ASPECT_COLOR_BIT);
@@ -34,6 +35,7 @@ struct Offscreen::Impl {
     depth.reset();
     color.reset();
     painter.reset();
+    particles.reset();
   }
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
@@ -41,27 +43,47 @@ struct Offscreen::Impl {
   render::Size size;
   VkExtent2D extent;
   Gpu gpu;
-  Styler styler;
+  std::optional<Styler> styler;
+  std::optional<Particles> particles;
   std::optional<Painter> painter;
   std::optional<DeviceImage> color;
   std::optional<DeviceImage> depth;
   std::optional<HostBuffer> readback;
   VkFramebuffer framebuffer = VK_NULL_HANDLE;
-  std::vector<Instance> instances;
   render::Image image;
 };
 
-Offscreen::Offscreen(render::Size size, const Style& style, const Snapshot& first_frame)
-    : impl_(std::make_unique<Impl>(size, style, first_frame)) {}
+Offscreen::Offscreen(render::Size size, int wanted_device)
+    : impl_(std::make_unique<Impl>(size, wanted_device)) {}
 
 Offscreen::~Offscreen() = default;
 
-const render::Image& Offscreen::draw(const render::Camera& camera, const Snapshot& frame) {
+void Offscreen::restyle(const Style& style, const Snapshot& first_frame) {
+  impl_->styler.emplace(style, first_frame);
+  impl_->particles->detach();
+}
+
+Result<std::unique_ptr<Device>> Offscreen::open_compute_device() const {
+  return viewer::open_compute_device(impl_->gpu);
+}
+
+void Offscreen::attach(Simulation& sim, const Snapshot& first_frame) {
+  if (!impl_->styler) throw std::logic_error("viewer: attach before restyle");
+  impl_->particles->attach(*impl_->styler, sim, first_frame);
+  impl_->gpu.check_messages();
+}
+
+bool Offscreen::attached() const { return impl_->particles->attached(); }
+
+const render::Image& Offscreen::draw(const render::Camera& camera, const Snapshot* frame) {
   Impl& m = *impl_;
-  m.styler.instances(frame, m.instances);
-  m.painter->upload(m.instances);
+  if (!m.styler) throw std::logic_error("viewer: draw before restyle");
+  if (!m.particles->attached()) {
+    if (frame == nullptr) throw std::logic_error("viewer: a staged draw needs a frame");
+    m.particles->stage(*m.styler, *frame);
+  }
   VkCommandBuffer cmd = m.gpu.begin_commands();
-  m.painter->record(cmd, m.framebuffer, m.extent, m.styler.constants(camera, m.size));
+  m.painter->record(cmd, m.framebuffer, m.extent, m.styler->constants(camera, m.size));
   record_readback(m.gpu, cmd, m.color->image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, m.extent,
                   m.readback->buffer);
   m.gpu.submit_and_wait(cmd);
@@ -70,5 +92,7 @@ const render::Image& Offscreen::draw(const render::Camera& camera, const Snapsho
 }
 
 const std::string& Offscreen::device_name() const { return impl_->gpu.name; }
+
+int Offscreen::device_index() const { return impl_->gpu.index; }
 
 }  // namespace motes::viewer

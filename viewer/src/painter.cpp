@@ -11,8 +11,6 @@
 
 namespace motes::viewer {
 
-namespace {
-
 VkShaderModule make_module(const Gpu& gpu, std::string_view name) {
   for (const Shader& s : shader_table()) {
     if (name != s.name) continue;
@@ -27,6 +25,8 @@ VkShaderModule make_module(const Gpu& gpu, std::string_view name) {
   throw std::runtime_error(fmt::format("viewer: shader {} is not embedded", name));
 }
 
+namespace {
+
 VkFormat pick_depth_format(const Gpu& gpu) {
   for (VkFormat f : {VK_FORMAT_D32_SFLOAT, VK_FORMAT_X8_D24_UNORM_PACK32, VK_FORMAT_D16_UNORM}) {
     VkFormatProperties props{};
@@ -40,8 +40,9 @@ VkFormat pick_depth_format(const Gpu& gpu) {
 
 }  // namespace
 
-Painter::Painter(const Gpu& gpu, VkFormat color_format, VkImageLayout final_layout)
-    : gpu_(gpu), depth_format_(pick_depth_format(gpu)) {
+Painter::Painter(const Gpu& gpu, const Particles& particles, VkFormat color_format,
+                 VkImageLayout final_layout)
+    : gpu_(gpu), particles_(particles), depth_format_(pick_depth_format(gpu)) {
   VkAttachmentDescription attachments[2]{};
   attachments[0].format = color_format;
   attachments[0].samples = VK_SAMPLE_COUNT_1_BIT;
@@ -96,8 +97,11 @@ Painter::Painter(const Gpu& gpu, VkFormat color_format, VkImageLayout final_layo
   VkPushConstantRange range{};
   range.stageFlags = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
   range.size = sizeof(ViewConstants);
+  const VkDescriptorSetLayout colors = particles.set_layout();
   VkPipelineLayoutCreateInfo layout{};
   layout.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  layout.setLayoutCount = 1;
+  layout.pSetLayouts = &colors;
   layout.pushConstantRangeCount = 1;
   layout.pPushConstantRanges = &range;
   check(gpu.vk.vkCreatePipelineLayout(gpu.device, &layout, nullptr, &layout_),
@@ -118,14 +122,19 @@ VkPipeline Painter::make_pipeline(const char* vert, const char* frag, bool spher
   stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
   stages[1].module = fs;
 
-  const VkVertexInputBindingDescription binding{0, sizeof(Instance), VK_VERTEX_INPUT_RATE_INSTANCE};
+  // Two per-instance arrays of vec4 (particles.h): the spheres, and their colours or velocities;
+  // motes' ParticlePos and ParticleVel have this layout, so the zero-copy path binds them as
+  // they are.
+  const VkVertexInputBindingDescription bindings[2] = {
+      {0, sizeof(Vec4), VK_VERTEX_INPUT_RATE_INSTANCE},
+      {1, sizeof(Vec4), VK_VERTEX_INPUT_RATE_INSTANCE}};
   const VkVertexInputAttributeDescription attributes[2] = {
-      {0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0}, {1, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 16}};
+      {0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0}, {1, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0}};
   VkPipelineVertexInputStateCreateInfo input{};
   input.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO;
   if (spheres) {
-    input.vertexBindingDescriptionCount = 1;
-    input.pVertexBindingDescriptions = &binding;
+    input.vertexBindingDescriptionCount = 2;
+    input.pVertexBindingDescriptions = bindings;
     input.vertexAttributeDescriptionCount = 2;
     input.pVertexAttributeDescriptions = attributes;
   }
@@ -188,24 +197,12 @@ VkPipeline Painter::make_pipeline(const char* vert, const char* frag, bool spher
   return pipeline;
 }
 
-void Painter::upload(const std::vector<Instance>& instances) {
-  const VkDeviceSize bytes = std::max<VkDeviceSize>(sizeof(Instance) * instances.size(), 64);
-  if (!instances_ || instances_->size < bytes) {
-    instances_.reset();
-    instances_ =
-        std::make_unique<HostBuffer>(gpu_, bytes + bytes / 4, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-  }
-  if (!instances.empty()) {
-    std::memcpy(instances_->mapped, instances.data(), sizeof(Instance) * instances.size());
-  }
-  instance_count_ = static_cast<std::uint32_t>(instances.size());
-}
-
 void Painter::record(VkCommandBuffer cmd, VkFramebuffer framebuffer, VkExtent2D extent,
                      const ViewConstants& constants) const {
   VkClearValue clears[2]{};
   clears[0].color = {{0.0f, 0.0f, 0.0f, 1.0f}};
   clears[1].depthStencil = {0.0f, 0};
+  particles_.record_before(cmd);
   VkRenderPassBeginInfo begin{};
   begin.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
   begin.renderPass = render_pass_;
@@ -224,18 +221,13 @@ void Painter::record(VkCommandBuffer cmd, VkFramebuffer framebuffer, VkExtent2D 
                              sizeof(ViewConstants), constants.v.data());
   gpu_.vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, backdrop_);
   gpu_.vk.vkCmdDraw(cmd, 3, 1, 0, 0);
-  if (instance_count_ > 0) {
-    gpu_.vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, spheres_);
-    const VkDeviceSize offset = 0;
-    gpu_.vk.vkCmdBindVertexBuffers(cmd, 0, 1, &instances_->buffer, &offset);
-    gpu_.vk.vkCmdDraw(cmd, 4, instance_count_, 0, 0);
-  }
+  gpu_.vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, spheres_);
+  particles_.record_draw(cmd, layout_);
   gpu_.vk.vkCmdEndRenderPass(cmd);
 }
 
 Painter::~Painter() {
   gpu_.vk.vkDeviceWaitIdle(gpu_.device);
-  instances_.reset();
   if (spheres_ != VK_NULL_HANDLE) gpu_.vk.vkDestroyPipeline(gpu_.device, spheres_, nullptr);
   if (backdrop_ != VK_NULL_HANDLE) gpu_.vk.vkDestroyPipeline(gpu_.device, backdrop_, nullptr);
   if (layout_ != VK_NULL_HANDLE) gpu_.vk.vkDestroyPipelineLayout(gpu_.device, layout_, nullptr);

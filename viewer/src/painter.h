@@ -2,27 +2,30 @@
 // particle), the particles' instance buffer, and the copy of a drawn picture to the host.
 #pragma once
 
-#include <memory>
+#include <string_view>
 #include <vector>
 
 #include "gpu.h"
 #include "motes/render.h"
+#include "particles.h"
 #include "style.h"
 
 namespace motes::viewer {
 
+/// A shader module of the embedded shader `name` (e.g. "sphere.vert").
+VkShaderModule make_module(const Gpu& gpu, std::string_view name);
+
 class Painter {
  public:
-  /// For colour attachments of `color_format`, left in `final_layout` after the pass.
-  Painter(const Gpu& gpu, VkFormat color_format, VkImageLayout final_layout);
+  /// For colour attachments of `color_format`, left in `final_layout` after the pass; the
+  /// spheres from `particles` (whose colour set the sphere pipeline reads).
+  Painter(const Gpu& gpu, const Particles& particles, VkFormat color_format,
+          VkImageLayout final_layout);
   ~Painter();
   Painter(const Painter&) = delete;
   Painter& operator=(const Painter&) = delete;
 
-  /// Copies the particles into the instance buffer (grown as needed). The previous draw must be
-  /// done.
-  void upload(const std::vector<Instance>& instances);
-  /// Records the pass: clear, backdrop, spheres.
+  /// Records what the particles need before the pass, then the pass: clear, backdrop, spheres.
   void record(VkCommandBuffer cmd, VkFramebuffer framebuffer, VkExtent2D extent,
               const ViewConstants& constants) const;
 
@@ -33,13 +36,12 @@ class Painter {
   VkPipeline make_pipeline(const char* vert, const char* frag, bool spheres) const;
 
   const Gpu& gpu_;
+  const Particles& particles_;
   VkFormat depth_format_ = VK_FORMAT_UNDEFINED;
   VkRenderPass render_pass_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline backdrop_ = VK_NULL_HANDLE;
   VkPipeline spheres_ = VK_NULL_HANDLE;
-  std::unique_ptr<HostBuffer> instances_;
-  std::uint32_t instance_count_ = 0;
 };
 
 /// A framebuffer of a colour view and a depth view.

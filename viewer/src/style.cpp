@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 
@@ -29,6 +30,11 @@ void put(ViewConstants& c, int slot, const Eigen::Vector3f& v, float w) {
   c.v[i + 1] = v.y();
   c.v[i + 2] = v.z();
   c.v[i + 3] = w;
+}
+
+Vec4 linear_color(const Eigen::Vector3f& srgb) {
+  const Eigen::Vector3f linear = srgb.cwiseProduct(srgb);  // gamma 2, as the headless renderer
+  return {linear.x(), linear.y(), linear.z(), 1.0f};
 }
 
 }  // namespace
@@ -60,17 +66,44 @@ Styler::Styler(const Style& style, const Snapshot& first_frame)
   grid_ = nice_spacing(radius_ / 5.0f);
 }
 
-void Styler::instances(const Snapshot& frame, std::vector<Instance>& out) {
+void Styler::instances(const Snapshot& frame, Instances& out) {
   colors_.observe(frame);
-  out.clear();
-  out.reserve(frame.particle_pos.size());
+  out.spheres.clear();
+  out.colors.clear();
+  out.spheres.reserve(frame.particle_pos.size());
+  out.colors.reserve(frame.particle_pos.size());
   for (std::size_t i = 0; i < frame.particle_pos.size(); ++i) {
     const shared::vec4& p = frame.particle_pos[i];
     if (!finite(p)) continue;
-    const Eigen::Vector3f c = colors_(frame, i);
-    const Eigen::Vector3f linear = c.cwiseProduct(c);  // gamma 2, as the headless renderer
-    out.push_back({{p.x, p.y, p.z, p.w}, {linear.x(), linear.y(), linear.z(), 1.0f}});
+    out.spheres.push_back({p.x, p.y, p.z, p.w});
+    out.colors.push_back(linear_color(colors_(frame, i)));
   }
+}
+
+ColorState Styler::color_state() const {
+  ColorState c;
+  const auto& stops = render::ParticleColors::map_stops();
+  for (std::size_t k = 0; k < stops.size(); ++k) {
+    c.stops[k] = {stops[k].x(), stops[k].y(), stops[k].z(), 1.0f};
+  }
+  c.up = {colors_.up().x(), colors_.up().y(), colors_.up().z(), 0.0f};
+  if (colors_.height_range()) {
+    c.range = {(*colors_.height_range())[0], (*colors_.height_range())[1], 0.0f, 0.0f};
+  }
+  if (style_.color_by == render::ColorBy::Speed) c.mode = ColorState::kSpeed;
+  if (style_.color_by == render::ColorBy::Height) c.mode = ColorState::kHeight;
+  const float speed2 = colors_.speed_max() * colors_.speed_max();
+  std::memcpy(&c.speed2, &speed2, sizeof(speed2));
+  return c;
+}
+
+std::vector<Vec4> Styler::device_colors(const Snapshot& first_frame,
+                                        const std::vector<std::uint32_t>& order) const {
+  std::vector<Vec4> out(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    out[i] = linear_color(colors_(first_frame, order[i]));
+  }
+  return out;
 }
 
 ViewConstants Styler::constants(const render::Camera& camera, render::Size size) const {

@@ -32,11 +32,11 @@ std::vector<const char*> window_extensions() {
 }  // namespace
 
 struct Window::Impl {
-  Impl(render::Size s, const std::string& title, const Style& style, const Snapshot& first)
-      : gpu(start(s, title)), styler(style, first) {
+  Impl(render::Size s, const std::string& title, int wanted) : gpu(start(s, title)) {
     check(glfwCreateWindowSurface(gpu.instance, window, nullptr, &surface),
           "cannot make a Vulkan surface of the window");
-    gpu.open(surface);
+    gpu.open(surface, wanted);
+    particles.emplace(gpu);
     glfwSetWindowUserPointer(window, this);
     glfwSetScrollCallback(window, [](GLFWwindow* w, double /*x*/, double y) {
       static_cast<Impl*>(glfwGetWindowUserPointer(w))->input.zoom += static_cast<float>(y);
@@ -124,7 +124,7 @@ struct Window::Impl {
     }
     if (!painter || chosen.format != format) {
       painter.reset();
-      painter.emplace(gpu, chosen.format, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR);
+      painter.emplace(gpu, *particles, chosen.format, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR);
       format = chosen.format;
     }
     can_copy = (caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_SRC_BIT) != 0;
@@ -201,6 +201,7 @@ struct Window::Impl {
       drop_swapchain();
       readback.reset();
       painter.reset();
+      particles.reset();
       if (acquired != VK_NULL_HANDLE) gpu.vk.vkDestroySemaphore(gpu.device, acquired, nullptr);
       if (command != VK_NULL_HANDLE) gpu.vk.vkFreeCommandBuffers(gpu.device, gpu.pool, 1, &command);
     }
@@ -211,7 +212,11 @@ struct Window::Impl {
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
 
-  void draw(const render::Camera& camera, const Snapshot& frame, render::Image* screenshot) {
+  void draw(const render::Camera& camera, const Snapshot* frame, render::Image* screenshot) {
+    if (!styler) throw std::logic_error("viewer: draw before restyle");
+    if (!particles->attached() && frame == nullptr) {
+      throw std::logic_error("viewer: a staged draw needs a frame");
+    }
     if (resized) {
       resized = false;
       build_swapchain();
@@ -228,8 +233,7 @@ struct Window::Impl {
       return;
     }
     if (r != VK_SUBOPTIMAL_KHR) check(r, "vkAcquireNextImageKHR");
-    styler.instances(frame, instances);
-    painter->upload(instances);
+    if (!particles->attached()) particles->stage(*styler, *frame);
     if (command == VK_NULL_HANDLE) {
       VkCommandBufferAllocateInfo alloc{};
       alloc.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
@@ -245,7 +249,7 @@ struct Window::Impl {
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     check(gpu.vk.vkBeginCommandBuffer(command, &begin), "vkBeginCommandBuffer");
     const render::Size size{static_cast<int>(extent.width), static_cast<int>(extent.height)};
-    painter->record(command, framebuffers[index], extent, styler.constants(camera, size));
+    painter->record(command, framebuffers[index], extent, styler->constants(camera, size));
     const bool copy = screenshot != nullptr && readback.has_value();
     if (copy) {
       record_readback(gpu, command, images[index], VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, extent,
@@ -290,13 +294,14 @@ struct Window::Impl {
   GLFWwindow* window = nullptr;
   bool glfw_started = false;
   Gpu gpu;
-  Styler styler;
+  std::optional<Styler> styler;
   VkSurfaceKHR surface = VK_NULL_HANDLE;
   VkSwapchainKHR swapchain = VK_NULL_HANDLE;
   VkFormat format = VK_FORMAT_UNDEFINED;
   VkExtent2D extent{0, 0};
   bool can_copy = false;
   bool resized = false;
+  std::optional<Particles> particles;  // before the painter, which draws them
   std::optional<Painter> painter;
   std::optional<DeviceImage> depth;
   std::optional<HostBuffer> readback;
@@ -306,7 +311,6 @@ struct Window::Impl {
   std::vector<VkSemaphore> drawn;
   VkSemaphore acquired = VK_NULL_HANDLE;
   VkCommandBuffer command = VK_NULL_HANDLE;
-  std::vector<Instance> instances;
   Input input;
   double last_x = 0.0, last_y = 0.0;
   bool have_cursor = false;
@@ -314,9 +318,8 @@ struct Window::Impl {
   bool grabbing = false;
 };
 
-Window::Window(render::Size size, const std::string& title, const Style& style,
-               const Snapshot& first_frame)
-    : impl_(std::make_unique<Impl>(size, title, style, first_frame)) {}
+Window::Window(render::Size size, const std::string& title, int wanted_device)
+    : impl_(std::make_unique<Impl>(size, title, wanted_device)) {}
 
 Window::~Window() = default;
 
@@ -378,14 +381,29 @@ render::Size Window::size() const {
   return {static_cast<int>(impl_->extent.width), static_cast<int>(impl_->extent.height)};
 }
 
-void Window::draw(const render::Camera& camera, const Snapshot& frame, render::Image* screenshot) {
+void Window::draw(const render::Camera& camera, const Snapshot* frame, render::Image* screenshot) {
   impl_->draw(camera, frame, screenshot);
 }
 
 void Window::restyle(const Style& style, const Snapshot& first_frame) {
-  impl_->styler = Styler(style, first_frame);
+  impl_->styler.emplace(style, first_frame);
+  impl_->particles->detach();
 }
 
+Result<std::unique_ptr<Device>> Window::open_compute_device() const {
+  return viewer::open_compute_device(impl_->gpu);
+}
+
+void Window::attach(Simulation& sim, const Snapshot& first_frame) {
+  if (!impl_->styler) throw std::logic_error("viewer: attach before restyle");
+  impl_->particles->attach(*impl_->styler, sim, first_frame);
+  impl_->gpu.check_messages();
+}
+
+bool Window::attached() const { return impl_->particles->attached(); }
+
 const std::string& Window::device_name() const { return impl_->gpu.name; }
+
+int Window::device_index() const { return impl_->gpu.index; }
 
 }  // namespace motes::viewer

@@ -295,6 +295,11 @@ class Simulation {
     return static_cast<std::uint32_t>(bodies_.size());
   }
   [[nodiscard]] const std::vector<BodyInfo>& bodies() const { return bodies_; }
+  /// For each particle on the device (the order of its buffers: rigid bodies' particles first,
+  /// then free spheres, soft bodies, cloth and ropes), its index in the scene's particle order
+  /// (Snapshot, BodyInfo::first_particle): how a program that reads the device's buffers itself
+  /// (motes/vulkan_interop.h) finds a particle's body. A permutation of [0, particle_count()).
+  [[nodiscard]] std::vector<std::uint32_t> scene_particle_order() const;
   /// The device's sizes: rigid bodies first (sizes().bodies of them), then the free spheres, then
   /// the cloth and rope particles.
   [[nodiscard]] const Sizes& sizes() const { return sizes_; }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -116,6 +117,16 @@ class ParticleColors {
   /// The colour of particle `index` of `frame`.
   [[nodiscard]] Eigen::Vector3f operator()(const Snapshot& frame, std::size_t index) const;
   [[nodiscard]] ColorBy color_by() const { return color_by_; }
+
+  // The rule's data, for a GPU that applies it itself (motes view's zero-copy path): the colour
+  // map's stops (sRGB; colours by speed and height interpolate them linearly over [0, 1] in equal
+  // steps, clamped), the fastest speed observed so far, the height range (none before a frame
+  // with particles) and the unit up it is measured along.
+  static constexpr std::size_t kMapStops = 5;
+  [[nodiscard]] static const std::array<Eigen::Vector3f, kMapStops>& map_stops();
+  [[nodiscard]] float speed_max() const { return speed_max_; }
+  [[nodiscard]] const std::optional<Eigen::Vector2f>& height_range() const { return height_range_; }
+  [[nodiscard]] const Eigen::Vector3f& up() const { return look_.up; }
 
  private:
   ColorBy color_by_;

@@ -23,20 +23,37 @@ struct Style {
   render::ColorBy color_by = render::ColorBy::Body;
 };
 
+// Offscreen and Window draw the particles by one of two paths (docs/viewer.md): staged, from a
+// Snapshot each frame (any backend), or zero copy, from the buffers of a simulation that runs on
+// the viewer's own Vulkan device (open_compute_device, then attach). Before the first draw, and
+// after each new scene, restyle() gives the colours and the ground; it returns to the staged
+// path until attach() is called again.
+
 /// Draws into an offscreen colour and depth image and reads the picture back.
 class Offscreen {
  public:
-  /// The ground's extent and grid, and the height colours, come from `first_frame` (as the
-  /// headless renderer takes them from the first frame it draws).
-  Offscreen(render::Size size, const Style& style, const Snapshot& first_frame);
+  /// On Vulkan physical device `wanted_device` (the loader's order) when it can draw, else on the
+  /// best one that can.
+  explicit Offscreen(render::Size size, int wanted_device = -1);
   ~Offscreen();
   Offscreen(const Offscreen&) = delete;
   Offscreen& operator=(const Offscreen&) = delete;
 
-  /// Draws `frame` seen by `camera`; the reference stays valid until the next call.
-  const render::Image& draw(const render::Camera& camera, const Snapshot& frame);
-  /// The Vulkan device that draws.
+  /// The ground's extent and grid, and the height colours, come from `first_frame` (as the
+  /// headless renderer takes them from the first frame it draws).
+  void restyle(const Style& style, const Snapshot& first_frame);
+  /// A motes device on the viewer's Vulkan device (motes/vulkan_interop.h), or why not.
+  [[nodiscard]] Result<std::unique_ptr<Device>> open_compute_device() const;
+  /// Zero copy: draws `sim` (on a device from open_compute_device; `first_frame` its state now)
+  /// from its own buffers until the next restyle.
+  void attach(Simulation& sim, const Snapshot& first_frame);
+  [[nodiscard]] bool attached() const;
+  /// Draws `frame` (staged; ignored, and may be null, when attached) seen by `camera`; the
+  /// reference stays valid until the next call.
+  const render::Image& draw(const render::Camera& camera, const Snapshot* frame);
+  /// The Vulkan device that draws, and its place in the loader's order.
   [[nodiscard]] const std::string& device_name() const;
+  [[nodiscard]] int device_index() const;
 
  private:
   struct Impl;
@@ -103,9 +120,9 @@ class Script {
 /// A GLFW window with a Vulkan swapchain.
 class Window {
  public:
-  /// Opens a window of `size` pixels; throws NoDisplay when there is no display.
-  Window(render::Size size, const std::string& title, const Style& style,
-         const Snapshot& first_frame);
+  /// Opens a window of `size` pixels, drawn on Vulkan physical device `wanted_device` when it
+  /// can, else on the best one that can; throws NoDisplay when there is no display.
+  Window(render::Size size, const std::string& title, int wanted_device = -1);
   ~Window();
   Window(const Window&) = delete;
   Window& operator=(const Window&) = delete;
@@ -115,11 +132,17 @@ class Window {
   void set_title(const std::string& title);
   /// The drawable size in pixels (changes when the window is resized).
   [[nodiscard]] render::Size size() const;
-  /// Draws `frame` and shows it; with `screenshot`, also reads the shown picture back into it.
-  void draw(const render::Camera& camera, const Snapshot& frame, render::Image* screenshot);
-  /// New colours and extent after a reset (a reloaded scene).
+  /// Draws `frame` (staged; ignored, and may be null, when attached) and shows it; with
+  /// `screenshot`, also reads the shown picture back into it.
+  void draw(const render::Camera& camera, const Snapshot* frame, render::Image* screenshot);
+  /// Colours and extent of a scene (as Offscreen::restyle).
   void restyle(const Style& style, const Snapshot& first_frame);
+  /// As Offscreen's.
+  [[nodiscard]] Result<std::unique_ptr<Device>> open_compute_device() const;
+  void attach(Simulation& sim, const Snapshot& first_frame);
+  [[nodiscard]] bool attached() const;
   [[nodiscard]] const std::string& device_name() const;
+  [[nodiscard]] int device_index() const;
 
  private:
   struct Impl;
