@@ -50,6 +50,9 @@ struct ViewArgs {
 #ifdef MOTES_HAVE_VIEWER
 
 constexpr double kFrameRate = 60.0;
+/// The run's guards (Simulation::check_motion: tunnelling, a runaway) every this many frames
+/// stepped: half a second of real time, as `motes run` checks at its frames.
+constexpr std::uint64_t kGuardFrames = 30;
 volatile std::sig_atomic_t g_stop = 0;
 
 extern "C" void on_stop_signal(int /*signal*/) { g_stop = 1; }
@@ -356,6 +359,9 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
   viewer::Orbit orbit(camera);
   std::uint64_t steps = frame_steps(sim->settings().dt);
   bool paused = false, slow = false;
+  // The guards: the warnings seen (each printed once) and the first failure, which pauses the run.
+  std::uint64_t stepped_frames = 0, guard_warnings = 0;
+  std::string last_warning, guard_failure;
   double owed_steps = 0.0;
   std::uint64_t shown = 0;
   double total_step = 0.0, total_copy = 0.0, total_draw = 0.0;
@@ -393,6 +399,8 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
             Simulation::create(reloaded.value(), Simulation::take_device(std::move(sim)));
         if (!made) fail(made.message());
         sim = std::move(made.value());
+        guard_failure.clear();  // a new run: its guards start again
+        last_warning.clear();
         steps = frame_steps(sim->settings().dt);
         frame = must_snapshot(*sim);
         frame_current = true;
@@ -419,6 +427,7 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
       advance = static_cast<std::uint64_t>(owed_steps);
       owed_steps -= static_cast<double>(advance);
     }
+    const bool last = args.frames > 0 && shown + 1 >= args.frames;
     const auto t0 = Clock::now();
     if (advance > 0) {
       if (grab.active()) {
@@ -429,6 +438,20 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
       // Stepping alone (a backend may queue steps and return before they are done).
       if (Status s = sim->device().synchronize(); !s) fail(s.message());
       frame_current = false;
+      // Every kGuardFrames frames stepped, and at the last frame of a run with a frame limit.
+      if ((++stepped_frames % kGuardFrames == 0 || last) && guard_failure.empty()) {
+        Result<MotionReport> r = sim->check_motion();
+        if (!r) {  // unstable: the run stops here, paused, and says why
+          guard_failure = r.message();
+          paused = true;
+          fmt::print(stderr, "motes view: guard: {} (paused)\n", guard_failure);
+        } else if (!r.value().warning.empty() && r.value().warning != last_warning) {
+          last_warning = r.value().warning;
+          ++guard_warnings;
+          fmt::print(stderr, "motes view: guard warning: {}\n", last_warning);
+        }
+        std::fflush(stderr);
+      }
     }
     if (in.grab_end) {
       grab.stop(sim.get());
@@ -437,7 +460,6 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     const auto t1 = Clock::now();
     if (!zero_copy) current_frame();  // the staged path draws from the host's copy
     const auto t2 = Clock::now();
-    const bool last = args.frames > 0 && shown + 1 >= args.frames;
     const bool keep = in.screenshot || (last && !args.screenshot.empty()) || recorder.on();
     render::Image picture;
     surface.draw(orbit.camera(), zero_copy ? nullptr : &frame, keep ? &picture : nullptr);
@@ -467,10 +489,13 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
       const bool behind = !paused && window_step / window_frames > 1.0 / kFrameRate;
       surface.set_title(fmt::format(
           "motes view: {} | {:.0f} fps | step {:.1f} ms, draw {:.1f} ms ({}) | {:.2f}x real time{} "
-          "| {} particles | {}{}{}",
+          "| {} particles | {}{}{}{}",
           name, fps, 1e3 * window_step / window_frames, 1e3 * window_draw / window_frames, path,
           factor, behind ? " (slower than real time)" : "", sim->particle_count(), backend,
-          paused ? " | paused" : "", slow ? " | slow motion x0.25" : ""));
+          paused ? " | paused" : "", slow ? " | slow motion x0.25" : "",
+          !guard_failure.empty() ? " | guard: unstable, paused"
+          : guard_warnings > 0   ? fmt::format(" | guard warnings: {}", guard_warnings)
+                                 : std::string()));
       window_start = Clock::now();
       window_frames = 0;
       window_step = window_draw = window_simulated = 0.0;
@@ -497,9 +522,12 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
   const double n = static_cast<double>(std::max<std::uint64_t>(shown, 1));
   fmt::print(
       "motes view: {} frames shown, {} particles on {}, drawn {} {}on {}: {:.2f} ms step, {:.2f} "
-      "ms copy to the host and {:.2f} ms draw a frame{}{}\n",
+      "ms copy to the host and {:.2f} ms draw a frame; {}{}{}\n",
       shown, sim->particle_count(), backend, path, surface.real_time() ? "" : "offscreen ",
       surface.device_name(), 1e3 * total_step / n, 1e3 * total_copy / n, 1e3 * total_draw / n,
+      !guard_failure.empty() ? "guard: unstable (paused)"
+      : guard_warnings > 0   ? fmt::format("guard warnings: {}", guard_warnings)
+                             : std::string("no guard warning"),
       args.screenshot.empty() ? "" : fmt::format("; picture {}", args.screenshot),
       args.save_state.empty() ? "" : fmt::format("; state {}", args.save_state));
   std::fflush(stdout);

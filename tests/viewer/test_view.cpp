@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -294,6 +295,37 @@ TEST(ViewWindow, ClosedMidRunLeavesNoProcess) {
   ASSERT_TRUE(WIFEXITED(status)) << "motes view did not exit cleanly";
   EXPECT_EQ(WEXITSTATUS(status), 0);
   EXPECT_NE(kill(pid, 0), 0);  // gone, and reaped
+}
+
+// Every example scene in a window under Xvfb: two frames stepped on openmp (drawn staged), and
+// the position scenes also on vulkan (drawn zero copy), each ending with the run's guards, which
+// must find nothing (a guard warning fails the scene, as in the scene runs of CI).
+TEST(ViewWindow, EveryExampleSceneRunsUnderXvfb) {
+  Xvfb x;
+  if (!x.ready()) GTEST_SKIP() << "skipped: no Xvfb (Debian: xvfb)";
+  std::vector<fs::path> scenes;
+  for (const auto& e : fs::directory_iterator(fs::path(MOTES_SOURCE_DIR) / "examples/scenes")) {
+    if (e.path().extension() == ".json") scenes.push_back(e.path());
+  }
+  std::sort(scenes.begin(), scenes.end());
+  ASSERT_GE(scenes.size(), 20u);
+  const bool vulkan = static_cast<bool>(motes::open_device("vulkan"));
+  const fs::path out = scratch("every.txt"), err = scratch("every-err.txt");
+  for (const fs::path& scene : scenes) {
+    std::vector<std::string> backends = {"openmp"};
+    if (vulkan && scene.stem().string().rfind("position_", 0) == 0) backends.emplace_back("vulkan");
+    for (const std::string& backend : backends) {
+      SCOPED_TRACE(scene.filename().string() + " on " + backend);
+      const int rc = shell("DISPLAY=" + x.display() + " " + std::string(MOTES_CLI_PATH) + " view " +
+                           scene.string() + " --backend " + backend +
+                           " --size 160x120 --frames 2 > " + out.string() + " 2> " + err.string());
+      const std::string text = read_text(out);
+      EXPECT_EQ(rc, 0) << text << read_text(err);
+      EXPECT_NE(text.find("2 frames shown"), std::string::npos) << text;
+      EXPECT_NE(text.find("no guard warning"), std::string::npos) << text;
+      EXPECT_EQ(read_text(err), "");
+    }
+  }
 }
 
 // Scripted input (--input): the same Input as keys and mouse, offscreen too.
