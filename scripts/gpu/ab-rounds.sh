@@ -4,7 +4,7 @@
 # temperature with the others' (a bisect, or a before and after finer than ab-bench.sh's pairs).
 # Each run's `motes bench --json` (full-precision ms/step and per-kernel times) is kept.
 # Usage: scripts/gpu/ab-rounds.sh BACKEND WORKLOAD ROUNDS NAME=MOTES...
-#   WORKLOAD as scripts/gpu/ab-bench.sh (falling1m: W1 falling at 1 M alone)
+#   WORKLOAD as scripts/gpu/ab-bench.sh (falling1m, falling16m: W1 falling at 1 M or 16 M alone)
 # Output: ${OUT:-gpu-out}/ab-rounds.tar.gz holding BACKEND-WORKLOAD-NAME-ROUND.json, and a line
 # per run on stdout.
 set -uo pipefail
@@ -16,6 +16,7 @@ mkdir -p "$out" bench-cache
 case $workload in
   falling) args="--workload settle --phase falling --sizes 1048576,16777216" ;;
   falling1m) args="--workload settle --phase falling --sizes 1048576" ;;
+  falling16m) args="--workload settle --phase falling --sizes 16777216" ;;
   dominoes) args="--workload dominoes --dominoes 100000 --domino-rows 100" ;;
   cloth) args="--workload cloth --cloth-sides 256,1024" ;;
   soft) args="--workload soft --soft-counts 10000" ;;
