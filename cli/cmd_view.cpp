@@ -53,6 +53,9 @@ constexpr double kFrameRate = 60.0;
 /// The run's guards (Simulation::check_motion: tunnelling, a runaway) every this many frames
 /// stepped: half a second of real time, as `motes run` checks at its frames.
 constexpr std::uint64_t kGuardFrames = 30;
+/// The most grid cells, and the most contacts, a wireframe draws (W, C): made on the host each
+/// frame, they are a look at a small scene or part of one.
+constexpr std::size_t kWireframeLimit = 200000;
 volatile std::sig_atomic_t g_stop = 0;
 
 extern "C" void on_stop_signal(int /*signal*/) { g_stop = 1; }
@@ -288,6 +291,7 @@ class Surface {
   virtual void attach(Simulation& sim, const Snapshot& first) = 0;
   [[nodiscard]] virtual bool attached() const = 0;
   virtual void set_title(const std::string& title) = 0;
+  virtual void set_overlay(const viewer::Segments& segments) = 0;
   [[nodiscard]] virtual const std::string& device_name() const = 0;
   [[nodiscard]] virtual int device_index() const = 0;
   [[nodiscard]] virtual bool real_time() const = 0;
@@ -306,6 +310,7 @@ class TargetSurface : public Surface {
   }
   void attach(Simulation& sim, const Snapshot& first) override { target_->attach(sim, first); }
   [[nodiscard]] bool attached() const override { return target_->attached(); }
+  void set_overlay(const viewer::Segments& segments) override { target_->set_overlay(segments); }
   [[nodiscard]] const std::string& device_name() const override { return target_->device_name(); }
   [[nodiscard]] int device_index() const override { return target_->device_index(); }
   [[nodiscard]] bool real_time() const override { return kRealTime; }
@@ -359,6 +364,9 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
   viewer::Orbit orbit(camera);
   std::uint64_t steps = frame_steps(sim->settings().dt);
   bool paused = false, slow = false;
+  // The wireframes (W: grid cells, C: contacts), made from the host's copy of the state.
+  bool grid_wireframe = false, contact_wireframe = false;
+  bool overlay_shown = false, overlay_truncated_said = false;
   // The guards: the warnings seen (each printed once) and the first failure, which pauses the run.
   std::uint64_t stepped_frames = 0, guard_warnings = 0;
   std::string last_warning, guard_failure;
@@ -389,6 +397,8 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
       }
     }
     if (in.pause) paused = !paused;
+    if (in.grid_wireframe) grid_wireframe = !grid_wireframe;
+    if (in.contact_wireframe) contact_wireframe = !contact_wireframe;
     if (in.slow_motion) slow = !slow;
     if (in.reset) {
       Result<Scene> reloaded = load_scene_file(args.scene);
@@ -459,6 +469,29 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     }
     const auto t1 = Clock::now();
     if (!zero_copy) current_frame();  // the staged path draws from the host's copy
+    if (grid_wireframe || contact_wireframe) {
+      viewer::Segments lines;
+      if (grid_wireframe) {
+        lines = viewer::grid_cell_segments(current_frame(), sim->step_params().inv_cell_size,
+                                           kWireframeLimit);
+      }
+      if (contact_wireframe) {
+        viewer::Segments contacts = viewer::contact_segments(current_frame(), kWireframeLimit);
+        lines.ends.insert(lines.ends.end(), contacts.ends.begin(), contacts.ends.end());
+        lines.colors.insert(lines.colors.end(), contacts.colors.begin(), contacts.colors.end());
+        lines.truncated = lines.truncated || contacts.truncated;
+      }
+      if (lines.truncated && !overlay_truncated_said) {
+        fmt::print(stderr, "motes view: the wireframe shows its first {} cells or contacts\n",
+                   kWireframeLimit);
+        overlay_truncated_said = true;
+      }
+      surface.set_overlay(lines);
+      overlay_shown = true;
+    } else if (overlay_shown) {
+      surface.set_overlay({});
+      overlay_shown = false;
+    }
     const auto t2 = Clock::now();
     const bool keep = in.screenshot || (last && !args.screenshot.empty()) || recorder.on();
     render::Image picture;

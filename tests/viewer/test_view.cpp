@@ -23,6 +23,7 @@
 #include "motes/render.h"
 #include "motes/scene.h"
 #include "motes/simulation.h"
+#include "motes/viewer.h"
 
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_NO_SIMD
@@ -396,6 +397,71 @@ TEST(ViewScript, SpacePausesAndResetStartsAgain) {
   const motes::Snapshot reset = scripted_run("reset", 12, "10 key r\n");
   EXPECT_EQ(reset.step, 2 * steps);
   EXPECT_TRUE(same_positions(reset, two));
+}
+
+// The wireframes (keys W and C): the segments, and that they show in the picture.
+TEST(ViewWireframe, GridCellsAndContactsFromAState) {
+  motes::Snapshot s;
+  s.particle_pos = {{0.05f, 0.05f, 0.05f, 0.05f},   // body 0
+                    {0.149f, 0.05f, 0.05f, 0.05f},  // body 1: touches body 0's particle
+                    {0.05f, 0.149f, 0.05f, 0.05f},  // body 0 too: its own, not a contact
+                    {0.5f, 0.5f, 0.5f, 0.05f}};     // body 2, alone
+  s.particle_body = {0, 1, 0, 2};
+  const motes::viewer::Segments contacts = motes::viewer::contact_segments(s, 100);
+  ASSERT_EQ(contacts.colors.size(), 1u);
+  ASSERT_EQ(contacts.ends.size(), 2u);
+  EXPECT_FLOAT_EQ(contacts.ends[0].x(), 0.05f);
+  EXPECT_FLOAT_EQ(contacts.ends[1].x(), 0.149f);
+  EXPECT_FALSE(contacts.truncated);
+  EXPECT_TRUE(motes::viewer::contact_segments(s, 0).truncated);
+  // Cells of 0.1 m: the first three particles' centres lie in cells (0,0,0), (1,0,0), (0,1,0),
+  // the fourth in (5,5,5): four cubes of 12 edges, each edge 0.1 m long on an axis.
+  const motes::viewer::Segments cells = motes::viewer::grid_cell_segments(s, 10.0f, 100);
+  ASSERT_EQ(cells.colors.size(), 48u);
+  for (std::size_t k = 0; k < cells.colors.size(); ++k) {
+    EXPECT_NEAR((cells.ends[2 * k + 1] - cells.ends[2 * k]).norm(), 0.1f, 1e-6f);
+  }
+  EXPECT_EQ(motes::viewer::grid_cell_segments(s, 10.0f, 2).colors.size(), 24u);
+}
+
+/// Pixels of `image` within 6 of `rgb` in every channel.
+int pixels_like(const Image& image, int r, int g, int b) {
+  int n = 0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint8_t* p = image.pixel(x, y);
+      n += std::abs(p[0] - r) <= 6 && std::abs(p[1] - g) <= 6 && std::abs(p[2] - b) <= 6;
+    }
+  }
+  return n;
+}
+
+TEST(ViewWireframe, KeysWAndCDrawOverThePicture) {
+  const auto run = [](const std::string& tag, const std::string& script) {
+    const fs::path png = scratch(tag + ".png");
+    std::string command = std::string(MOTES_CLI_PATH) + " view " + kScene +
+                          " --backend openmp --offscreen --size 320x240 --frames 40 --screenshot " +
+                          png.string();
+    if (!script.empty()) command += " --input " + write_file(tag + ".txt", script).string();
+    EXPECT_EQ(shell(command), 0) << command;
+    return load_png(png);
+  };
+  const Image plain = run("plain", "");
+  const Image contacts = run("contacts", "0 key c\n");
+  const Image cells = run("cells", "0 key w\n");
+  const Image off = run("off", "0 key c\n0 key w\n20 key c\n20 key w\n");
+  // The colours of wireframe.cpp (contacts linear (1, 0.15, 0.1), cells (0.25, 0.65, 1)) after
+  // the viewer's gamma 2.
+  const int red_plain = pixels_like(plain, 255, 99, 81);
+  const int red = pixels_like(contacts, 255, 99, 81);
+  const int blue_plain = pixels_like(plain, 128, 206, 255);
+  const int blue = pixels_like(cells, 128, 206, 255);
+  std::printf("contact-coloured pixels %d (without: %d), cell-coloured %d (without: %d)\n", red,
+              red_plain, blue, blue_plain);
+  EXPECT_GT(red, red_plain + 50);
+  EXPECT_GT(blue, blue_plain + 200);
+  // Both toggled off again: the plain picture.
+  EXPECT_EQ(off.rgb, plain.rgb);
 }
 
 TEST(ViewScript, QuitEndsARunWithoutAFrameLimit) {

@@ -14,6 +14,7 @@ void Window::set_title(const std::string& /*title*/) {}
 render::Size Window::size() const { return {}; }
 void Window::draw(const render::Camera& /*camera*/, const Snapshot* /*frame*/,
                   render::Image* /*screenshot*/) {}
+void Window::set_overlay(const Segments& /*segments*/) {}
 void Window::restyle(const Style& /*style*/, const Snapshot& /*first_frame*/) {}
 Result<std::unique_ptr<Device>> Window::open_compute_device() const {
   return Status::error("built without GLFW");

@@ -46,6 +46,7 @@ struct Offscreen::Impl {
   std::optional<Styler> styler;
   std::optional<Particles> particles;
   std::optional<Painter> painter;
+  Segments overlay;  ///< the wireframe (set_overlay), given to the painter at each draw
   std::optional<DeviceImage> color;
   std::optional<DeviceImage> depth;
   std::optional<HostBuffer> readback;
@@ -83,6 +84,7 @@ const render::Image& Offscreen::draw(const render::Camera& camera, const Snapsho
     m.particles->stage(*m.styler, *frame);
   }
   VkCommandBuffer cmd = m.gpu.begin_commands();
+  m.painter->set_segments(m.overlay);
   m.painter->record(cmd, m.framebuffer, m.extent, m.styler->constants(camera, m.size));
   record_readback(m.gpu, cmd, m.color->image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, m.extent,
                   m.readback->buffer);
@@ -90,6 +92,8 @@ const render::Image& Offscreen::draw(const render::Camera& camera, const Snapsho
   unpack_rgb(m.readback->mapped, m.extent, false, m.image);
   return m.image;
 }
+
+void Offscreen::set_overlay(const Segments& segments) { impl_->overlay = segments; }
 
 const std::string& Offscreen::device_name() const { return impl_->gpu.name; }
 

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 #include <string_view>
@@ -106,11 +107,32 @@ Painter::Painter(const Gpu& gpu, const Particles& particles, VkFormat color_form
   layout.pPushConstantRanges = &range;
   check(gpu.vk.vkCreatePipelineLayout(gpu.device, &layout, nullptr, &layout_),
         "vkCreatePipelineLayout");
-  backdrop_ = make_pipeline("backdrop.vert", "backdrop.frag", false);
-  spheres_ = make_pipeline("sphere.vert", "sphere.frag", true);
+  backdrop_ = make_pipeline("backdrop.vert", "backdrop.frag", Kind::Backdrop);
+  spheres_ = make_pipeline("sphere.vert", "sphere.frag", Kind::Spheres);
+  lines_ = make_pipeline("lines.vert", "lines.frag", Kind::Lines);
 }
 
-VkPipeline Painter::make_pipeline(const char* vert, const char* frag, bool spheres) const {
+void Painter::set_segments(const Segments& segments) {
+  // Two vec4 a point: position, then its segment's colour (lines.vert).
+  const std::size_t points = std::min(segments.ends.size(), 2 * segments.colors.size());
+  const VkDeviceSize bytes = std::max<VkDeviceSize>(points, 1) * 2 * sizeof(Vec4);
+  if (!segments_ || segments_->size < bytes) {
+    segments_.reset();
+    segments_ = std::make_unique<HostBuffer>(gpu_, bytes, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  }
+  auto* out = static_cast<float*>(segments_->mapped);
+  for (std::size_t k = 0; k < points; ++k) {
+    const Eigen::Vector3f& p = segments.ends[k];
+    const Eigen::Vector3f& c = segments.colors[k / 2];
+    const float v[8] = {p.x(), p.y(), p.z(), 1.0f, c.x(), c.y(), c.z(), 1.0f};
+    std::copy(v, v + 8, out + 8 * k);
+  }
+  segment_points_ = static_cast<std::uint32_t>(points);
+}
+
+VkPipeline Painter::make_pipeline(const char* vert, const char* frag, Kind kind) const {
+  const bool spheres = kind == Kind::Spheres;
+  const bool lines = kind == Kind::Lines;
   const VkShaderModule vs = make_module(gpu_, vert);
   const VkShaderModule fs = make_module(gpu_, frag);
   VkPipelineShaderStageCreateInfo stages[2]{};
@@ -130,6 +152,12 @@ VkPipeline Painter::make_pipeline(const char* vert, const char* frag, bool spher
       {1, sizeof(Vec4), VK_VERTEX_INPUT_RATE_INSTANCE}};
   const VkVertexInputAttributeDescription attributes[2] = {
       {0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0}, {1, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0}};
+  // A wireframe's points: one array of position and colour pairs (set_segments).
+  const VkVertexInputBindingDescription line_binding{0, 2 * sizeof(Vec4),
+                                                     VK_VERTEX_INPUT_RATE_VERTEX};
+  const VkVertexInputAttributeDescription line_attributes[2] = {
+      {0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0},
+      {1, 0, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(Vec4)}};
   VkPipelineVertexInputStateCreateInfo input{};
   input.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO;
   if (spheres) {
@@ -137,11 +165,17 @@ VkPipeline Painter::make_pipeline(const char* vert, const char* frag, bool spher
     input.pVertexBindingDescriptions = bindings;
     input.vertexAttributeDescriptionCount = 2;
     input.pVertexAttributeDescriptions = attributes;
+  } else if (lines) {
+    input.vertexBindingDescriptionCount = 1;
+    input.pVertexBindingDescriptions = &line_binding;
+    input.vertexAttributeDescriptionCount = 2;
+    input.pVertexAttributeDescriptions = line_attributes;
   }
   VkPipelineInputAssemblyStateCreateInfo assembly{};
   assembly.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO;
-  assembly.topology =
-      spheres ? VK_PRIMITIVE_TOPOLOGY_TRIANGLE_STRIP : VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+  assembly.topology = spheres ? VK_PRIMITIVE_TOPOLOGY_TRIANGLE_STRIP
+                      : lines ? VK_PRIMITIVE_TOPOLOGY_LINE_LIST
+                              : VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
   VkPipelineViewportStateCreateInfo viewport{};
   viewport.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO;
   viewport.viewportCount = 1;
@@ -157,8 +191,9 @@ VkPipeline Painter::make_pipeline(const char* vert, const char* frag, bool spher
   multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
   VkPipelineDepthStencilStateCreateInfo depth{};
   depth.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO;
-  depth.depthTestEnable = VK_TRUE;
-  depth.depthWriteEnable = VK_TRUE;
+  // A wireframe is drawn over everything (a contact's segment lies inside its two spheres).
+  depth.depthTestEnable = lines ? VK_FALSE : VK_TRUE;
+  depth.depthWriteEnable = lines ? VK_FALSE : VK_TRUE;
   // Depth is near / distance: greater is nearer. The backdrop goes first and sets every pixel.
   depth.depthCompareOp = spheres ? VK_COMPARE_OP_GREATER : VK_COMPARE_OP_ALWAYS;
   VkPipelineColorBlendAttachmentState blend{};
@@ -223,11 +258,18 @@ void Painter::record(VkCommandBuffer cmd, VkFramebuffer framebuffer, VkExtent2D 
   gpu_.vk.vkCmdDraw(cmd, 3, 1, 0, 0);
   gpu_.vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, spheres_);
   particles_.record_draw(cmd, layout_);
+  if (segment_points_ > 0) {
+    gpu_.vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, lines_);
+    const VkDeviceSize offset = 0;
+    gpu_.vk.vkCmdBindVertexBuffers(cmd, 0, 1, &segments_->buffer, &offset);
+    gpu_.vk.vkCmdDraw(cmd, segment_points_, 1, 0, 0);
+  }
   gpu_.vk.vkCmdEndRenderPass(cmd);
 }
 
 Painter::~Painter() {
   gpu_.vk.vkDeviceWaitIdle(gpu_.device);
+  if (lines_ != VK_NULL_HANDLE) gpu_.vk.vkDestroyPipeline(gpu_.device, lines_, nullptr);
   if (spheres_ != VK_NULL_HANDLE) gpu_.vk.vkDestroyPipeline(gpu_.device, spheres_, nullptr);
   if (backdrop_ != VK_NULL_HANDLE) gpu_.vk.vkDestroyPipeline(gpu_.device, backdrop_, nullptr);
   if (layout_ != VK_NULL_HANDLE) gpu_.vk.vkDestroyPipelineLayout(gpu_.device, layout_, nullptr);

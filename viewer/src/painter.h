@@ -1,12 +1,14 @@
-// The render pass and the two pipelines (backdrop: sky and ground; spheres: one quad per
-// particle), the particles' instance buffer, and the copy of a drawn picture to the host.
+// The render pass and the three pipelines (backdrop: sky and ground; spheres: one quad per
+// particle; lines: a wireframe over the picture), and the copy of a drawn picture to the host.
 #pragma once
 
+#include <memory>
 #include <string_view>
 #include <vector>
 
 #include "gpu.h"
 #include "motes/render.h"
+#include "motes/viewer.h"
 #include "particles.h"
 #include "style.h"
 
@@ -25,7 +27,11 @@ class Painter {
   Painter(const Painter&) = delete;
   Painter& operator=(const Painter&) = delete;
 
-  /// Records what the particles need before the pass, then the pass: clear, backdrop, spheres.
+  /// The wireframe drawn over the spheres from the next record on (none when empty). The previous
+  /// draw must be done.
+  void set_segments(const Segments& segments);
+  /// Records what the particles need before the pass, then the pass: clear, backdrop, spheres,
+  /// the wireframe.
   void record(VkCommandBuffer cmd, VkFramebuffer framebuffer, VkExtent2D extent,
               const ViewConstants& constants) const;
 
@@ -33,7 +39,8 @@ class Painter {
   [[nodiscard]] VkFormat depth_format() const { return depth_format_; }
 
  private:
-  VkPipeline make_pipeline(const char* vert, const char* frag, bool spheres) const;
+  enum class Kind { Backdrop, Spheres, Lines };
+  VkPipeline make_pipeline(const char* vert, const char* frag, Kind kind) const;
 
   const Gpu& gpu_;
   const Particles& particles_;
@@ -42,6 +49,9 @@ class Painter {
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline backdrop_ = VK_NULL_HANDLE;
   VkPipeline spheres_ = VK_NULL_HANDLE;
+  VkPipeline lines_ = VK_NULL_HANDLE;
+  std::unique_ptr<HostBuffer> segments_;  ///< the wireframe's points (set_segments)
+  std::uint32_t segment_points_ = 0;
 };
 
 /// A framebuffer of a colour view and a depth view.

@@ -23,6 +23,8 @@ void Input::merge(const Input& o) {
   slow_motion = slow_motion || o.slow_motion;
   screenshot = screenshot || o.screenshot;
   record = record || o.record;
+  grid_wireframe = grid_wireframe || o.grid_wireframe;
+  contact_wireframe = contact_wireframe || o.contact_wireframe;
   quit = quit || o.quit;
   if (o.grab_start || o.grabbing || o.grab_end) {
     cursor_x = o.cursor_x;
@@ -66,6 +68,10 @@ bool press_key(const std::string& key, Input& in) {
     in.screenshot = true;
   } else if (k == "v") {
     in.record = true;
+  } else if (k == "w") {
+    in.grid_wireframe = true;
+  } else if (k == "c") {
+    in.contact_wireframe = true;
   } else if (k == "q" || k == "escape" || k == "esc") {
     in.quit = true;
   } else {

@@ -64,6 +64,12 @@ struct Window::Impl {
                            case GLFW_KEY_V:
                              in.record = true;
                              break;
+                           case GLFW_KEY_W:
+                             in.grid_wireframe = true;
+                             break;
+                           case GLFW_KEY_C:
+                             in.contact_wireframe = true;
+                             break;
                            case GLFW_KEY_ESCAPE:
                            case GLFW_KEY_Q:
                              in.quit = true;
@@ -249,6 +255,7 @@ struct Window::Impl {
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     check(gpu.vk.vkBeginCommandBuffer(command, &begin), "vkBeginCommandBuffer");
     const render::Size size{static_cast<int>(extent.width), static_cast<int>(extent.height)};
+    painter->set_segments(overlay);
     painter->record(command, framebuffers[index], extent, styler->constants(camera, size));
     const bool copy = screenshot != nullptr && readback.has_value();
     if (copy) {
@@ -303,6 +310,7 @@ struct Window::Impl {
   bool resized = false;
   std::optional<Particles> particles;  // before the painter, which draws them
   std::optional<Painter> painter;
+  Segments overlay;  ///< the wireframe (set_overlay), given to the painter at each draw
   std::optional<DeviceImage> depth;
   std::optional<HostBuffer> readback;
   std::vector<VkImage> images;
@@ -380,6 +388,8 @@ void Window::set_title(const std::string& title) {
 render::Size Window::size() const {
   return {static_cast<int>(impl_->extent.width), static_cast<int>(impl_->extent.height)};
 }
+
+void Window::set_overlay(const Segments& segments) { impl_->overlay = segments; }
 
 void Window::draw(const render::Camera& camera, const Snapshot* frame, render::Image* screenshot) {
   impl_->draw(camera, frame, screenshot);

@@ -23,6 +23,22 @@ struct Style {
   render::ColorBy color_by = render::ColorBy::Body;
 };
 
+/// Line segments drawn over the picture (the wireframes of `motes view`'s W and C keys): segment k
+/// runs from ends[2k] to ends[2k + 1] in colors[k] (linear RGB).
+struct Segments {
+  std::vector<Eigen::Vector3f> ends;
+  std::vector<Eigen::Vector3f> colors;
+  bool truncated = false;  ///< the limit it was made with was reached: some are left out
+};
+
+/// The cells of the collision grid (a cell holds the points x with floor(x * inv_cell_size) equal,
+/// as the simulation's StepParams) that hold a particle centre of `frame`, each as its 12 edges;
+/// the first `max_cells` cells met in particle order.
+Segments grid_cell_segments(const Snapshot& frame, float inv_cell_size, std::size_t max_cells);
+/// Every pair of particles of different bodies that touch in `frame` (centres closer than 1.01
+/// times the sum of the radii), as the segment between their centres; at most `max_contacts`.
+Segments contact_segments(const Snapshot& frame, std::size_t max_contacts);
+
 // Offscreen and Window draw the particles by one of two paths (docs/viewer.md): staged, from a
 // Snapshot each frame (any backend), or zero copy, from the buffers of a simulation that runs on
 // the viewer's own Vulkan device (open_compute_device, then attach). Before the first draw, and
@@ -51,6 +67,8 @@ class Offscreen {
   /// Draws `frame` (staged; ignored, and may be null, when attached) seen by `camera`; the
   /// reference stays valid until the next call.
   const render::Image& draw(const render::Camera& camera, const Snapshot* frame);
+  /// The wireframe drawn over the particles from the next draw on (none when empty).
+  void set_overlay(const Segments& segments);
   /// The Vulkan device that draws, and its place in the loader's order.
   [[nodiscard]] const std::string& device_name() const;
   [[nodiscard]] int device_index() const;
@@ -71,14 +89,16 @@ struct Input {
   float orbit_y = 0.0f;
   float pan_x = 0.0f;  ///< pixels dragged with the right or middle button
   float pan_y = 0.0f;
-  float zoom = 0.0f;         ///< wheel steps (positive: towards the target)
-  bool pause = false;        ///< Space
-  bool step = false;         ///< .
-  bool reset = false;        ///< R
-  bool slow_motion = false;  ///< S
-  bool screenshot = false;   ///< P
-  bool record = false;       ///< V: start or stop recording a video
-  bool quit = false;         ///< Esc, Q or the window closed
+  float zoom = 0.0f;               ///< wheel steps (positive: towards the target)
+  bool pause = false;              ///< Space
+  bool step = false;               ///< .
+  bool reset = false;              ///< R
+  bool slow_motion = false;        ///< S
+  bool screenshot = false;         ///< P
+  bool record = false;             ///< V: start or stop recording a video
+  bool grid_wireframe = false;     ///< W: the collision grid's occupied cells on or off
+  bool contact_wireframe = false;  ///< C: the contacts on or off
+  bool quit = false;               ///< Esc, Q or the window closed
   /// Shift + left button: grab (pick and drag). grab_start on the press, grabbing while held
   /// (the press's frame too), grab_end on the release; the cursor in drawable pixels (x right, y
   /// down, as the pictures' pixel centres at i + 0.5).
@@ -94,8 +114,8 @@ struct Input {
 
 /// Scripted input (`motes view --input FILE`, docs/viewer.md): timed events by frame number, one
 /// a line, turned into the same Input a person's keys and mouse give. Lines: `FRAME key NAME`
-/// (space, period or ., r, s, p, v, q, escape), `FRAME wheel STEPS`, `FRAME drag X0 Y0 X1 Y1 N
-/// [left|right|middle|shift]` (pressed at pixel (X0, Y0), moved evenly to (X1, Y1) over the N
+/// (space, period or ., r, s, p, v, w, c, q, escape), `FRAME wheel STEPS`, `FRAME drag X0 Y0 X1 Y1
+/// N [left|right|middle|shift]` (pressed at pixel (X0, Y0), moved evenly to (X1, Y1) over the N
 /// frames after FRAME, released at FRAME + N; shift: Shift + left, a grab), `FRAME quit`; `#`
 /// starts a comment.
 class Script {
@@ -135,6 +155,8 @@ class Window {
   /// Draws `frame` (staged; ignored, and may be null, when attached) and shows it; with
   /// `screenshot`, also reads the shown picture back into it.
   void draw(const render::Camera& camera, const Snapshot* frame, render::Image* screenshot);
+  /// The wireframe drawn over the particles from the next draw on (none when empty).
+  void set_overlay(const Segments& segments);
   /// Colours and extent of a scene (as Offscreen::restyle).
   void restyle(const Style& style, const Snapshot& first_frame);
   /// As Offscreen's.
