@@ -288,8 +288,9 @@ class Surface {
   virtual void draw(const render::Camera& camera, const Snapshot* frame, render::Image* shot) = 0;
   virtual void restyle(const viewer::Style& style, const Snapshot& first) = 0;
   [[nodiscard]] virtual Result<std::unique_ptr<Device>> open_compute_device() const = 0;
-  virtual void attach(Simulation& sim, const Snapshot& first) = 0;
+  virtual std::string attach(Simulation& sim, const Snapshot& first) = 0;
   [[nodiscard]] virtual bool attached() const = 0;
+  [[nodiscard]] virtual const char* path() const = 0;
   virtual void set_title(const std::string& title) = 0;
   virtual void set_overlay(const viewer::Segments& segments) = 0;
   [[nodiscard]] virtual const std::string& device_name() const = 0;
@@ -308,8 +309,11 @@ class TargetSurface : public Surface {
   [[nodiscard]] Result<std::unique_ptr<Device>> open_compute_device() const override {
     return target_->open_compute_device();
   }
-  void attach(Simulation& sim, const Snapshot& first) override { target_->attach(sim, first); }
+  std::string attach(Simulation& sim, const Snapshot& first) override {
+    return target_->attach(sim, first);
+  }
   [[nodiscard]] bool attached() const override { return target_->attached(); }
+  [[nodiscard]] const char* path() const override { return target_->path(); }
   void set_overlay(const viewer::Segments& segments) override { target_->set_overlay(segments); }
   [[nodiscard]] const std::string& device_name() const override { return target_->device_name(); }
   [[nodiscard]] int device_index() const override { return target_->device_index(); }
@@ -351,10 +355,10 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
               const std::optional<viewer::Script>& script) {
   const std::string name = std::filesystem::path(args.scene).filename().string();
   const std::string backend = sim->device().info().backend;
-  // Zero copy: the picture comes from the simulation's buffers; `frame` is read back only when
-  // the host needs it (picking and pulling), and is stale in between.
+  // Zero copy or the CUDA copy: the picture comes from the device; `frame` is read back only
+  // when the host needs it (picking and pulling), and is stale in between.
   const bool zero_copy = surface.attached();
-  const char* path = zero_copy ? "zero copy" : "staged";
+  const std::string path = surface.path();
   bool frame_current = true;
   auto current_frame = [&]() -> const Snapshot& {
     if (!frame_current) frame = must_snapshot(*sim);
@@ -416,7 +420,9 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
         frame_current = true;
         style.look = render::look_from_scene(reloaded.value());
         surface.restyle(style, frame);
-        if (zero_copy) surface.attach(*sim, frame);  // the new simulation's buffers
+        if (zero_copy) {  // the new simulation's buffers
+          if (std::string why = surface.attach(*sim, frame); !why.empty()) fail(why);
+        }
         owed_steps = 0.0;
         grab.stop(nullptr);
       }
@@ -647,10 +653,19 @@ void view(const ViewArgs& args) {
   style.look = render::look_from_scene(scene.value());
   style.color_by = color_by.value();
   surface->restyle(style, first);
-  if (zero_copy) surface->attach(*sim, first);
+  if (zero_copy) {
+    if (std::string why = surface->attach(*sim, first); !why.empty()) fail(why);
+  } else if (compute.backend == "cuda") {
+    // The CUDA copy: into memory the viewer shares with CUDA on the same GPU, device to device.
+    staged_why = args.staged ? "--staged" : surface->attach(*sim, first);
+  }
+  const std::string path = surface->path();
   fmt::print("motes view: drawing {}\n",
-             zero_copy ? "zero copy, from the simulation's own Vulkan buffers"
-                       : fmt::format("staged, through the host ({})", staged_why));
+             path == "zero copy" ? "zero copy, from the simulation's own Vulkan buffers"
+             : path == "CUDA copy"
+                 ? "by the CUDA copy, device to device into the viewer's memory (CUDA-Vulkan "
+                   "external memory)"
+                 : fmt::format("staged, through the host ({})", staged_why));
   std::fflush(stdout);
   const render::Camera camera =
       scene->camera ? render::camera_from_spec(*scene->camera)
@@ -700,7 +715,8 @@ void add_view_command(CLI::App& app) {
                   "record the displayed frames from the start as an MP4 video (ffmpeg; V stops)");
   sub->add_flag("--staged", args->staged,
                 "draw from a copy of the particles through the host even where the Vulkan "
-                "backend's buffers could be drawn as they are (zero copy; docs/viewer.md)");
+                "backend's buffers could be drawn as they are (zero copy) or CUDA could copy "
+                "them on the GPU (the CUDA copy; docs/viewer.md)");
   sub->add_flag(
       "--offscreen", args->offscreen,
       "draw without a window (needs --frames, or an --input script that quits; for machines "

@@ -26,6 +26,10 @@ if(MOTES_VULKAN)
   install(FILES backends/vulkan/include/motes/vulkan_interop.h
           DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/motes)
 endif()
+if(MOTES_CUDA)
+  install(FILES backends/cuda/include/motes/cuda_interop.h
+          DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/motes)
+endif()
 install(FILES core/include/motes/backend/device.h core/include/motes/backend/kernels.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/motes/backend)
 file(GLOB MOTES_SHARED_HEADERS CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/shaders/shared/*.h)

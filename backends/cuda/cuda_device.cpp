@@ -91,6 +91,8 @@ Result<std::unique_ptr<Device>> CudaDevice::open(int ordinal) {
     return s;
   }
   d->info_ = describe(ordinal, prop);
+  static_assert(sizeof(prop.uuid) == sizeof(d->uuid_));
+  std::memcpy(d->uuid_.data(), &prop.uuid, sizeof(d->uuid_));
   const char* host_rebuild = std::getenv("MOTES_CUDA_HOST_REBUILD");
   d->host_rebuild_ = host_rebuild != nullptr && std::strcmp(host_rebuild, "1") == 0;
   for (cudaStream_t* stream : {&d->stream_, &d->body_stream_}) {

@@ -57,6 +57,13 @@ class CudaDevice final : public Device {
   Status fetch_peer_outbox(std::size_t peer, std::size_t from, std::size_t to,
                            std::size_t bytes) override;
   void close_peer_outboxes() override;
+  /// The GPU's cudaDeviceProp::uuid (motes/cuda_interop.h).
+  [[nodiscard]] const std::array<std::uint8_t, 16>& uuid() const { return uuid_; }
+  [[nodiscard]] int ordinal() const { return ordinal_; }
+  /// Runs the queued kernels, then copies the first `count` particle positions to `positions`
+  /// and, unless it is null, the velocities to `velocities` (device memory on this GPU); returns
+  /// when the copy is complete (cuda_interop.cpp).
+  Status copy_particles_to(void* positions, void* velocities, std::size_t count);
   void set_timing(bool on) override { timing_ = on; }
   [[nodiscard]] KernelTimes kernel_times() const override { return times_; }
   void reset_kernel_times() override { times_ = {}; }
@@ -115,6 +122,7 @@ class CudaDevice final : public Device {
 
   DeviceInfo info_;
   int ordinal_ = 0;
+  std::array<std::uint8_t, 16> uuid_{};
   cudaStream_t stream_ = nullptr;  ///< every launch goes here
   /// A second stream, swapped into stream_ while the body of a conditional rebuild is captured.
   cudaStream_t body_stream_ = nullptr;

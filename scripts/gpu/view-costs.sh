@@ -3,8 +3,8 @@
 # "What a frame costs"): boxes of 4 x 4 x 4 particles on a floor with position contacts in 4
 # substeps, 160, 16,000 and 160,000 of them (10,240, 1,024,000 and 10,240,000 particles), drawn
 # offscreen at 1280 x 720 for FRAMES frames (default 20) on Vulkan, zero copy and --staged, and on
-# CUDA (staged, the only path there). Each run prints its summary line: step, copy to the host and
-# draw, ms a frame. Run from the repository root after `. scripts/gpu/prelude.sh`:
+# CUDA, by the CUDA copy and --staged. Each run prints its summary line: step, copy to the host and
+# draw (which holds the CUDA copy), ms a frame. Run from the repository root after `. scripts/gpu/prelude.sh`:
 #   scripts/gpu/view-costs.sh [FRAMES] [SIZES...]      e.g. scripts/gpu/view-costs.sh 20 160 16000
 set -euo pipefail
 frames=${1:-20}
@@ -34,7 +34,7 @@ JSON
 for boxes in "${sizes[@]}"; do
   file=$dir/boxes-$boxes.json
   scene "$boxes" "$file"
-  for run in "vulkan" "vulkan --staged" "cuda"; do
+  for run in "vulkan" "vulkan --staged" "cuda" "cuda --staged"; do
     echo "== $((64 * boxes)) particles, --backend $run"
     # shellcheck disable=SC2086
     "$motes" view "$file" --offscreen --frames "$frames" --size 1280x720 --backend $run |

@@ -217,20 +217,22 @@ class ViewOffscreen : public testing::TestWithParam<const char*> {};
 
 TEST_P(ViewOffscreen, MatchesTheHeadlessRenderer) {
   const std::string backend = GetParam();
-  if (backend == "vulkan" && !motes::open_device("vulkan")) {
-    GTEST_SKIP() << "skipped: no Vulkan device for the simulation";
+  if (backend != "openmp" && !motes::open_device(backend)) {
+    GTEST_SKIP() << "skipped: no " << backend << " device for the simulation";
   }
   const fs::path png = scratch("offscreen-" + backend + ".png");
   const fs::path out = scratch("offscreen-" + backend + ".txt");
   ASSERT_EQ(shell(view_command(backend, png, true) + " > " + out.string()), 0);
-  // Vulkan draws zero copy, openmp staged (docs/viewer.md).
+  // Vulkan draws zero copy, CUDA by the CUDA copy, openmp staged (docs/viewer.md).
   const std::string text = read_text(out);
-  EXPECT_NE(text.find(backend == "vulkan" ? "drawn zero copy" : "drawn staged"), std::string::npos)
-      << text;
+  const char* path = backend == "vulkan" ? "drawn zero copy"
+                     : backend == "cuda" ? "drawn CUDA copy"
+                                         : "drawn staged";
+  EXPECT_NE(text.find(path), std::string::npos) << text;
   expect_matches(load_png(png), reference());
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, ViewOffscreen, testing::Values("openmp", "vulkan"));
+INSTANTIATE_TEST_SUITE_P(Backends, ViewOffscreen, testing::Values("openmp", "vulkan", "cuda"));
 
 TEST(ViewWindow, MatchesTheHeadlessRendererUnderXvfb) {
   Xvfb x;
@@ -692,54 +694,78 @@ TEST(ViewGrab, ShiftDragInAWindowUnderXvfb) {
   EXPECT_LT(std::abs(orbited), 1e-3);
 }
 
-bool has_vulkan() { return motes::open_device("vulkan").is_ok(); }
+bool has_backend(const char* backend) { return motes::open_device(backend).is_ok(); }
 
-// Zero copy (docs/viewer.md): on the Vulkan backend the viewer draws from the simulation's own
-// buffers (Backends/ViewOffscreen.MatchesTheHeadlessRenderer/1 compares that picture with the
-// headless renderer's); its pictures must be the staged path's, whatever the colours.
-TEST(ViewZeroCopy, PicturesMatchTheStagedPath) {
-  if (!has_vulkan()) GTEST_SKIP() << "skipped: no Vulkan device for the simulation";
+// Drawn without the host (docs/viewer.md, "How it draws"), on `backend`, whose path the summary
+// names as `path`: the pictures must be the staged path's, whatever the colours.
+void expect_pictures_match_the_staged_path(const std::string& backend, const std::string& path) {
   for (const std::string color_by : {"body", "speed", "height"}) {
     Image pictures[2];
     for (int staged = 0; staged < 2; ++staged) {
-      const std::string tag = color_by + (staged != 0 ? "-staged" : "-zero-copy");
+      const std::string tag = backend + "-" + color_by + (staged != 0 ? "-staged" : "-direct");
       const fs::path png = scratch(tag + ".png"), out = scratch(tag + ".txt");
-      ASSERT_EQ(shell(view_command("vulkan", png, true, 8) + " --color-by " + color_by +
+      ASSERT_EQ(shell(view_command(backend, png, true, 8) + " --color-by " + color_by +
                       (staged != 0 ? " --staged" : "") + " > " + out.string()),
                 0);
       const std::string text = read_text(out);
-      EXPECT_NE(text.find(staged != 0 ? "drawn staged" : "drawn zero copy"), std::string::npos)
+      EXPECT_NE(text.find(staged != 0 ? "drawn staged" : "drawn " + path), std::string::npos)
           << text;
       pictures[staged] = load_png(png);
     }
     const double d = difference(pictures[0], pictures[1]);
-    std::printf("colours by %s: zero copy against staged %.3f\n", color_by.c_str(), d);
+    std::printf("colours by %s: %s against staged %.3f\n", color_by.c_str(), path.c_str(), d);
     EXPECT_LT(d, kSameBelow);
   }
 }
 
-// Many frames zero copy under the validation layer (MOTES_VULKAN_VALIDATION=1 in ctest: any
-// message is an error that ends the run): speed colours (the compute pass), a grab (snapshots
-// and write_state between the frames) and a reset (the simulation made again on the viewer's
-// device). The reset's state is a fresh 3-frame run's.
-TEST(ViewZeroCopy, ManyFramesWithAGrabAndAReset) {
-  if (!has_vulkan()) GTEST_SKIP() << "skipped: no Vulkan device for the simulation";
-  const fs::path scene_path = write_file("zero-copy-box.json", kBoxScene);
+// Many frames drawn without the host, under the validation layer (MOTES_VULKAN_VALIDATION=1 in
+// ctest: any message is an error that ends the run): speed colours (the compute pass), a grab
+// (snapshots and write_state between the frames) and a reset (the simulation made again, and
+// drawn again without the host). The reset's state is a fresh 3-frame run's.
+void expect_many_frames_with_a_grab_and_a_reset(const std::string& backend,
+                                                const std::string& path) {
+  const fs::path scene_path = write_file(backend + "-direct-box.json", kBoxScene);
   auto run = [&](const std::string& tag, int frames, const std::string& script) {
     const fs::path state = scratch(tag + ".state"), out = scratch(tag + ".txt");
     std::string command = std::string(MOTES_CLI_PATH) + " view " + scene_path.string() +
-                          " --backend vulkan --offscreen --size 320x240 --color-by speed " +
-                          "--frames " + std::to_string(frames) + " --save-state " + state.string();
+                          " --backend " + backend +
+                          " --offscreen --size 320x240 --color-by speed --frames " +
+                          std::to_string(frames) + " --save-state " + state.string();
     if (!script.empty()) command += " --input " + write_file(tag + "-input.txt", script).string();
     EXPECT_EQ(shell(command + " > " + out.string() + " 2>&1"), 0) << read_text(out);
-    EXPECT_NE(read_text(out).find("drawn zero copy"), std::string::npos) << read_text(out);
+    EXPECT_NE(read_text(out).find("drawn " + path), std::string::npos) << read_text(out);
     return load_saved(scene_path, state);
   };
-  const motes::Snapshot three = run("zero-copy-three", 3, "");
+  const motes::Snapshot three = run(backend + "-direct-three", 3, "");
   const motes::Snapshot reset =
-      run("zero-copy-reset", 100, "5 drag 165 117 225 117 10 shift\n97 key r\n");
+      run(backend + "-direct-reset", 100, "5 drag 165 117 225 117 10 shift\n97 key r\n");
   EXPECT_EQ(reset.step, three.step);
   EXPECT_TRUE(same_positions(reset, three));
+}
+
+// Zero copy: on the Vulkan backend the viewer draws from the simulation's own buffers
+// (Backends/ViewOffscreen.MatchesTheHeadlessRenderer/1 compares that picture with the headless
+// renderer's).
+TEST(ViewZeroCopy, PicturesMatchTheStagedPath) {
+  if (!has_backend("vulkan")) GTEST_SKIP() << "skipped: no Vulkan device for the simulation";
+  expect_pictures_match_the_staged_path("vulkan", "zero copy");
+}
+
+TEST(ViewZeroCopy, ManyFramesWithAGrabAndAReset) {
+  if (!has_backend("vulkan")) GTEST_SKIP() << "skipped: no Vulkan device for the simulation";
+  expect_many_frames_with_a_grab_and_a_reset("vulkan", "zero copy");
+}
+
+// The CUDA copy: on the CUDA backend, CUDA copies the particles device to device into memory
+// the viewer exported (CUDA-Vulkan external memory); runs where a CUDA GPU is (the GPU machine).
+TEST(ViewCudaCopy, PicturesMatchTheStagedPath) {
+  if (!has_backend("cuda")) GTEST_SKIP() << "skipped: no CUDA device";
+  expect_pictures_match_the_staged_path("cuda", "CUDA copy");
+}
+
+TEST(ViewCudaCopy, ManyFramesWithAGrabAndAReset) {
+  if (!has_backend("cuda")) GTEST_SKIP() << "skipped: no CUDA device";
+  expect_many_frames_with_a_grab_and_a_reset("cuda", "CUDA copy");
 }
 
 }  // namespace

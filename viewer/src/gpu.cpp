@@ -228,7 +228,19 @@ void Gpu::open(VkSurfaceKHR surface, int wanted) {
       memory_budget = true;
       exts.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
     }
+    // For a CUDA run's particles copied into the viewer's memory (cuda_share.h).
+    if (std::strcmp(e.extensionName, VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME) == 0) {
+      external_memory_fd = true;
+      exts.push_back(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME);
+    }
   }
+  VkPhysicalDeviceIDProperties id{};
+  id.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ID_PROPERTIES;
+  VkPhysicalDeviceProperties2 props2{};
+  props2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+  props2.pNext = &id;
+  vkGetPhysicalDeviceProperties2(physical, &props2);
+  std::memcpy(uuid.data(), id.deviceUUID, uuid.size());
   VkDeviceCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
   info.queueCreateInfoCount = 1;

@@ -5,6 +5,7 @@
 
 #include <volk.h>
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -55,9 +56,11 @@ class Gpu {
   VkDevice device = VK_NULL_HANDLE;
   VkQueue queue = VK_NULL_HANDLE;
   std::uint32_t family = 0;
-  bool family_computes = false;  ///< the queue's family has compute too
-  int index = -1;                ///< the physical device's place in the loader's order
-  bool memory_budget = false;    ///< VK_EXT_memory_budget is enabled (for motes' device)
+  bool family_computes = false;     ///< the queue's family has compute too
+  int index = -1;                   ///< the physical device's place in the loader's order
+  bool memory_budget = false;       ///< VK_EXT_memory_budget is enabled (for motes' device)
+  bool external_memory_fd = false;  ///< VK_KHR_external_memory_fd is enabled (cuda_share.h)
+  std::array<std::uint8_t, VK_UUID_SIZE> uuid{};  ///< VkPhysicalDeviceIDProperties::deviceUUID
   VkCommandPool pool = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
   VolkDeviceTable vk{};

@@ -19,8 +19,11 @@ void Window::restyle(const Style& /*style*/, const Snapshot& /*first_frame*/) {}
 Result<std::unique_ptr<Device>> Window::open_compute_device() const {
   return Status::error("built without GLFW");
 }
-void Window::attach(Simulation& /*sim*/, const Snapshot& /*first_frame*/) {}
+std::string Window::attach(Simulation& /*sim*/, const Snapshot& /*first_frame*/) {
+  return "built without GLFW";
+}
 bool Window::attached() const { return false; }
+const char* Window::path() const { return "staged"; }
 const std::string& Window::device_name() const {
   static const std::string none;
   return none;

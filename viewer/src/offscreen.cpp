@@ -68,13 +68,16 @@ Result<std::unique_ptr<Device>> Offscreen::open_compute_device() const {
   return viewer::open_compute_device(impl_->gpu);
 }
 
-void Offscreen::attach(Simulation& sim, const Snapshot& first_frame) {
+std::string Offscreen::attach(Simulation& sim, const Snapshot& first_frame) {
   if (!impl_->styler) throw std::logic_error("viewer: attach before restyle");
-  impl_->particles->attach(*impl_->styler, sim, first_frame);
+  std::string why = impl_->particles->attach(*impl_->styler, sim, first_frame);
   impl_->gpu.check_messages();
+  return why;
 }
 
 bool Offscreen::attached() const { return impl_->particles->attached(); }
+
+const char* Offscreen::path() const { return impl_->particles->path(); }
 
 const render::Image& Offscreen::draw(const render::Camera& camera, const Snapshot* frame) {
   Impl& m = *impl_;
@@ -83,6 +86,7 @@ const render::Image& Offscreen::draw(const render::Camera& camera, const Snapsho
     if (frame == nullptr) throw std::logic_error("viewer: a staged draw needs a frame");
     m.particles->stage(*m.styler, *frame);
   }
+  m.particles->refresh();  // the CUDA path's copy
   VkCommandBuffer cmd = m.gpu.begin_commands();
   m.painter->set_segments(m.overlay);
   m.painter->record(cmd, m.framebuffer, m.extent, m.styler->constants(camera, m.size));

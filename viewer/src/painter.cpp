@@ -265,6 +265,7 @@ void Painter::record(VkCommandBuffer cmd, VkFramebuffer framebuffer, VkExtent2D 
     gpu_.vk.vkCmdDraw(cmd, segment_points_, 1, 0, 0);
   }
   gpu_.vk.vkCmdEndRenderPass(cmd);
+  particles_.record_after(cmd);
 }
 
 Painter::~Painter() {

@@ -106,8 +106,19 @@ void Particles::detach() {
   if (!direct_) return;
   direct_.reset();
   per_device_.reset();
+  shared_.reset();
+  shared_sim_ = nullptr;
   count_ = 0;
   write_colors(ColorState{});  // staged, the colours come with the particles
+}
+
+const char* Particles::path() const {
+  if (!direct_) return "staged";
+  return shared_ ? "CUDA copy" : "zero copy";
+}
+
+void Particles::refresh() {
+  if (shared_) shared_->copy(*shared_sim_);
 }
 
 void Particles::stage(Styler& styler, const Snapshot& frame) {
@@ -129,13 +140,37 @@ void Particles::stage(Styler& styler, const Snapshot& frame) {
   }
 }
 
-void Particles::attach(const Styler& styler, Simulation& sim, const Snapshot& first_frame) {
-  Result<VulkanParticleBuffers> buffers = vulkan_particle_buffers(sim);
-  if (!buffers) throw std::runtime_error("viewer: " + buffers.message());
-  const VulkanBufferRange& positions = buffers->positions;
-  const VulkanBufferRange& velocities = buffers->velocities;
+std::string Particles::attach(const Styler& styler, Simulation& sim, const Snapshot& first_frame) {
+  detach();
+  if (sim.device().info().backend == "vulkan") {
+    Result<VulkanParticleBuffers> buffers = vulkan_particle_buffers(sim);
+    if (!buffers) return buffers.message();
+    use(styler, sim, first_frame, buffers.value());
+    return {};
+  }
+  if (std::string why = CudaShare::why_not(gpu_, sim); !why.empty()) return why;
+  const bool velocities = styler.color_state().mode != ColorState::kAttribute;
+  try {
+    shared_ = std::make_unique<CudaShare>(gpu_, sim, velocities);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  shared_sim_ = &sim;
+  VulkanParticleBuffers buffers;
+  buffers.positions.buffer = buffers.velocities.buffer = shared_->buffer();
+  buffers.positions.count = buffers.velocities.count = sim.particle_count();
+  buffers.positions.stride = buffers.velocities.stride = kVec4;
+  buffers.positions.size = buffers.velocities.size = kVec4 * sim.particle_count();
+  buffers.velocities.offset = shared_->velocities_offset();
+  use(styler, sim, first_frame, buffers);
+  return {};
+}
+
+void Particles::use(const Styler& styler, Simulation& sim, const Snapshot& first_frame,
+                    const VulkanParticleBuffers& buffers) {
+  const VulkanBufferRange& positions = buffers.positions;
+  const VulkanBufferRange& velocities = buffers.velocities;
   staged_.reset();
-  per_device_.reset();
   count_ = positions.count;
   Direct d;
   d.positions = positions.buffer;
@@ -169,6 +204,7 @@ void Particles::attach(const Styler& styler, Simulation& sim, const Snapshot& fi
 
 void Particles::record_before(VkCommandBuffer cmd) const {
   if (!direct_ || count_ == 0) return;
+  if (shared_) shared_->record_acquire(cmd);
   // motes' compute and transfer writes (submitted before on this queue), and the last frame's
   // reads of the running speed maximum, before this frame reads and updates them.
   VkMemoryBarrier after_motes{};
@@ -217,6 +253,10 @@ void Particles::record_draw(VkCommandBuffer cmd, VkPipelineLayout layout) const 
   }
   gpu_.vk.vkCmdBindVertexBuffers(cmd, 0, 2, buffers, offsets);
   gpu_.vk.vkCmdDraw(cmd, 4, count_, 0, 0);
+}
+
+void Particles::record_after(VkCommandBuffer cmd) const {
+  if (shared_ && count_ > 0) shared_->record_release(cmd);
 }
 
 }  // namespace motes::viewer

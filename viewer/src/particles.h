@@ -7,7 +7,9 @@
 
 #include <memory>
 #include <optional>
+#include <string>
 
+#include "cuda_share.h"
 #include "gpu.h"
 #include "motes/simulation.h"
 #include "style.h"
@@ -23,12 +25,19 @@ class Particles {
 
   /// Staged: the finite particles of `frame` and their colours (leaves the zero-copy path).
   void stage(Styler& styler, const Snapshot& frame);
-  /// Zero copy: from now on `sim`'s buffers, which must be on this Gpu's device; `first_frame`
-  /// (its state now) gives body and kind colours. Again after every Simulation::create.
-  void attach(const Styler& styler, Simulation& sim, const Snapshot& first_frame);
+  /// From now on without the host: zero copy, `sim`'s own buffers when it runs on this Gpu's
+  /// device; or the CUDA path, its particles copied by CUDA into memory shared with this Gpu
+  /// (cuda_share.h) when it runs on CUDA on the same GPU. `first_frame` (its state now) gives
+  /// body and kind colours. Again after every Simulation::create. Returns why neither path can
+  /// draw `sim` (empty when attached), left on the staged path then.
+  std::string attach(const Styler& styler, Simulation& sim, const Snapshot& first_frame);
   /// Back to the staged path (a new scene: its simulation's buffers are not these).
   void detach();
   [[nodiscard]] bool attached() const { return direct_.has_value(); }
+  /// "zero copy", "CUDA copy" or "staged".
+  [[nodiscard]] const char* path() const;
+  /// Before recording a frame: on the CUDA path, CUDA copies the particles in.
+  void refresh();
 
   /// The set the sphere pipeline reads the colour rule from (colors.glsl).
   [[nodiscard]] VkDescriptorSetLayout set_layout() const { return set_layout_; }
@@ -38,6 +47,8 @@ class Particles {
   /// Inside the render pass with the sphere pipeline bound (`layout` its layout): the colours'
   /// set, the two per-instance buffers and the draw.
   void record_draw(VkCommandBuffer cmd, VkPipelineLayout layout) const;
+  /// After the render pass: on the CUDA path the shared memory given back to CUDA.
+  void record_after(VkCommandBuffer cmd) const;
 
  private:
   /// The zero-copy path's buffers: positions (binding 0), the second attribute (binding 1:
@@ -50,6 +61,9 @@ class Particles {
     bool speed = false;
   };
   void write_colors(const ColorState& state);
+  /// Draws from `positions` and `velocities` (in the device's particle order) from now on.
+  void use(const Styler& styler, Simulation& sim, const Snapshot& first_frame,
+           const VulkanParticleBuffers& buffers);
 
   const Gpu& gpu_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
@@ -62,6 +76,8 @@ class Particles {
   VkDeviceSize staged_colors_offset_ = 0;     ///< where the colours start in staged_
   std::unique_ptr<DeviceBuffer> per_device_;  ///< zero copy: colours in the device's order
   std::optional<Direct> direct_;
+  std::unique_ptr<CudaShare> shared_;  ///< the CUDA path's memory
+  Simulation* shared_sim_ = nullptr;   ///< the simulation it copies from
   std::uint32_t count_ = 0;
 };
 

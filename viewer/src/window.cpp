@@ -240,6 +240,7 @@ struct Window::Impl {
     }
     if (r != VK_SUBOPTIMAL_KHR) check(r, "vkAcquireNextImageKHR");
     if (!particles->attached()) particles->stage(*styler, *frame);
+    particles->refresh();  // the CUDA path's copy (no draw of the last frame is in flight)
     if (command == VK_NULL_HANDLE) {
       VkCommandBufferAllocateInfo alloc{};
       alloc.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
@@ -404,13 +405,16 @@ Result<std::unique_ptr<Device>> Window::open_compute_device() const {
   return viewer::open_compute_device(impl_->gpu);
 }
 
-void Window::attach(Simulation& sim, const Snapshot& first_frame) {
+std::string Window::attach(Simulation& sim, const Snapshot& first_frame) {
   if (!impl_->styler) throw std::logic_error("viewer: attach before restyle");
-  impl_->particles->attach(*impl_->styler, sim, first_frame);
+  std::string why = impl_->particles->attach(*impl_->styler, sim, first_frame);
   impl_->gpu.check_messages();
+  return why;
 }
 
 bool Window::attached() const { return impl_->particles->attached(); }
+
+const char* Window::path() const { return impl_->particles->path(); }
 
 const std::string& Window::device_name() const { return impl_->gpu.name; }
 

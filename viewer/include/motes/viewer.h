@@ -39,10 +39,11 @@ Segments grid_cell_segments(const Snapshot& frame, float inv_cell_size, std::siz
 /// times the sum of the radii), as the segment between their centres; at most `max_contacts`.
 Segments contact_segments(const Snapshot& frame, std::size_t max_contacts);
 
-// Offscreen and Window draw the particles by one of two paths (docs/viewer.md): staged, from a
-// Snapshot each frame (any backend), or zero copy, from the buffers of a simulation that runs on
-// the viewer's own Vulkan device (open_compute_device, then attach). Before the first draw, and
-// after each new scene, restyle() gives the colours and the ground; it returns to the staged
+// Offscreen and Window draw the particles by one of three paths (docs/viewer.md): staged, from a
+// Snapshot each frame (any backend); zero copy, from the buffers of a simulation that runs on
+// the viewer's own Vulkan device (open_compute_device, then attach); or the CUDA copy, from
+// memory the viewer shares with a CUDA simulation on the same GPU (attach). Before the first draw,
+// and after each new scene, restyle() gives the colours and the ground; it returns to the staged
 // path until attach() is called again.
 
 /// Draws into an offscreen colour and depth image and reads the picture back.
@@ -60,10 +61,15 @@ class Offscreen {
   void restyle(const Style& style, const Snapshot& first_frame);
   /// A motes device on the viewer's Vulkan device (motes/vulkan_interop.h), or why not.
   [[nodiscard]] Result<std::unique_ptr<Device>> open_compute_device() const;
-  /// Zero copy: draws `sim` (on a device from open_compute_device; `first_frame` its state now)
-  /// from its own buffers until the next restyle.
-  void attach(Simulation& sim, const Snapshot& first_frame);
+  /// Draws `sim` (`first_frame`: its state now) without the host until the next restyle: zero
+  /// copy from its own buffers when it runs on a device from open_compute_device; or, when it
+  /// runs on CUDA on the viewer's GPU, from memory the viewer shares with CUDA, which copies the
+  /// particles in device to device before each draw. Returns why neither can be (empty when
+  /// attached); the draws stay staged then.
+  std::string attach(Simulation& sim, const Snapshot& first_frame);
   [[nodiscard]] bool attached() const;
+  /// How the particles come to the picture: "zero copy", "CUDA copy" or "staged".
+  [[nodiscard]] const char* path() const;
   /// Draws `frame` (staged; ignored, and may be null, when attached) seen by `camera`; the
   /// reference stays valid until the next call.
   const render::Image& draw(const render::Camera& camera, const Snapshot* frame);
@@ -161,8 +167,9 @@ class Window {
   void restyle(const Style& style, const Snapshot& first_frame);
   /// As Offscreen's.
   [[nodiscard]] Result<std::unique_ptr<Device>> open_compute_device() const;
-  void attach(Simulation& sim, const Snapshot& first_frame);
+  std::string attach(Simulation& sim, const Snapshot& first_frame);
   [[nodiscard]] bool attached() const;
+  [[nodiscard]] const char* path() const;
   [[nodiscard]] const std::string& device_name() const;
   [[nodiscard]] int device_index() const;
 
