@@ -10,7 +10,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -24,6 +23,7 @@
 #include "motes/scene.h"
 #include "motes/simulation.h"
 #ifdef MOTES_HAVE_VIEWER
+#include "motes/view_pick.h"
 #include "motes/viewer.h"
 #endif
 
@@ -106,8 +106,9 @@ Eigen::Vector3f pixel_ray(const render::Camera& camera, render::Size size, float
 }
 
 /// Pick and drag (Shift + left button, docs/viewer.md): the nearest sphere of a dynamic body
-/// under the cursor, tested against every particle of the last snapshot on the host, is pulled
-/// towards the point under the cursor on the plane through it that faces the camera.
+/// under the cursor, picked through a grid of the last snapshot's particles made on the host
+/// (motes/view_pick.h), is pulled towards the point under the cursor on the plane through it that
+/// faces the camera.
 class Grab {
  public:
   /// Seconds in which the pull would close the gap, and the fastest pull (m/s).
@@ -120,28 +121,17 @@ class Grab {
     active_ = false;
     const Eigen::Vector3f eye = camera.position;
     const Eigen::Vector3f d = pixel_ray(camera, size, x, y);
-    const float dd = d.squaredNorm();
-    float best = std::numeric_limits<float>::infinity();
-    for (std::size_t i = 0; i < frame.particle_pos.size(); ++i) {
+    // Static bodies stay where they are, and so does a pinned particle of a cloth or rope
+    // (inverse mass 0 without a body state).
+    const viewer::Pickable pickable = [&](std::uint32_t i) {
       const std::uint32_t body = frame.particle_body[i];
-      if (body >= sim.bodies().size() || sim.bodies()[body].kind == BodyKind::Static) continue;
-      // A pinned particle of a cloth or rope (inverse mass 0) stays where it is.
-      if (!sim.bodies()[body].has_body_state() && frame.particle_vel[i].w == 0.0f) continue;
-      const shared::vec4& p = frame.particle_pos[i];
-      const Eigen::Vector3f c(p.x, p.y, p.z);
-      // |eye + t d - c| = r: the nearer root, in units where t = distance along forward.
-      const Eigen::Vector3f oc = eye - c;
-      const float b = oc.dot(d), q = oc.squaredNorm() - p.w * p.w;
-      const float disc = b * b - dd * q;
-      if (disc < 0.0f) continue;
-      const float t = (-b - std::sqrt(disc)) / dd;
-      if (t > 0.0f && t < best) {
-        best = t;
-        particle_ = static_cast<std::uint32_t>(i);
-        body_ = body;
-      }
-    }
-    if (!std::isfinite(best)) return false;
+      if (body >= sim.bodies().size() || sim.bodies()[body].kind == BodyKind::Static) return false;
+      return sim.bodies()[body].has_body_state() || frame.particle_vel[i].w != 0.0f;
+    };
+    const viewer::PickHit hit = viewer::PickGrid(frame.particle_pos, pickable).pick(eye, d);
+    if (!hit.hit) return false;
+    particle_ = hit.particle;
+    body_ = frame.particle_body[particle_];
     const shared::vec4& p = frame.particle_pos[particle_];
     inverse_mass_ = frame.particle_vel[particle_].w;
     depth_ = (Eigen::Vector3f(p.x, p.y, p.z) - eye).dot((camera.target - eye).normalized());
