@@ -11,10 +11,10 @@
 
 namespace {
 
+using Eigen::Vector3f;
 using motes::shared::vec4;
 using motes::viewer::PickGrid;
 using motes::viewer::PickHit;
-using Eigen::Vector3f;
 
 struct Cloud {
   std::vector<vec4> spheres;
@@ -113,8 +113,8 @@ TEST(ViewPick, GridFindsWhatTheScanFindsOnRandomClouds) {
           dir = random_direction(rng).normalized() * (1.0f + u(rng));
           break;
       }
-      const std::string what = "cloud " + std::to_string(cloud_no) + " ray " +
-                               std::to_string(ray) + " kind " + std::to_string(kind);
+      const std::string what = "cloud " + std::to_string(cloud_no) + " ray " + std::to_string(ray) +
+                               " kind " + std::to_string(kind);
       const PickHit scan = motes::viewer::pick_every_sphere(cloud.spheres, pickable, origin, dir);
       expect_same(grid.pick(origin, dir), scan, what);
       (scan.hit ? hits : misses)++;

@@ -83,7 +83,8 @@ PickGrid::PickGrid(std::span<const shared::vec4> spheres, const Pickable& pickab
   const double budget = kCellsPerSphere * static_cast<double>(kept.size()) + 64.0;
   const auto count_cells = [&](float h) {
     double total = 1.0;
-    for (int a = 0; a < 3; ++a) total *= std::floor(static_cast<double>(extent[a]) / static_cast<double>(h)) + 1.0;
+    for (int a = 0; a < 3; ++a)
+      total *= std::floor(static_cast<double>(extent[a]) / static_cast<double>(h)) + 1.0;
     return total;
   };
   while (count_cells(cell) > budget) cell *= 1.25f;
@@ -99,8 +100,8 @@ PickGrid::PickGrid(std::span<const shared::vec4> spheres, const Pickable& pickab
     const Eigen::Vector3f c(s.x, s.y, s.z);
     std::size_t key = 0;
     for (int a = 2; a >= 0; --a) {
-      const int k = std::clamp(static_cast<int>(std::floor((c[a] - lo_[a]) * inv_cell_)), 0,
-                               n_[a] - 1);
+      const int k =
+          std::clamp(static_cast<int>(std::floor((c[a] - lo_[a]) * inv_cell_)), 0, n_[a] - 1);
       key = key * static_cast<std::size_t>(n_[a]) + static_cast<std::size_t>(k);
     }
     return key;
@@ -163,7 +164,7 @@ PickHit PickGrid::pick(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir
   }
 
   // Tests the spheres of the cells [from, to] (inclusive, clipped to the grid).
-  const auto test_block = [&](const int (&from)[3], const int (&to)[3]) {
+  const auto test_block = [&](const int(&from)[3], const int(&to)[3]) {
     int lo[3];
     int hi[3];
     for (int a = 0; a < 3; ++a) {
@@ -173,10 +174,9 @@ PickHit PickGrid::pick(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir
     }
     for (int z = lo[2]; z <= hi[2]; ++z) {
       for (int y = lo[1]; y <= hi[1]; ++y) {
-        const std::size_t row =
-            (static_cast<std::size_t>(z) * static_cast<std::size_t>(n_[1]) +
-             static_cast<std::size_t>(y)) *
-            static_cast<std::size_t>(n_[0]);
+        const std::size_t row = (static_cast<std::size_t>(z) * static_cast<std::size_t>(n_[1]) +
+                                 static_cast<std::size_t>(y)) *
+                                static_cast<std::size_t>(n_[0]);
         const std::uint32_t first = start_[row + static_cast<std::size_t>(lo[0])];
         const std::uint32_t last = start_[row + static_cast<std::size_t>(hi[0]) + 1];
         for (std::uint32_t k = first; k < last; ++k) {

@@ -58,9 +58,9 @@ class PickGrid {
   [[nodiscard]] std::array<int, 3> cells() const { return {n_[0], n_[1], n_[2]}; }
 
  private:
-  std::vector<shared::vec4> spheres_;  ///< the binned ones, in cell order
-  std::vector<std::uint32_t> index_;   ///< their particle numbers
-  std::vector<std::uint32_t> start_;   ///< cell c's spheres: [start_[c], start_[c + 1])
+  std::vector<shared::vec4> spheres_;             ///< the binned ones, in cell order
+  std::vector<std::uint32_t> index_;              ///< their particle numbers
+  std::vector<std::uint32_t> start_;              ///< cell c's spheres: [start_[c], start_[c + 1])
   Eigen::Vector3f lo_ = Eigen::Vector3f::Zero();  ///< the corner of cell (0, 0, 0)
   float cell_ = 1.0f;
   float inv_cell_ = 1.0f;
