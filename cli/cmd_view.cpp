@@ -45,6 +45,7 @@ struct ViewArgs {
   std::string save_state;
   std::string record;
   bool staged = false;
+  bool no_shadows = false;
 };
 
 #ifdef MOTES_HAVE_VIEWER
@@ -282,6 +283,7 @@ class Surface {
   [[nodiscard]] virtual bool attached() const = 0;
   virtual void set_title(const std::string& title) = 0;
   virtual void set_overlay(const viewer::Segments& segments) = 0;
+  virtual void set_shadows(bool on) = 0;
   [[nodiscard]] virtual const std::string& device_name() const = 0;
   [[nodiscard]] virtual int device_index() const = 0;
   [[nodiscard]] virtual bool real_time() const = 0;
@@ -301,6 +303,7 @@ class TargetSurface : public Surface {
   void attach(Simulation& sim, const Snapshot& first) override { target_->attach(sim, first); }
   [[nodiscard]] bool attached() const override { return target_->attached(); }
   void set_overlay(const viewer::Segments& segments) override { target_->set_overlay(segments); }
+  void set_shadows(bool on) override { target_->set_shadows(on); }
   [[nodiscard]] const std::string& device_name() const override { return target_->device_name(); }
   [[nodiscard]] int device_index() const override { return target_->device_index(); }
   [[nodiscard]] bool real_time() const override { return kRealTime; }
@@ -357,6 +360,9 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
   // The wireframes (W: grid cells, C: contacts), made from the host's copy of the state.
   bool grid_wireframe = false, contact_wireframe = false;
   bool overlay_shown = false, overlay_truncated_said = false;
+  // The particles' shadows on the ground (H; --no-shadows starts without them).
+  bool shadows = !args.no_shadows;
+  surface.set_shadows(shadows);
   // The guards: the warnings seen (each printed once) and the first failure, which pauses the run.
   std::uint64_t stepped_frames = 0, guard_warnings = 0;
   std::string last_warning, guard_failure;
@@ -389,6 +395,10 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     if (in.pause) paused = !paused;
     if (in.grid_wireframe) grid_wireframe = !grid_wireframe;
     if (in.contact_wireframe) contact_wireframe = !contact_wireframe;
+    if (in.shadows) {
+      shadows = !shadows;
+      surface.set_shadows(shadows);
+    }
     if (in.slow_motion) slow = !slow;
     if (in.reset) {
       Result<Scene> reloaded = load_scene_file(args.scene);
@@ -691,6 +701,8 @@ void add_view_command(CLI::App& app) {
   sub->add_flag("--staged", args->staged,
                 "draw from a copy of the particles through the host even where the Vulkan "
                 "backend's buffers could be drawn as they are (zero copy; docs/viewer.md)");
+  sub->add_flag("--no-shadows", args->no_shadows,
+                "start without the particles' shadows on the ground (H turns them on and off)");
   sub->add_flag(
       "--offscreen", args->offscreen,
       "draw without a window (needs --frames, or an --input script that quits; for machines "
