@@ -8,6 +8,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "device_choice.h"
+
 namespace motes::viewer {
 
 const char* result_name(VkResult r) {
@@ -88,21 +90,6 @@ bool layer_available(const char* name) {
   });
 }
 
-int type_rank(VkPhysicalDeviceType t) {
-  switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
-      return 0;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
-      return 1;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
-      return 2;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU:
-      return 3;
-    default:
-      return 4;
-  }
-}
-
 }  // namespace
 
 Gpu::Gpu(const std::vector<const char*>& extensions) : messages_(std::make_unique<Messages>()) {
@@ -171,45 +158,37 @@ void Gpu::open(VkSurfaceKHR surface, int wanted) {
   vkEnumeratePhysicalDevices(instance, &count, nullptr);
   std::vector<VkPhysicalDevice> handles(count);
   vkEnumeratePhysicalDevices(instance, &count, handles.data());
-  int best_rank = 1000;
+  // What each device offers (presenting asked of graphics families alone), then the choice
+  // (device_choice.h).
+  std::vector<DeviceFacts> facts(count);
+  std::vector<std::string> names(count);
   for (std::uint32_t d = 0; d < count; ++d) {
     const VkPhysicalDevice h = handles[d];
     VkPhysicalDeviceProperties props{};
     vkGetPhysicalDeviceProperties(h, &props);
-    if (props.apiVersion < VK_API_VERSION_1_2) continue;
+    facts[d].api_version = props.apiVersion;
+    facts[d].type = props.deviceType;
+    names[d] = props.deviceName;
     std::uint32_t families = 0;
     vkGetPhysicalDeviceQueueFamilyProperties(h, &families, nullptr);
-    std::vector<VkQueueFamilyProperties> fam(families);
-    vkGetPhysicalDeviceQueueFamilyProperties(h, &families, fam.data());
-    // A graphics family that presents; one that computes too ranks first.
-    int chosen = -1;
+    facts[d].families.resize(families);
+    vkGetPhysicalDeviceQueueFamilyProperties(h, &families, facts[d].families.data());
+    facts[d].presents.assign(families, false);
+    if (surface == VK_NULL_HANDLE || props.apiVersion < VK_API_VERSION_1_2) continue;
     for (std::uint32_t f = 0; f < families; ++f) {
-      if ((fam[f].queueFlags & VK_QUEUE_GRAPHICS_BIT) == 0) continue;
-      if (surface != VK_NULL_HANDLE) {
-        VkBool32 present = VK_FALSE;
-        vkGetPhysicalDeviceSurfaceSupportKHR(h, f, surface, &present);
-        if (present != VK_TRUE) continue;
-      }
-      const bool computes = (fam[f].queueFlags & VK_QUEUE_COMPUTE_BIT) != 0;
-      if (chosen < 0 || computes) chosen = static_cast<int>(f);
-      if (computes) break;
-    }
-    if (chosen < 0) continue;
-    const int rank = static_cast<int>(d) == wanted ? -1 : type_rank(props.deviceType);
-    if (rank < best_rank) {
-      best_rank = rank;
-      physical = h;
-      family = static_cast<std::uint32_t>(chosen);
-      family_computes = (fam[family].queueFlags & VK_QUEUE_COMPUTE_BIT) != 0;
-      index = static_cast<int>(d);
-      name = props.deviceName;
+      if ((facts[d].families[f].queueFlags & VK_QUEUE_GRAPHICS_BIT) == 0) continue;
+      VkBool32 present = VK_FALSE;
+      vkGetPhysicalDeviceSurfaceSupportKHR(h, f, surface, &present);
+      facts[d].presents[f] = present == VK_TRUE;
     }
   }
-  if (physical == VK_NULL_HANDLE) {
-    throw std::runtime_error(surface != VK_NULL_HANDLE
-                                 ? "viewer: no Vulkan 1.2 device draws to this window"
-                                 : "viewer: no Vulkan 1.2 device with a graphics queue");
-  }
+  const DeviceChoice choice = choose_device(facts, surface != VK_NULL_HANDLE, wanted);
+  if (choice.device < 0) throw std::runtime_error(choice.error);
+  index = choice.device;
+  physical = handles[static_cast<std::size_t>(index)];
+  family = choice.family;
+  family_computes = choice.family_computes;
+  name = names[static_cast<std::size_t>(index)];
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo q{};
   q.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
