@@ -291,6 +291,16 @@ std::uint32_t Gpu::memory_type(std::uint32_t bits, VkMemoryPropertyFlags flags) 
   throw std::runtime_error("viewer: no suitable Vulkan memory type");
 }
 
+VkDeviceMemory Gpu::allocate(const VkMemoryRequirements& req, VkMemoryPropertyFlags flags) const {
+  VkMemoryAllocateInfo alloc{};
+  alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  alloc.allocationSize = req.size;
+  alloc.memoryTypeIndex = memory_type(req.memoryTypeBits, flags);
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  check(vk.vkAllocateMemory(device, &alloc, nullptr, &memory), "vkAllocateMemory");
+  return memory;
+}
+
 Gpu::~Gpu() {
   if (device != VK_NULL_HANDLE) {
     vk.vkDeviceWaitIdle(device);
@@ -312,13 +322,8 @@ HostBuffer::HostBuffer(const Gpu& g, VkDeviceSize bytes, VkBufferUsageFlags usag
   check(gpu.vk.vkCreateBuffer(gpu.device, &info, nullptr, &buffer), "vkCreateBuffer");
   VkMemoryRequirements req{};
   gpu.vk.vkGetBufferMemoryRequirements(gpu.device, buffer, &req);
-  VkMemoryAllocateInfo alloc{};
-  alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-  alloc.allocationSize = req.size;
-  alloc.memoryTypeIndex =
-      gpu.memory_type(req.memoryTypeBits,
-                      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-  check(gpu.vk.vkAllocateMemory(gpu.device, &alloc, nullptr, &memory), "vkAllocateMemory");
+  memory =
+      gpu.allocate(req, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
   check(gpu.vk.vkBindBufferMemory(gpu.device, buffer, memory, 0), "vkBindBufferMemory");
   check(gpu.vk.vkMapMemory(gpu.device, memory, 0, VK_WHOLE_SIZE, 0, &mapped), "vkMapMemory");
 }
@@ -339,11 +344,7 @@ DeviceBuffer::DeviceBuffer(const Gpu& g, const void* data, VkDeviceSize size,
   check(gpu.vk.vkCreateBuffer(gpu.device, &info, nullptr, &buffer), "vkCreateBuffer");
   VkMemoryRequirements req{};
   gpu.vk.vkGetBufferMemoryRequirements(gpu.device, buffer, &req);
-  VkMemoryAllocateInfo alloc{};
-  alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-  alloc.allocationSize = req.size;
-  alloc.memoryTypeIndex = gpu.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  check(gpu.vk.vkAllocateMemory(gpu.device, &alloc, nullptr, &memory), "vkAllocateMemory");
+  memory = gpu.allocate(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   check(gpu.vk.vkBindBufferMemory(gpu.device, buffer, memory, 0), "vkBindBufferMemory");
   const HostBuffer staging(gpu, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   std::memcpy(staging.mapped, data, size);
@@ -383,11 +384,7 @@ DeviceImage::DeviceImage(const Gpu& g, VkFormat format, VkExtent2D extent, VkIma
   check(gpu.vk.vkCreateImage(gpu.device, &info, nullptr, &image), "vkCreateImage");
   VkMemoryRequirements req{};
   gpu.vk.vkGetImageMemoryRequirements(gpu.device, image, &req);
-  VkMemoryAllocateInfo alloc{};
-  alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-  alloc.allocationSize = req.size;
-  alloc.memoryTypeIndex = gpu.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  check(gpu.vk.vkAllocateMemory(gpu.device, &alloc, nullptr, &memory), "vkAllocateMemory");
+  memory = gpu.allocate(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   check(gpu.vk.vkBindImageMemory(gpu.device, image, memory, 0), "vkBindImageMemory");
   VkImageViewCreateInfo view_info{};
   view_info.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
