@@ -72,7 +72,7 @@ TEST(ViewPick, GridFindsWhatTheScanFindsOnRandomClouds) {
     for (int ray = 0; ray < 200; ++ray) {
       Vector3f origin;
       Vector3f dir = random_direction(rng);
-      const int kind = ray % 6;
+      const int kind = ray % 7;
       const Vector3f inside =
           cloud.lo + Vector3f(u(rng), u(rng), u(rng)).cwiseProduct(cloud.hi - cloud.lo);
       switch (kind) {
@@ -107,6 +107,11 @@ TEST(ViewPick, GridFindsWhatTheScanFindsOnRandomClouds) {
         case 4:  // pointing away from the cloud: a miss
           origin = centre + random_direction(rng).normalized() * size * 2.0f;
           dir = origin - centre + 0.1f * size * random_direction(rng);
+          break;
+        case 5:  // from far away (10 to 1,000 times the cloud's size), towards a point of it
+          origin = centre + random_direction(rng).normalized() * size *
+                                std::pow(10.0f, 1.0f + 2.0f * u(rng));
+          dir = inside - origin;
           break;
         default:  // a pixel ray's length (|dir| > 1), from anywhere near
           origin = centre + random_direction(rng) * size;

@@ -30,28 +30,44 @@ void consider(PickHit& hit, std::uint32_t index, float t) {
 
 }  // namespace
 
-float ray_sphere(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float dd,
+float ray_sphere(const Eigen::Vector3f& origin, const Eigen::Vector3f& unit_dir,
                  const shared::vec4& s) {
-  // |origin + t dir - c| = r: the nearer root.
-  const Eigen::Vector3f oc = origin - Eigen::Vector3f(s.x, s.y, s.z);
-  const float b = oc.dot(dir);
-  const float q = oc.squaredNorm() - s.w * s.w;
-  const float disc = b * b - dd * q;
-  if (!(disc >= 0.0f)) return kInf;
-  return (-b - std::sqrt(disc)) / dd;
+  // The centre's distance along the ray and its offset across it, as sphere.frag: no
+  // |origin - c|^2 - r^2, which loses a small sphere seen from afar to rounding.
+  const Eigen::Vector3f oc = Eigen::Vector3f(s.x, s.y, s.z) - origin;
+  const float along = oc.dot(unit_dir);
+  const Eigen::Vector3f across = oc - along * unit_dir;
+  const float off2 = across.squaredNorm();
+  const float r2 = s.w * s.w;
+  if (!(off2 <= r2)) return kInf;
+  return along - std::sqrt(r2 - off2);
 }
+
+namespace {
+
+/// The ray's length and direction; false when `dir` has no usable length.
+bool unit(const Eigen::Vector3f& dir, float& length, Eigen::Vector3f& unit_dir) {
+  length = dir.norm();
+  if (!(length > 0.0f) || !std::isfinite(length)) return false;
+  unit_dir = dir / length;
+  return true;
+}
+
+}  // namespace
 
 PickHit pick_every_sphere(std::span<const shared::vec4> spheres, const Pickable& pickable,
                           const Eigen::Vector3f& origin, const Eigen::Vector3f& dir) {
   PickHit hit;
-  const float dd = dir.squaredNorm();
-  if (!(dd > 0.0f) || !std::isfinite(dd)) return hit;
+  float length = 0.0f;
+  Eigen::Vector3f u;
+  if (!unit(dir, length, u)) return hit;
   for (std::size_t i = 0; i < spheres.size(); ++i) {
     const auto index = static_cast<std::uint32_t>(i);
     if (pickable && !pickable(index)) continue;
     ++hit.tests;
-    consider(hit, index, ray_sphere(origin, dir, dd, spheres[i]));
+    consider(hit, index, ray_sphere(origin, u, spheres[i]));
   }
+  if (hit.hit) hit.t /= length;
   return hit;
 }
 
@@ -125,10 +141,12 @@ PickGrid::PickGrid(std::span<const shared::vec4> spheres, const Pickable& pickab
   }
 }
 
-PickHit PickGrid::pick(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir) const {
+PickHit PickGrid::pick(const Eigen::Vector3f& origin, const Eigen::Vector3f& ray) const {
   PickHit hit;
-  const float dd = dir.squaredNorm();
-  if (spheres_.empty() || !(dd > 0.0f) || !std::isfinite(dd) || !origin.allFinite()) return hit;
+  // Distances along the unit direction until the end (as pick_every_sphere).
+  float length = 0.0f;
+  Eigen::Vector3f dir;
+  if (spheres_.empty() || !origin.allFinite() || !unit(ray, length, dir)) return hit;
 
   // The grid with a border of one empty cell: every point of a sphere lies inside it.
   float t0 = 0.0f;
@@ -181,7 +199,7 @@ PickHit PickGrid::pick(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir
         const std::uint32_t last = start_[row + static_cast<std::size_t>(hi[0]) + 1];
         for (std::uint32_t k = first; k < last; ++k) {
           ++hit.tests;
-          consider(hit, index_[k], ray_sphere(origin, dir, dd, spheres_[k]));
+          consider(hit, index_[k], ray_sphere(origin, dir, spheres_[k]));
         }
       }
     }
@@ -205,6 +223,7 @@ PickHit PickGrid::pick(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir
     from[a] = to[a] = at[a] + step[a];
     test_block(from, to);
   }
+  if (hit.hit) hit.t /= length;
   return hit;
 }
 

@@ -14,14 +14,14 @@
 
 namespace motes::viewer {
 
-/// Where the ray origin + t dir first meets sphere `s` (xyz centre, w radius): the nearer root t
-/// (in units of |dir|), or +infinity when the ray's line misses it. `dd` is dir's squared norm. A
-/// ray that starts inside the sphere gets a negative t: a pick takes only t > 0.
-float ray_sphere(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float dd,
+/// How far along the ray from `origin` in direction `unit_dir` (unit length) it first meets sphere
+/// `s` (xyz centre, w radius): the nearer root, or +infinity when the ray's line misses it. A ray
+/// that starts inside the sphere gets a negative distance: a pick takes only positive ones.
+float ray_sphere(const Eigen::Vector3f& origin, const Eigen::Vector3f& unit_dir,
                  const shared::vec4& s);
 
-/// What a pick found: the particle with the smallest t > 0 (the lower index of equal ones), and
-/// how many sphere tests it made.
+/// What a pick found: the particle with the nearest hit in front of the origin (ray_sphere; the
+/// lower index of equal ones), where: origin + t dir, and how many sphere tests it made.
 struct PickHit {
   bool hit = false;
   std::uint32_t particle = 0;
@@ -50,7 +50,7 @@ class PickGrid {
   PickGrid(std::span<const shared::vec4> spheres, const Pickable& pickable);
 
   /// The same particle and t as pick_every_sphere over the spheres it was built from.
-  [[nodiscard]] PickHit pick(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir) const;
+  [[nodiscard]] PickHit pick(const Eigen::Vector3f& origin, const Eigen::Vector3f& ray) const;
 
   [[nodiscard]] float cell_size() const { return cell_; }
   /// The lowest corner of cell (0, 0, 0): the least coordinates of the binned centres.
