@@ -188,6 +188,12 @@ TEST(ViewPick, NothingPickableOrNothingToPick) {
   ASSERT_TRUE(from_inside.hit);
   EXPECT_EQ(from_inside.particle, 1u);
   EXPECT_FLOAT_EQ(from_inside.t, 2.0f);
+  // Spread wider than float's range (the extent is infinite): one cell, still the scan's answer.
+  const std::vector<vec4> wide = {{-3e38f, 0, 0, 1}, {3e38f, 0, 0, 1}, {0, 0, 0, 1}};
+  const PickHit middle = PickGrid(wide, nullptr).pick({0, 0, -5}, {0, 0, 1});
+  ASSERT_TRUE(middle.hit);
+  EXPECT_EQ(middle.particle, 2u);
+  EXPECT_EQ(middle.t, motes::viewer::pick_every_sphere(wide, nullptr, {0, 0, -5}, {0, 0, 1}).t);
   // Not finite: left out.
   const std::vector<vec4> bad = {{NAN, 0, 0, 1}, {0, 0, 0, INFINITY}, {3, 0, 0, 1}};
   const PickHit past = PickGrid(bad, nullptr).pick({-5, 0, 0}, {1, 0, 0});

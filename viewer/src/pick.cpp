@@ -103,16 +103,23 @@ PickGrid::PickGrid(std::span<const shared::vec4> spheres, const Pickable& pickab
       total *= std::floor(static_cast<double>(extent[a]) / static_cast<double>(h)) + 1.0;
     return total;
   };
-  while (count_cells(cell) > budget) cell *= 1.25f;
-  cell_ = cell;
-  inv_cell_ = 1.0f / cell;
+  while (count_cells(cell) > budget && std::isfinite(cell)) cell *= 1.25f;
   lo_ = lo;
-  for (int a = 0; a < 3; ++a) {
-    n_[a] = static_cast<int>(std::floor(extent[a] * inv_cell_)) + 1;
+  if (std::isfinite(cell) && std::isfinite(extent.maxCoeff())) {
+    cell_ = cell;
+    inv_cell_ = 1.0f / cell;
+    for (int a = 0; a < 3; ++a) {
+      n_[a] = static_cast<int>(std::floor(extent[a] * inv_cell_)) + 1;
+    }
+  } else {
+    // Spread over more than float's range: one cell, which pick() scans.
+    n_[0] = n_[1] = n_[2] = 1;
+    inv_cell_ = 0.0f;
   }
 
   // Counting sort by cell.
   const auto cell_of = [&](const shared::vec4& s) {
+    if (inv_cell_ == 0.0f) return std::size_t{0};
     const Eigen::Vector3f c(s.x, s.y, s.z);
     std::size_t key = 0;
     for (int a = 2; a >= 0; --a) {
@@ -147,6 +154,16 @@ PickHit PickGrid::pick(const Eigen::Vector3f& origin, const Eigen::Vector3f& ray
   float length = 0.0f;
   Eigen::Vector3f dir;
   if (spheres_.empty() || !origin.allFinite() || !unit(ray, length, dir)) return hit;
+
+  if (n_[0] == 1 && n_[1] == 1 && n_[2] == 1) {
+    // One cell: its spheres are all there is to test.
+    for (std::size_t k = 0; k < spheres_.size(); ++k) {
+      ++hit.tests;
+      consider(hit, index_[k], ray_sphere(origin, dir, spheres_[k]));
+    }
+    if (hit.hit) hit.t /= length;
+    return hit;
+  }
 
   // The grid with a border of one empty cell: every point of a sphere lies inside it.
   float t0 = 0.0f;
