@@ -3,7 +3,9 @@
 // types, --device, and the family preferred.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "device_choice.h"
