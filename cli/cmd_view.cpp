@@ -10,7 +10,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -24,6 +23,7 @@
 #include "motes/scene.h"
 #include "motes/simulation.h"
 #ifdef MOTES_HAVE_VIEWER
+#include "motes/view_pick.h"
 #include "motes/viewer.h"
 #endif
 
@@ -45,6 +45,7 @@ struct ViewArgs {
   std::string save_state;
   std::string record;
   bool staged = false;
+  bool no_shadows = false;
 };
 
 #ifdef MOTES_HAVE_VIEWER
@@ -106,8 +107,9 @@ Eigen::Vector3f pixel_ray(const render::Camera& camera, render::Size size, float
 }
 
 /// Pick and drag (Shift + left button, docs/viewer.md): the nearest sphere of a dynamic body
-/// under the cursor, tested against every particle of the last snapshot on the host, is pulled
-/// towards the point under the cursor on the plane through it that faces the camera.
+/// under the cursor, picked through a grid of the last snapshot's particles made on the host
+/// (motes/view_pick.h), is pulled towards the point under the cursor on the plane through it that
+/// faces the camera.
 class Grab {
  public:
   /// Seconds in which the pull would close the gap, and the fastest pull (m/s).
@@ -120,28 +122,17 @@ class Grab {
     active_ = false;
     const Eigen::Vector3f eye = camera.position;
     const Eigen::Vector3f d = pixel_ray(camera, size, x, y);
-    const float dd = d.squaredNorm();
-    float best = std::numeric_limits<float>::infinity();
-    for (std::size_t i = 0; i < frame.particle_pos.size(); ++i) {
+    // Static bodies stay where they are, and so does a pinned particle of a cloth or rope
+    // (inverse mass 0 without a body state).
+    const viewer::Pickable pickable = [&](std::uint32_t i) {
       const std::uint32_t body = frame.particle_body[i];
-      if (body >= sim.bodies().size() || sim.bodies()[body].kind == BodyKind::Static) continue;
-      // A pinned particle of a cloth or rope (inverse mass 0) stays where it is.
-      if (!sim.bodies()[body].has_body_state() && frame.particle_vel[i].w == 0.0f) continue;
-      const shared::vec4& p = frame.particle_pos[i];
-      const Eigen::Vector3f c(p.x, p.y, p.z);
-      // |eye + t d - c| = r: the nearer root, in units where t = distance along forward.
-      const Eigen::Vector3f oc = eye - c;
-      const float b = oc.dot(d), q = oc.squaredNorm() - p.w * p.w;
-      const float disc = b * b - dd * q;
-      if (disc < 0.0f) continue;
-      const float t = (-b - std::sqrt(disc)) / dd;
-      if (t > 0.0f && t < best) {
-        best = t;
-        particle_ = static_cast<std::uint32_t>(i);
-        body_ = body;
-      }
-    }
-    if (!std::isfinite(best)) return false;
+      if (body >= sim.bodies().size() || sim.bodies()[body].kind == BodyKind::Static) return false;
+      return sim.bodies()[body].has_body_state() || frame.particle_vel[i].w != 0.0f;
+    };
+    const viewer::PickHit hit = viewer::PickGrid(frame.particle_pos, pickable).pick(eye, d);
+    if (!hit.hit) return false;
+    particle_ = hit.particle;
+    body_ = frame.particle_body[particle_];
     const shared::vec4& p = frame.particle_pos[particle_];
     inverse_mass_ = frame.particle_vel[particle_].w;
     depth_ = (Eigen::Vector3f(p.x, p.y, p.z) - eye).dot((camera.target - eye).normalized());
@@ -293,6 +284,7 @@ class Surface {
   [[nodiscard]] virtual const char* path() const = 0;
   virtual void set_title(const std::string& title) = 0;
   virtual void set_overlay(const viewer::Segments& segments) = 0;
+  virtual void set_shadows(bool on) = 0;
   [[nodiscard]] virtual const std::string& device_name() const = 0;
   [[nodiscard]] virtual int device_index() const = 0;
   [[nodiscard]] virtual bool real_time() const = 0;
@@ -315,6 +307,7 @@ class TargetSurface : public Surface {
   [[nodiscard]] bool attached() const override { return target_->attached(); }
   [[nodiscard]] const char* path() const override { return target_->path(); }
   void set_overlay(const viewer::Segments& segments) override { target_->set_overlay(segments); }
+  void set_shadows(bool on) override { target_->set_shadows(on); }
   [[nodiscard]] const std::string& device_name() const override { return target_->device_name(); }
   [[nodiscard]] int device_index() const override { return target_->device_index(); }
   [[nodiscard]] bool real_time() const override { return kRealTime; }
@@ -371,6 +364,9 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
   // The wireframes (W: grid cells, C: contacts), made from the host's copy of the state.
   bool grid_wireframe = false, contact_wireframe = false;
   bool overlay_shown = false, overlay_truncated_said = false;
+  // The particles' shadows on the ground (H; --no-shadows starts without them).
+  bool shadows = !args.no_shadows;
+  surface.set_shadows(shadows);
   // The guards: the warnings seen (each printed once) and the first failure, which pauses the run.
   std::uint64_t stepped_frames = 0, guard_warnings = 0;
   std::string last_warning, guard_failure;
@@ -403,6 +399,10 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     if (in.pause) paused = !paused;
     if (in.grid_wireframe) grid_wireframe = !grid_wireframe;
     if (in.contact_wireframe) contact_wireframe = !contact_wireframe;
+    if (in.shadows) {
+      shadows = !shadows;
+      surface.set_shadows(shadows);
+    }
     if (in.slow_motion) slow = !slow;
     if (in.reset) {
       Result<Scene> reloaded = load_scene_file(args.scene);
@@ -717,6 +717,8 @@ void add_view_command(CLI::App& app) {
                 "draw from a copy of the particles through the host even where the Vulkan "
                 "backend's buffers could be drawn as they are (zero copy) or CUDA could copy "
                 "them on the GPU (the CUDA copy; docs/viewer.md)");
+  sub->add_flag("--no-shadows", args->no_shadows,
+                "start without the particles' shadows on the ground (H turns them on and off)");
   sub->add_flag(
       "--offscreen", args->offscreen,
       "draw without a window (needs --frames, or an --input script that quits; for machines "

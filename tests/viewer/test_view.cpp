@@ -137,11 +137,13 @@ int shell(const std::string& command) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+/// `motes view` of kScene; without shadows unless `shadows` (the headless reference has none:
+/// its shadows are another method's, shadow-mapped).
 std::string view_command(const std::string& backend, const fs::path& png, bool offscreen,
-                         int frames = kFrames) {
+                         int frames = kFrames, bool shadows = false) {
   return std::string(MOTES_CLI_PATH) + " view " + kScene + " --backend " + backend +
          " --size 320x240 --frames " + std::to_string(frames) + " --screenshot " + png.string() +
-         (offscreen ? " --offscreen" : "");
+         (offscreen ? " --offscreen" : "") + (shadows ? "" : " --no-shadows");
 }
 
 void expect_matches(const Image& picture, const Reference& ref) {
@@ -466,6 +468,119 @@ TEST(ViewWireframe, KeysWAndCDrawOverThePicture) {
   EXPECT_EQ(off.rgb, plain.rgb);
 }
 
+/// One sphere above the ground seen offscreen (`shadows` on or off; `ground`: the scene has one),
+/// and where the camera sees the point below its centre along the light, and its centre.
+struct ShadowPicture {
+  Image image;
+  Eigen::Vector2f shadow_pixel, sphere_pixel;
+};
+
+ShadowPicture sphere_above_ground(bool shadows, bool ground) {
+  motes::Snapshot s;
+  const Eigen::Vector3f centre(0.0f, 0.25f, 0.0f);
+  s.particle_pos = {{centre.x(), centre.y(), centre.z(), 0.1f}};
+  s.particle_vel = {{0.0f, 0.0f, 0.0f, 1.0f}};
+  s.particle_body = {0};
+  motes::viewer::Style style;
+  style.look.up = Eigen::Vector3f::UnitY();
+  if (ground) style.look.ground_height = 0.0f;
+  motes::render::Camera camera;
+  camera.position = {0.0f, 1.2f, 2.0f};
+  camera.target = {0.1f, 0.0f, 0.0f};
+  camera.up = Eigen::Vector3f::UnitY();
+  motes::viewer::Offscreen view({kWidth, kHeight});
+  view.restyle(style, s);
+  view.set_shadows(shadows);
+  ShadowPicture out;
+  out.image = view.draw(camera, &s);
+  // The light as viewer/src/style.cpp sets it (from above, left and behind the camera), the
+  // centre cast along it onto the ground, and both points' pixels (motes/render.h's camera).
+  const Eigen::Vector3f forward = (camera.target - camera.position).normalized();
+  const Eigen::Vector3f right = forward.cross(camera.up).normalized();
+  const Eigen::Vector3f view_up = right.cross(forward);
+  const Eigen::Vector3f up = style.look.up;
+  const Eigen::Vector3f light = (up - 0.7f * right - 0.35f * forward).normalized();
+  const Eigen::Vector3f below = centre - light * (centre.dot(up) / light.dot(up));
+  const float focal = 0.5f * kHeight / std::tan(0.5f * camera.fov_degrees * 3.14159265f / 180.0f);
+  const auto pixel = [&](const Eigen::Vector3f& p) {
+    const Eigen::Vector3f rel = p - camera.position;
+    const float z = rel.dot(forward);
+    return Eigen::Vector2f(0.5f * kWidth + focal * rel.dot(right) / z,
+                           0.5f * kHeight - focal * rel.dot(view_up) / z);
+  };
+  out.shadow_pixel = pixel(below);
+  out.sphere_pixel = pixel(centre);
+  return out;
+}
+
+/// The sum of the three channels of pixel `p` (rounded down to a pixel).
+int brightness(const Image& image, const Eigen::Vector2f& p) {
+  const auto at = static_cast<std::size_t>(
+      3 * (static_cast<int>(p.y()) * image.width + static_cast<int>(p.x())));
+  return image.rgb[at] + image.rgb[at + 1] + image.rgb[at + 2];
+}
+
+TEST(ViewShadows, ASphereDarkensTheGroundBelowItAlongTheLight) {
+  const ShadowPicture on = sphere_above_ground(true, true);
+  const ShadowPicture off = sphere_above_ground(false, true);
+  ASSERT_EQ(on.image.rgb.size(), off.image.rgb.size());
+  // The point below the centre along the light: in the picture, on the ground (not behind the
+  // sphere), and darker with the shadow.
+  const Eigen::Vector2f s = on.shadow_pixel;
+  ASSERT_GT(s.x(), 0.0f);
+  ASSERT_LT(s.x(), kWidth);
+  ASSERT_GT(s.y(), 0.0f);
+  ASSERT_LT(s.y(), kHeight);
+  const int lit = brightness(off.image, s), shaded = brightness(on.image, s);
+  std::printf(
+      "below the sphere along the light, pixel (%.0f, %.0f): %d without the shadow, %d "
+      "with it\n",
+      static_cast<double>(s.x()), static_cast<double>(s.y()), lit, shaded);
+  EXPECT_LT(shaded, lit - 60);
+  // The sphere itself is as it was; nothing is brighter; every pixel that changed lies near the
+  // shadow (the sphere's radius is 0.1 m, some 25 pixels here), the rest of the picture is
+  // unchanged.
+  EXPECT_EQ(brightness(on.image, on.sphere_pixel), brightness(off.image, off.sphere_pixel));
+  int changed = 0, brighter = 0, far_changed = 0;
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      const Eigen::Vector2f p(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
+      const int a = brightness(on.image, p), b = brightness(off.image, p);
+      if (a == b) continue;
+      ++changed;
+      if (a > b) ++brighter;
+      if ((p - s).norm() > 60.0f) ++far_changed;
+    }
+  }
+  std::printf("pixels changed by the shadow %d, brighter %d, more than 60 pixels away %d\n",
+              changed, brighter, far_changed);
+  EXPECT_GT(changed, 200);
+  EXPECT_EQ(brighter, 0);
+  EXPECT_EQ(far_changed, 0);
+}
+
+TEST(ViewShadows, NoGroundNoShadow) {
+  EXPECT_EQ(sphere_above_ground(true, false).image.rgb,
+            sphere_above_ground(false, false).image.rgb);
+}
+
+TEST(ViewShadows, KeyHTurnsThemOffAndOn) {
+  const auto run = [](const std::string& tag, const std::string& script, bool no_shadows) {
+    const fs::path png = scratch(tag + ".png");
+    std::string command = std::string(MOTES_CLI_PATH) + " view " + kScene +
+                          " --backend openmp --offscreen --size 320x240 --frames 4 --screenshot " +
+                          png.string() + (no_shadows ? " --no-shadows" : "");
+    if (!script.empty()) command += " --input " + write_file(tag + ".txt", script).string();
+    EXPECT_EQ(shell(command), 0) << command;
+    return load_png(png);
+  };
+  const Image with = run("shadows-on", "", false);
+  const Image without = run("shadows-off", "", true);
+  EXPECT_NE(with.rgb, without.rgb);
+  EXPECT_EQ(run("shadows-key-off", "0 key h\n", false).rgb, without.rgb);
+  EXPECT_EQ(run("shadows-key-on", "0 key h\n", true).rgb, with.rgb);
+}
+
 TEST(ViewScript, QuitEndsARunWithoutAFrameLimit) {
   const fs::path script = write_file("quit.txt", "3 quit\n");
   const fs::path state = scratch("quit.state");
@@ -704,7 +819,8 @@ void expect_pictures_match_the_staged_path(const std::string& backend, const std
     for (int staged = 0; staged < 2; ++staged) {
       const std::string tag = backend + "-" + color_by + (staged != 0 ? "-staged" : "-direct");
       const fs::path png = scratch(tag + ".png"), out = scratch(tag + ".txt");
-      ASSERT_EQ(shell(view_command(backend, png, true, 8) + " --color-by " + color_by +
+      // With shadows: both paths cast them from the same per-instance positions.
+      ASSERT_EQ(shell(view_command(backend, png, true, 8, true) + " --color-by " + color_by +
                       (staged != 0 ? " --staged" : "") + " > " + out.string()),
                 0);
       const std::string text = read_text(out);

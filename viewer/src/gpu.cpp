@@ -8,6 +8,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "device_choice.h"
+
 namespace motes::viewer {
 
 const char* result_name(VkResult r) {
@@ -88,21 +90,6 @@ bool layer_available(const char* name) {
   });
 }
 
-int type_rank(VkPhysicalDeviceType t) {
-  switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
-      return 0;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
-      return 1;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
-      return 2;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU:
-      return 3;
-    default:
-      return 4;
-  }
-}
-
 }  // namespace
 
 Gpu::Gpu(const std::vector<const char*>& extensions) : messages_(std::make_unique<Messages>()) {
@@ -171,45 +158,37 @@ void Gpu::open(VkSurfaceKHR surface, int wanted) {
   vkEnumeratePhysicalDevices(instance, &count, nullptr);
   std::vector<VkPhysicalDevice> handles(count);
   vkEnumeratePhysicalDevices(instance, &count, handles.data());
-  int best_rank = 1000;
+  // What each device offers (presenting asked of graphics families alone), then the choice
+  // (device_choice.h).
+  std::vector<DeviceFacts> facts(count);
+  std::vector<std::string> names(count);
   for (std::uint32_t d = 0; d < count; ++d) {
     const VkPhysicalDevice h = handles[d];
     VkPhysicalDeviceProperties props{};
     vkGetPhysicalDeviceProperties(h, &props);
-    if (props.apiVersion < VK_API_VERSION_1_2) continue;
+    facts[d].api_version = props.apiVersion;
+    facts[d].type = props.deviceType;
+    names[d] = props.deviceName;
     std::uint32_t families = 0;
     vkGetPhysicalDeviceQueueFamilyProperties(h, &families, nullptr);
-    std::vector<VkQueueFamilyProperties> fam(families);
-    vkGetPhysicalDeviceQueueFamilyProperties(h, &families, fam.data());
-    // A graphics family that presents; one that computes too ranks first.
-    int chosen = -1;
+    facts[d].families.resize(families);
+    vkGetPhysicalDeviceQueueFamilyProperties(h, &families, facts[d].families.data());
+    facts[d].presents.assign(families, false);
+    if (surface == VK_NULL_HANDLE || props.apiVersion < VK_API_VERSION_1_2) continue;
     for (std::uint32_t f = 0; f < families; ++f) {
-      if ((fam[f].queueFlags & VK_QUEUE_GRAPHICS_BIT) == 0) continue;
-      if (surface != VK_NULL_HANDLE) {
-        VkBool32 present = VK_FALSE;
-        vkGetPhysicalDeviceSurfaceSupportKHR(h, f, surface, &present);
-        if (present != VK_TRUE) continue;
-      }
-      const bool computes = (fam[f].queueFlags & VK_QUEUE_COMPUTE_BIT) != 0;
-      if (chosen < 0 || computes) chosen = static_cast<int>(f);
-      if (computes) break;
-    }
-    if (chosen < 0) continue;
-    const int rank = static_cast<int>(d) == wanted ? -1 : type_rank(props.deviceType);
-    if (rank < best_rank) {
-      best_rank = rank;
-      physical = h;
-      family = static_cast<std::uint32_t>(chosen);
-      family_computes = (fam[family].queueFlags & VK_QUEUE_COMPUTE_BIT) != 0;
-      index = static_cast<int>(d);
-      name = props.deviceName;
+      if ((facts[d].families[f].queueFlags & VK_QUEUE_GRAPHICS_BIT) == 0) continue;
+      VkBool32 present = VK_FALSE;
+      vkGetPhysicalDeviceSurfaceSupportKHR(h, f, surface, &present);
+      facts[d].presents[f] = present == VK_TRUE;
     }
   }
-  if (physical == VK_NULL_HANDLE) {
-    throw std::runtime_error(surface != VK_NULL_HANDLE
-                                 ? "viewer: no Vulkan 1.2 device draws to this window"
-                                 : "viewer: no Vulkan 1.2 device with a graphics queue");
-  }
+  const DeviceChoice choice = choose_device(facts, surface != VK_NULL_HANDLE, wanted);
+  if (choice.device < 0) throw std::runtime_error(choice.error);
+  index = choice.device;
+  physical = handles[static_cast<std::size_t>(index)];
+  family = choice.family;
+  family_computes = choice.family_computes;
+  name = names[static_cast<std::size_t>(index)];
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo q{};
   q.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
@@ -324,6 +303,16 @@ std::uint32_t Gpu::memory_type(std::uint32_t bits, VkMemoryPropertyFlags flags) 
   throw std::runtime_error("viewer: no suitable Vulkan memory type");
 }
 
+VkDeviceMemory Gpu::allocate(const VkMemoryRequirements& req, VkMemoryPropertyFlags flags) const {
+  VkMemoryAllocateInfo alloc{};
+  alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  alloc.allocationSize = req.size;
+  alloc.memoryTypeIndex = memory_type(req.memoryTypeBits, flags);
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  check(vk.vkAllocateMemory(device, &alloc, nullptr, &memory), "vkAllocateMemory");
+  return memory;
+}
+
 Gpu::~Gpu() {
   if (device != VK_NULL_HANDLE) {
     vk.vkDeviceWaitIdle(device);
@@ -345,13 +334,8 @@ HostBuffer::HostBuffer(const Gpu& g, VkDeviceSize bytes, VkBufferUsageFlags usag
   check(gpu.vk.vkCreateBuffer(gpu.device, &info, nullptr, &buffer), "vkCreateBuffer");
   VkMemoryRequirements req{};
   gpu.vk.vkGetBufferMemoryRequirements(gpu.device, buffer, &req);
-  VkMemoryAllocateInfo alloc{};
-  alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-  alloc.allocationSize = req.size;
-  alloc.memoryTypeIndex =
-      gpu.memory_type(req.memoryTypeBits,
-                      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-  check(gpu.vk.vkAllocateMemory(gpu.device, &alloc, nullptr, &memory), "vkAllocateMemory");
+  memory =
+      gpu.allocate(req, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
   check(gpu.vk.vkBindBufferMemory(gpu.device, buffer, memory, 0), "vkBindBufferMemory");
   check(gpu.vk.vkMapMemory(gpu.device, memory, 0, VK_WHOLE_SIZE, 0, &mapped), "vkMapMemory");
 }
@@ -372,11 +356,7 @@ DeviceBuffer::DeviceBuffer(const Gpu& g, const void* data, VkDeviceSize size,
   check(gpu.vk.vkCreateBuffer(gpu.device, &info, nullptr, &buffer), "vkCreateBuffer");
   VkMemoryRequirements req{};
   gpu.vk.vkGetBufferMemoryRequirements(gpu.device, buffer, &req);
-  VkMemoryAllocateInfo alloc{};
-  alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-  alloc.allocationSize = req.size;
-  alloc.memoryTypeIndex = gpu.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  check(gpu.vk.vkAllocateMemory(gpu.device, &alloc, nullptr, &memory), "vkAllocateMemory");
+  memory = gpu.allocate(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   check(gpu.vk.vkBindBufferMemory(gpu.device, buffer, memory, 0), "vkBindBufferMemory");
   const HostBuffer staging(gpu, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   std::memcpy(staging.mapped, data, size);
@@ -416,11 +396,7 @@ DeviceImage::DeviceImage(const Gpu& g, VkFormat format, VkExtent2D extent, VkIma
   check(gpu.vk.vkCreateImage(gpu.device, &info, nullptr, &image), "vkCreateImage");
   VkMemoryRequirements req{};
   gpu.vk.vkGetImageMemoryRequirements(gpu.device, image, &req);
-  VkMemoryAllocateInfo alloc{};
-  alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-  alloc.allocationSize = req.size;
-  alloc.memoryTypeIndex = gpu.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  check(gpu.vk.vkAllocateMemory(gpu.device, &alloc, nullptr, &memory), "vkAllocateMemory");
+  memory = gpu.allocate(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   check(gpu.vk.vkBindImageMemory(gpu.device, image, memory, 0), "vkBindImageMemory");
   VkImageViewCreateInfo view_info{};
   view_info.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;

@@ -50,6 +50,9 @@ class Gpu {
 
   /// A memory type index with `flags` among `bits`; throws when none.
   std::uint32_t memory_type(std::uint32_t bits, VkMemoryPropertyFlags flags) const;
+  /// Memory for `req` of a type with `flags` (a buffer's or image's, then bound to it); throws
+  /// when there is none.
+  VkDeviceMemory allocate(const VkMemoryRequirements& req, VkMemoryPropertyFlags flags) const;
 
   VkInstance instance = VK_NULL_HANDLE;
   VkPhysicalDevice physical = VK_NULL_HANDLE;

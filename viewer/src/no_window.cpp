@@ -15,6 +15,7 @@ render::Size Window::size() const { return {}; }
 void Window::draw(const render::Camera& /*camera*/, const Snapshot* /*frame*/,
                   render::Image* /*screenshot*/) {}
 void Window::set_overlay(const Segments& /*segments*/) {}
+void Window::set_shadows(bool /*on*/) {}
 void Window::restyle(const Style& /*style*/, const Snapshot& /*first_frame*/) {}
 Result<std::unique_ptr<Device>> Window::open_compute_device() const {
   return Status::error("built without GLFW");

@@ -46,7 +46,8 @@ struct Offscreen::Impl {
   std::optional<Styler> styler;
   std::optional<Particles> particles;
   std::optional<Painter> painter;
-  Segments overlay;  ///< the wireframe (set_overlay), given to the painter at each draw
+  Segments overlay;     ///< the wireframe (set_overlay), given to the painter at each draw
+  bool shadows = true;  ///< set_shadows, given to the painter at each draw
   std::optional<DeviceImage> color;
   std::optional<DeviceImage> depth;
   std::optional<HostBuffer> readback;
@@ -89,6 +90,7 @@ const render::Image& Offscreen::draw(const render::Camera& camera, const Snapsho
   m.particles->refresh();  // the CUDA path's copy
   VkCommandBuffer cmd = m.gpu.begin_commands();
   m.painter->set_segments(m.overlay);
+  m.painter->set_shadows(m.shadows);
   m.painter->record(cmd, m.framebuffer, m.extent, m.styler->constants(camera, m.size));
   record_readback(m.gpu, cmd, m.color->image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, m.extent,
                   m.readback->buffer);
@@ -98,6 +100,8 @@ const render::Image& Offscreen::draw(const render::Camera& camera, const Snapsho
 }
 
 void Offscreen::set_overlay(const Segments& segments) { impl_->overlay = segments; }
+
+void Offscreen::set_shadows(bool on) { impl_->shadows = on; }
 
 const std::string& Offscreen::device_name() const { return impl_->gpu.name; }
 

@@ -108,6 +108,7 @@ Painter::Painter(const Gpu& gpu, const Particles& particles, VkFormat color_form
   check(gpu.vk.vkCreatePipelineLayout(gpu.device, &layout, nullptr, &layout_),
         "vkCreatePipelineLayout");
   backdrop_ = make_pipeline("backdrop.vert", "backdrop.frag", Kind::Backdrop);
+  shadows_ = make_pipeline("shadow.vert", "shadow.frag", Kind::Shadows);
   spheres_ = make_pipeline("sphere.vert", "sphere.frag", Kind::Spheres);
   lines_ = make_pipeline("lines.vert", "lines.frag", Kind::Lines);
 }
@@ -132,6 +133,7 @@ void Painter::set_segments(const Segments& segments) {
 
 VkPipeline Painter::make_pipeline(const char* vert, const char* frag, Kind kind) const {
   const bool spheres = kind == Kind::Spheres;
+  const bool shadows = kind == Kind::Shadows;
   const bool lines = kind == Kind::Lines;
   const VkShaderModule vs = make_module(gpu_, vert);
   const VkShaderModule fs = make_module(gpu_, frag);
@@ -165,6 +167,12 @@ VkPipeline Painter::make_pipeline(const char* vert, const char* frag, Kind kind)
     input.pVertexBindingDescriptions = bindings;
     input.vertexAttributeDescriptionCount = 2;
     input.pVertexAttributeDescriptions = attributes;
+  } else if (shadows) {
+    // The spheres alone: the draw binds the colours too (Particles::record_draw), unread.
+    input.vertexBindingDescriptionCount = 1;
+    input.pVertexBindingDescriptions = bindings;
+    input.vertexAttributeDescriptionCount = 1;
+    input.pVertexAttributeDescriptions = attributes;
   } else if (lines) {
     input.vertexBindingDescriptionCount = 1;
     input.pVertexBindingDescriptions = &line_binding;
@@ -173,9 +181,9 @@ VkPipeline Painter::make_pipeline(const char* vert, const char* frag, Kind kind)
   }
   VkPipelineInputAssemblyStateCreateInfo assembly{};
   assembly.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO;
-  assembly.topology = spheres ? VK_PRIMITIVE_TOPOLOGY_TRIANGLE_STRIP
-                      : lines ? VK_PRIMITIVE_TOPOLOGY_LINE_LIST
-                              : VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+  assembly.topology = spheres || shadows ? VK_PRIMITIVE_TOPOLOGY_TRIANGLE_STRIP
+                      : lines            ? VK_PRIMITIVE_TOPOLOGY_LINE_LIST
+                                         : VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
   VkPipelineViewportStateCreateInfo viewport{};
   viewport.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO;
   viewport.viewportCount = 1;
@@ -192,13 +200,35 @@ VkPipeline Painter::make_pipeline(const char* vert, const char* frag, Kind kind)
   VkPipelineDepthStencilStateCreateInfo depth{};
   depth.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO;
   // A wireframe is drawn over everything (a contact's segment lies inside its two spheres).
+  // Depth is near / distance: greater is nearer, 0 as cleared. The spheres go first; the
+  // shadows, on the ground, where no sphere is in front (they leave the depth as it is); the
+  // backdrop last, where no sphere is in front of the ground (the sky, at depth 0, where none
+  // is).
   depth.depthTestEnable = lines ? VK_FALSE : VK_TRUE;
-  depth.depthWriteEnable = lines ? VK_FALSE : VK_TRUE;
-  // Depth is near / distance: greater is nearer. The backdrop goes first and sets every pixel.
-  depth.depthCompareOp = spheres ? VK_COMPARE_OP_GREATER : VK_COMPARE_OP_ALWAYS;
+  depth.depthWriteEnable = lines || shadows ? VK_FALSE : VK_TRUE;
+  depth.depthCompareOp =
+      kind == Kind::Backdrop ? VK_COMPARE_OP_GREATER_OR_EQUAL : VK_COMPARE_OP_GREATER;
   VkPipelineColorBlendAttachmentState blend{};
   blend.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
                          VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+  if (shadows) {
+    // The light left on the ground (shadow.frag), the least of overlapping shadows' (MIN does
+    // not use the factors), in alpha alone.
+    blend.colorWriteMask = VK_COLOR_COMPONENT_A_BIT;
+    blend.blendEnable = VK_TRUE;
+    blend.srcColorBlendFactor = blend.dstColorBlendFactor = VK_BLEND_FACTOR_ONE;
+    blend.srcAlphaBlendFactor = blend.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+    blend.colorBlendOp = blend.alphaBlendOp = VK_BLEND_OP_MIN;
+  } else if (kind == Kind::Backdrop) {
+    // The sky and ground times that light (1, as cleared, where there is no shadow); alpha 1.
+    blend.blendEnable = VK_TRUE;
+    blend.srcColorBlendFactor = VK_BLEND_FACTOR_DST_ALPHA;
+    blend.dstColorBlendFactor = VK_BLEND_FACTOR_ZERO;
+    blend.colorBlendOp = VK_BLEND_OP_ADD;
+    blend.srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+    blend.dstAlphaBlendFactor = VK_BLEND_FACTOR_ZERO;
+    blend.alphaBlendOp = VK_BLEND_OP_ADD;
+  }
   VkPipelineColorBlendStateCreateInfo blending{};
   blending.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO;
   blending.attachmentCount = 1;
@@ -254,10 +284,16 @@ void Painter::record(VkCommandBuffer cmd, VkFramebuffer framebuffer, VkExtent2D 
   gpu_.vk.vkCmdPushConstants(cmd, layout_,
                              VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
                              sizeof(ViewConstants), constants.v.data());
-  gpu_.vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, backdrop_);
-  gpu_.vk.vkCmdDraw(cmd, 3, 1, 0, 0);
+  // The spheres; the shadows into the cleared alpha where no sphere hides the ground (grid_x.w,
+  // view.glsl: 1 when the scene has a ground); the backdrop scaled by it.
   gpu_.vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, spheres_);
   particles_.record_draw(cmd, layout_);
+  if (shadows_on_ && constants.v[31] > 0.5f) {
+    gpu_.vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, shadows_);
+    particles_.record_draw(cmd, layout_);
+  }
+  gpu_.vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, backdrop_);
+  gpu_.vk.vkCmdDraw(cmd, 3, 1, 0, 0);
   if (segment_points_ > 0) {
     gpu_.vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, lines_);
     const VkDeviceSize offset = 0;
@@ -272,6 +308,7 @@ Painter::~Painter() {
   gpu_.vk.vkDeviceWaitIdle(gpu_.device);
   if (lines_ != VK_NULL_HANDLE) gpu_.vk.vkDestroyPipeline(gpu_.device, lines_, nullptr);
   if (spheres_ != VK_NULL_HANDLE) gpu_.vk.vkDestroyPipeline(gpu_.device, spheres_, nullptr);
+  if (shadows_ != VK_NULL_HANDLE) gpu_.vk.vkDestroyPipeline(gpu_.device, shadows_, nullptr);
   if (backdrop_ != VK_NULL_HANDLE) gpu_.vk.vkDestroyPipeline(gpu_.device, backdrop_, nullptr);
   if (layout_ != VK_NULL_HANDLE) gpu_.vk.vkDestroyPipelineLayout(gpu_.device, layout_, nullptr);
   if (render_pass_ != VK_NULL_HANDLE) {

@@ -1,5 +1,6 @@
-// The render pass and the three pipelines (backdrop: sky and ground; spheres: one quad per
-// particle; lines: a wireframe over the picture), and the copy of a drawn picture to the host.
+// The render pass and the four pipelines (shadows: what the particles' shadows leave of the
+// ground's light; backdrop: sky and ground; spheres: one quad per particle; lines: a wireframe over
+// the picture), and the copy of a drawn picture to the host.
 #pragma once
 
 #include <memory>
@@ -30,8 +31,10 @@ class Painter {
   /// The wireframe drawn over the spheres from the next record on (none when empty). The previous
   /// draw must be done.
   void set_segments(const Segments& segments);
-  /// Records what the particles need before the pass, then the pass: clear, backdrop, spheres,
-  /// the wireframe.
+  /// Whether the particles' shadows are drawn on the ground (when the scene has one).
+  void set_shadows(bool on) { shadows_on_ = on; }
+  /// Records what the particles need before the pass, then the pass: clear, spheres, shadows,
+  /// backdrop, the wireframe.
   void record(VkCommandBuffer cmd, VkFramebuffer framebuffer, VkExtent2D extent,
               const ViewConstants& constants) const;
 
@@ -39,7 +42,7 @@ class Painter {
   [[nodiscard]] VkFormat depth_format() const { return depth_format_; }
 
  private:
-  enum class Kind { Backdrop, Spheres, Lines };
+  enum class Kind { Backdrop, Shadows, Spheres, Lines };
   VkPipeline make_pipeline(const char* vert, const char* frag, Kind kind) const;
 
   const Gpu& gpu_;
@@ -48,10 +51,12 @@ class Painter {
   VkRenderPass render_pass_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline backdrop_ = VK_NULL_HANDLE;
+  VkPipeline shadows_ = VK_NULL_HANDLE;
   VkPipeline spheres_ = VK_NULL_HANDLE;
   VkPipeline lines_ = VK_NULL_HANDLE;
   std::unique_ptr<HostBuffer> segments_;  ///< the wireframe's points (set_segments)
   std::uint32_t segment_points_ = 0;
+  bool shadows_on_ = true;
 };
 
 /// A framebuffer of a colour view and a depth view.

@@ -44,8 +44,8 @@ class Particles {
   /// Outside the render pass, before it: on the zero-copy path the barrier after motes' writes
   /// (and after the last frame's reads) and the speed reduction.
   void record_before(VkCommandBuffer cmd) const;
-  /// Inside the render pass with the sphere pipeline bound (`layout` its layout): the colours'
-  /// set, the two per-instance buffers and the draw.
+  /// Inside the render pass with the sphere or the shadow pipeline bound (`layout` their layout):
+  /// the colours' set, the two per-instance buffers and the draw.
   void record_draw(VkCommandBuffer cmd, VkPipelineLayout layout) const;
   /// After the render pass: on the CUDA path the shared memory given back to CUDA.
   void record_after(VkCommandBuffer cmd) const;

@@ -25,6 +25,7 @@ void Input::merge(const Input& o) {
   record = record || o.record;
   grid_wireframe = grid_wireframe || o.grid_wireframe;
   contact_wireframe = contact_wireframe || o.contact_wireframe;
+  shadows = shadows || o.shadows;
   quit = quit || o.quit;
   if (o.grab_start || o.grabbing || o.grab_end) {
     cursor_x = o.cursor_x;
@@ -72,6 +73,8 @@ bool press_key(const std::string& key, Input& in) {
     in.grid_wireframe = true;
   } else if (k == "c") {
     in.contact_wireframe = true;
+  } else if (k == "h") {
+    in.shadows = true;
   } else if (k == "q" || k == "escape" || k == "esc") {
     in.quit = true;
   } else {
@@ -113,8 +116,8 @@ Script Script::parse(const std::string& text, const std::string& name) {
       if (what == "key") {
         expect_words(3, 3, "FRAME key NAME");
         if (!press_key(w[2], e.input)) {
-          throw BadLine(
-              fmt::format("unknown key '{}' (space, period, r, s, p, v, q, escape)", w[2]));
+          throw BadLine(fmt::format(
+              "unknown key '{}' (space, period, r, s, p, v, w, c, h, q, escape)", w[2]));
         }
         script.events_.push_back(e);
       } else if (what == "quit") {

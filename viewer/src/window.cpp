@@ -70,6 +70,9 @@ struct Window::Impl {
                            case GLFW_KEY_C:
                              in.contact_wireframe = true;
                              break;
+                           case GLFW_KEY_H:
+                             in.shadows = true;
+                             break;
                            case GLFW_KEY_ESCAPE:
                            case GLFW_KEY_Q:
                              in.quit = true;
@@ -257,6 +260,7 @@ struct Window::Impl {
     check(gpu.vk.vkBeginCommandBuffer(command, &begin), "vkBeginCommandBuffer");
     const render::Size size{static_cast<int>(extent.width), static_cast<int>(extent.height)};
     painter->set_segments(overlay);
+    painter->set_shadows(shadows);
     painter->record(command, framebuffers[index], extent, styler->constants(camera, size));
     const bool copy = screenshot != nullptr && readback.has_value();
     if (copy) {
@@ -311,7 +315,8 @@ struct Window::Impl {
   bool resized = false;
   std::optional<Particles> particles;  // before the painter, which draws them
   std::optional<Painter> painter;
-  Segments overlay;  ///< the wireframe (set_overlay), given to the painter at each draw
+  Segments overlay;     ///< the wireframe (set_overlay), given to the painter at each draw
+  bool shadows = true;  ///< set_shadows, given to the painter at each draw
   std::optional<DeviceImage> depth;
   std::optional<HostBuffer> readback;
   std::vector<VkImage> images;
@@ -391,6 +396,8 @@ render::Size Window::size() const {
 }
 
 void Window::set_overlay(const Segments& segments) { impl_->overlay = segments; }
+
+void Window::set_shadows(bool on) { impl_->shadows = on; }
 
 void Window::draw(const render::Camera& camera, const Snapshot* frame, render::Image* screenshot) {
   impl_->draw(camera, frame, screenshot);

@@ -75,6 +75,9 @@ class Offscreen {
   const render::Image& draw(const render::Camera& camera, const Snapshot* frame);
   /// The wireframe drawn over the particles from the next draw on (none when empty).
   void set_overlay(const Segments& segments);
+  /// Whether the next draws cast the particles' shadows on the ground (when the scene has one;
+  /// on until set).
+  void set_shadows(bool on);
   /// The Vulkan device that draws, and its place in the loader's order.
   [[nodiscard]] const std::string& device_name() const;
   [[nodiscard]] int device_index() const;
@@ -104,6 +107,7 @@ struct Input {
   bool record = false;             ///< V: start or stop recording a video
   bool grid_wireframe = false;     ///< W: the collision grid's occupied cells on or off
   bool contact_wireframe = false;  ///< C: the contacts on or off
+  bool shadows = false;            ///< H: the shadows on the ground on or off
   bool quit = false;               ///< Esc, Q or the window closed
   /// Shift + left button: grab (pick and drag). grab_start on the press, grabbing while held
   /// (the press's frame too), grab_end on the release; the cursor in drawable pixels (x right, y
@@ -120,8 +124,8 @@ struct Input {
 
 /// Scripted input (`motes view --input FILE`, docs/viewer.md): timed events by frame number, one
 /// a line, turned into the same Input a person's keys and mouse give. Lines: `FRAME key NAME`
-/// (space, period or ., r, s, p, v, w, c, q, escape), `FRAME wheel STEPS`, `FRAME drag X0 Y0 X1 Y1
-/// N [left|right|middle|shift]` (pressed at pixel (X0, Y0), moved evenly to (X1, Y1) over the N
+/// (space, period or ., r, s, p, v, w, c, h, q, escape), `FRAME wheel STEPS`, `FRAME drag X0 Y0 X1
+/// Y1 N [left|right|middle|shift]` (pressed at pixel (X0, Y0), moved evenly to (X1, Y1) over the N
 /// frames after FRAME, released at FRAME + N; shift: Shift + left, a grab), `FRAME quit`; `#`
 /// starts a comment.
 class Script {
@@ -163,6 +167,8 @@ class Window {
   void draw(const render::Camera& camera, const Snapshot* frame, render::Image* screenshot);
   /// The wireframe drawn over the particles from the next draw on (none when empty).
   void set_overlay(const Segments& segments);
+  /// As Offscreen's.
+  void set_shadows(bool on);
   /// Colours and extent of a scene (as Offscreen::restyle).
   void restyle(const Style& style, const Snapshot& first_frame);
   /// As Offscreen's.
