@@ -6,6 +6,8 @@
 # CUDA, by the CUDA copy and --staged. Each run prints its summary line: step, copy to the host and
 # draw (which holds the CUDA copy), ms a frame. Run from the repository root after `. scripts/gpu/prelude.sh`:
 #   scripts/gpu/view-costs.sh [FRAMES] [SIZES...]      e.g. scripts/gpu/view-costs.sh 20 160 16000
+# RUNS (a |-separated list of backend options, default all four) and VIEW_ARGS (added to every
+# run, e.g. --no-shadows) choose what runs.
 set -euo pipefail
 frames=${1:-20}
 shift || true
@@ -34,10 +36,11 @@ JSON
 for boxes in "${sizes[@]}"; do
   file=$dir/boxes-$boxes.json
   scene "$boxes" "$file"
-  for run in "vulkan" "vulkan --staged" "cuda" "cuda --staged"; do
-    echo "== $((64 * boxes)) particles, --backend $run"
+  IFS='|' read -r -a runs <<<"${RUNS:-vulkan|vulkan --staged|cuda|cuda --staged}"
+  for run in "${runs[@]}"; do
+    echo "== $((64 * boxes)) particles, --backend $run ${VIEW_ARGS:-}"
     # shellcheck disable=SC2086
-    "$motes" view "$file" --offscreen --frames "$frames" --size 1280x720 --backend $run |
+    "$motes" view "$file" --offscreen --frames "$frames" --size 1280x720 --backend $run ${VIEW_ARGS:-} |
       grep -e '^motes view: drawing' -e 'frames shown' || echo "(failed)"
   done
 done
