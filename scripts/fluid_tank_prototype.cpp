@@ -8,9 +8,10 @@
 //
 // CFM: alpha~ as a multiple of the denominator of a lattice particle at rest; CONTACT: a minimum
 // distance between fluid particles, in diameters (0: none); WALLS: 1 to count the walls in the
-// density (the half-space integral of poly6, below), 0 not to. Differences from the plan: the
-// neighbours (within 1.1 h) are found anew every substep from a hash of h-sized cells; the tank's
-// five walls are planes that clamp the particles' centres half a diameter inside; no solids.
+// density (the half-space integral of poly6: fluid_plane_share), 0 not to. Differences from the
+// plan: the neighbours (within 1.1 h) are found anew every substep from a hash of h-sized cells;
+// the tank's five walls are planes that clamp the particles' centres half a diameter inside; no
+// solids.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -71,25 +72,8 @@ int main(int argc, char** argv) {
     }
   }
   const float alpha = cfm * (rest.w + sh::dot(sh::xyz(rest), sh::xyz(rest)) / m);
-  // A wall's part of the density (WALLS = 1): rho_0 times poly6 integrated over the half-space
-  // beyond the plane at distance z from the particle, (pi K / 4) int_z^h (h^2 - t^2)^4 dt with
-  // K = 315 / (64 pi h^9), and its derivative in z.
-  const auto wall_integral = [&](double z) {
-    const double hh = h;
-    const auto prim = [&](double t) {
-      const double h2 = hh * hh, t2 = t * t;
-      return t *
-             (h2 * h2 * h2 * h2 - 4.0 / 3.0 * h2 * h2 * h2 * t2 + 6.0 / 5.0 * h2 * h2 * t2 * t2 -
-              4.0 / 7.0 * h2 * t2 * t2 * t2 + t2 * t2 * t2 * t2 / 9.0);
-    };
-    return z >= hh ? 0.0 : 315.0 / (256.0 * std::pow(hh, 9)) * (prim(hh) - prim(std::max(z, 0.0)));
-  };
-  const auto wall_slope = [&](double z) {
-    const double hh = h;
-    if (z >= hh) return 0.0;
-    const double a = hh * hh - z * z;
-    return -315.0 / (256.0 * std::pow(hh, 9)) * a * a * a * a;
-  };
+  // A wall's part of the density (WALLS = 1): rho_0 times poly6's share beyond the plane, and its
+  // slope (shared/fluid.h, fluid_plane_share).
   std::vector<float> rho(n), lambda(n), lambda_sum(n);
   std::vector<vec3> wall_gradient(n);
   std::vector<std::vector<std::size_t>> near(n);
@@ -137,8 +121,8 @@ int main(int argc, char** argv) {
           const vec3 normal[5] = {vec3(0, 1, 0), vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 0, 1),
                                   vec3(0, 0, -1)};
           for (int w = 0; w < 5; ++w) {
-            r += rho0 * static_cast<float>(wall_integral(static_cast<double>(dist[w])));
-            wg += normal[w] * static_cast<float>(wall_slope(static_cast<double>(dist[w])));
+            r += rho0 * sh::fluid_plane_share(dist[w], h);
+            wg += normal[w] * sh::fluid_plane_share_slope(dist[w], h);
           }
           gathered += vec4(wg, 0.0f);  // (1 / rho0) rho0 dF/dz n, in grad_i C_i
         }

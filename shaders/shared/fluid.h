@@ -62,6 +62,34 @@ MOTES_FN vec3 fluid_spiky_gradient(vec3 rij, float h) {
   return rij * ((-45.0f / MOTES_FLUID_PI) * (a * a) / (h2 * h2 * r));
 }
 
+/// The share of poly6 beyond a plane at distance z from the particle: the integral of W over the
+/// half-space, (315 / 256) int_q^1 (1 - u^2)^4 du with q = z / h (1/2 at the plane, 0 from h on).
+/// A plane counts rho_0 times it in a fluid particle's density, as fluid filling the solid side
+/// would (docs/fluids.md, "Measured with the serial prototype": prototyped there, not yet in the
+/// plan's kernels).
+MOTES_FN float fluid_plane_share(float z, float h) {
+  float q = clamp(z / h, 0.0f, 1.0f);
+  // int_q^1 (1 - u^2)^4 du = (1 - q)^5 (128/315 + 65/63 q + 23/21 q^2 + 5/9 q^3 + 1/9 q^4): no
+  // cancellation near q = 1, exactly 0 there.
+  float a = 1.0f - q;
+  float a2 = a * a;
+  float rest =
+      128.0f / 315.0f + q * (65.0f / 63.0f + q * (23.0f / 21.0f + q * (5.0f / 9.0f + q / 9.0f)));
+  return (315.0f / 256.0f) * (a2 * a2 * a) * rest;
+}
+
+/// d/dz of fluid_plane_share: -(315 / 256) (1 - q^2)^4 / h for z < h, else 0 (the share falls
+/// as the particle leaves the plane).
+MOTES_FN float fluid_plane_share_slope(float z, float h) {
+  if (z >= h) {
+    return 0.0f;
+  }
+  float q = max(z / h, 0.0f);
+  float a = 1.0f - q * q;
+  float a2 = a * a;
+  return -(315.0f / 256.0f) * (a2 * a2) / h;
+}
+
 /// The density constraint C = rho / rho_0 - 1, unilateral (clamped to >= 0: a particle short of
 /// neighbours, at the free surface, is not pulled in; Macklin 2014, section 7) or not.
 MOTES_FN float fluid_constraint(float rho, float rho0, bool unilateral) {

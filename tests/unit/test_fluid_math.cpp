@@ -126,6 +126,42 @@ TEST(FluidMath, LatticeDensityAtTwoSpacings) {
   EXPECT_NEAR(rho / D(rho0), 103950.0 / (32768.0 * kPi), 1e-5);
 }
 
+// A plane's share of the kernel: half at the plane, none from h on, and the integral of poly6 over
+// the half-space beyond the plane (by slabs: each slab at height t carries pi K (h^2 - t^2)^4 / 4,
+// integrated here numerically from the kernel itself, over discs).
+TEST(FluidMath, PlaneShareIsTheKernelBeyondThePlane) {
+  const float h = 0.02f;
+  EXPECT_NEAR(D(sh::fluid_plane_share(0.0f, h)), 0.5, 1e-6);
+  EXPECT_EQ(sh::fluid_plane_share(h, h), 0.0f);
+  EXPECT_EQ(sh::fluid_plane_share(2.0f * h, h), 0.0f);
+  for (const double q : {0.1, 0.3, 0.5, 0.8}) {
+    // Beyond the plane at distance z = q h: slabs at t in [z, h], each a disc of radius
+    // sqrt(h^2 - t^2) integrated over rings of the kernel.
+    const double z = q * D(h);
+    const int n = 400;
+    double total = 0.0;
+    for (int a = 0; a < n; ++a) {
+      const double t = z + (D(h) - z) * (a + 0.5) / n;
+      const double rmax = std::sqrt(std::max(D(h) * D(h) - t * t, 0.0));
+      double disc = 0.0;
+      for (int b = 0; b < n; ++b) {
+        const double rho = rmax * (b + 0.5) / n;
+        disc += 2.0 * kPi * rho * D(sh::fluid_poly6(static_cast<float>(rho * rho + t * t), h)) *
+                rmax / n;
+      }
+      total += disc * (D(h) - z) / n;
+    }
+    EXPECT_NEAR(D(sh::fluid_plane_share(static_cast<float>(z), h)), total, 2e-4) << "q = " << q;
+    const double e = 1e-3 * D(h);
+    const double slope = (D(sh::fluid_plane_share(static_cast<float>(z + e), h)) -
+                          D(sh::fluid_plane_share(static_cast<float>(z - e), h))) /
+                         (2.0 * e);
+    EXPECT_NEAR(D(sh::fluid_plane_share_slope(static_cast<float>(z), h)), slope,
+                1e-3 * std::abs(slope))
+        << "q = " << q;
+  }
+}
+
 TEST(FluidMath, ConstraintIsUnilateral) {
   EXPECT_EQ(sh::fluid_constraint(900.0f, 1000.0f, true), 0.0f);
   EXPECT_NEAR(sh::fluid_constraint(900.0f, 1000.0f, false), -0.1f, 1e-7f);
