@@ -185,6 +185,16 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
       scene.linked.push_back(std::move(spec));
       continue;
     }
+    if (is_fluid(body)) {
+      FluidSpec spec = read_fluid(body, i, cache, scene);
+      check_initial_speed(body, fmt::format("fluid \"{}\"", spec.name), spec.velocity,
+                          Eigen::Vector3d::Zero(), 0.0, spec.diameter, scene.settings);
+      count(body, spec.points.size());
+      add_name(body, spec.name, body.path());
+      scene.fluids.push_back(std::move(spec));
+      continue;
+    }
+    if (auto fluid = body.find("fluid")) fluid->fail("\"fluid\" settings need \"kind\": \"fluid\"");
     body.expect_object({"name", "kind", "shape", "material", "position", "rotation", "velocity",
                         "angular_velocity", "repeat", "color", "soft"});
     BodySpec spec;
@@ -197,7 +207,9 @@ void read_bodies(const Node& bodies, ShapeCache& cache, Scene& scene,
         spec.soft = SoftSpec{};
       } else if (k != "dynamic") {
         kind->fail(fmt::format(
-            "must be \"dynamic\", \"static\", \"soft\", \"cloth\" or \"rope\", got \"{}\"", k));
+            "must be \"dynamic\", \"static\", \"soft\", \"cloth\", \"rope\" or \"fluid\", got "
+            "\"{}\"",
+            k));
       }
     }
     if (auto soft = body.find("soft")) {

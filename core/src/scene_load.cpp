@@ -26,7 +26,8 @@ using scene_detail::Sign;
 
 /// Reads the fields of a material object over `base` (missing fields keep base's values).
 Material read_material_fields(const Node& node, Material base) {
-  node.expect_object({"density", "stiffness", "damping", "tangential", "friction", "restitution"});
+  node.expect_object({"density", "stiffness", "damping", "tangential", "friction", "restitution",
+                      "rest_density", "viscosity", "vorticity", "cohesion", "adhesion"});
   if (auto v = node.find("density")) base.density = v->number(Sign::Positive);
   if (auto v = node.find("stiffness")) base.stiffness = v->number(Sign::Positive);
   if (auto v = node.find("damping")) base.damping = v->number(Sign::NonNegative);
@@ -42,6 +43,20 @@ Material read_material_fields(const Node& node, Material base) {
                           base.restitution));
     }
   }
+  // Fluids (docs/fluids.md).
+  if (auto v = node.find("rest_density")) base.rest_density = v->number(Sign::Positive);
+  if (auto v = node.find("viscosity")) {
+    base.viscosity = v->number(Sign::NonNegative);
+    if (!(base.viscosity <= 1.0)) {
+      v->fail(
+          fmt::format("XSPH viscosity is the fraction of the neighbours' mean velocity a "
+                      "particle takes per substep: from 0 to 1, got {}",
+                      base.viscosity));
+    }
+  }
+  if (auto v = node.find("vorticity")) base.vorticity = v->number(Sign::NonNegative);
+  if (auto v = node.find("cohesion")) base.cohesion = v->number(Sign::NonNegative);
+  if (auto v = node.find("adhesion")) base.adhesion = v->number(Sign::NonNegative);
   return base;
 }
 
@@ -278,6 +293,7 @@ std::size_t Scene::particle_count() const {
   std::size_t n = 0;
   for (const BodySpec& b : bodies) n += b.shape ? b.shape->points.size() : 0;
   for (const LinkedSpec& l : linked) n += l.points.size();
+  for (const FluidSpec& f : fluids) n += f.points.size();
   return n;
 }
 

@@ -14,6 +14,7 @@
 #include "shared/neighbours.h"
 #include "shared/halo.h"
 #include "shared/energy.h"
+#include "shared/fluid.h"
 
 layout(local_size_x = 64) in;
 layout(push_constant) uniform Push { StepParams p; };
@@ -22,6 +23,7 @@ layout(std430, binding = 1) buffer Vel { vec4 vel[]; };
 layout(std430, binding = 2) buffer Laws { ContactLaw laws[]; };
 layout(std430, binding = 3) buffer Planes { PlaneData planes[]; };
 layout(std430, binding = 4) buffer Out { vec4 result[]; };
+layout(std430, binding = 5) buffer Fluids { FluidMaterial fluids[]; };
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
@@ -41,7 +43,29 @@ void main() {
   body_integrate(body, q, v, l, w, vec4(1.0f), vec4(f, 0.0f), vec4(0.0f), p.gravity_dt, p.flags);
   vec3 x = particle_position(body, q, a) + particle_velocity(q, v, w, a);
   vec3 e = item_energy(a, v, v.w, true, w, l, p.gravity_dt, xyz(b));
-  result[i] = vec4(x + particle_torque(a, body, vec4(f, 0.0f)) + e,
+  FluidMaterial fm = fluids[0];
+  vec3 rij = xyz(a) - xyz(b);
+  vec3 g = fluid_spiky_gradient(rij, fm.density_h.y);
+  vec4 gt = fluid_gradient_term(rij, fm.density_h.z, 1.0f / fm.density_h.z, fm.density_h.x,
+                                fm.density_h.y);
+  float lambda = fluid_lambda(fluid_constraint(fluid_poly6(dot(rij, rij), fm.density_h.y) +
+                                                   fluid_spiky(length(rij), fm.density_h.y),
+                                               fm.density_h.x, true),
+                              gt, 1.0f / fm.density_h.z, fm.density_h.w);
+  vec3 fl = fluid_shift_term(lambda, lambda, fm.density_h.z, fm.density_h.z,
+                             fluid_s_corr(dot(rij, rij), fm.density_h.z, fm), g, fm.density_h.x) +
+            fluid_rigid_reaction(g, fm.density_h.z, p.gravity_dt.w) +
+            fluid_xsph_term(xyz(v), xyz(vel[i]), 1.0f, 1.0f, 0.0f, fm.density_h.y) +
+            fluid_confinement(fluid_eta_term(1.0f, 2.0f, 1.0f, 1.0f, g),
+                              fluid_vorticity_term(xyz(v), xyz(vel[i]), 1.0f, 1.0f, g), 1.0f,
+                              p.gravity_dt.w) +
+            fluid_cohesion_term(rij, 1.0f, 1.0f, 1.0f, fluid_normal_term(1.0f, 1.0f, g, 1.0f), g,
+                                1.0f, fm.velocity.z, fm.density_h.y, p.gravity_dt.w) +
+            fluid_adhesion_term(rij, 1.0f, fm.velocity.w, fm.density_h.y, p.gravity_dt.w) *
+                fluid_pressure(lambda, 1.0f, 1.0f, 1.0f, 1.0f) +
+            g * (fluid_plane_share(a.y, fm.density_h.y) +
+                 fluid_plane_share_slope(a.y, fm.density_h.y));
+  result[i] = vec4(x + particle_torque(a, body, vec4(f, 0.0f)) + e + fl,
                    float(bucket) + uintBitsToFloat(displacement2_bits(a, b)) +
                        float(energy_blocks(energy_items(p.body_count, p.particle_count,
                                                         p.rigid_particle_count))) +

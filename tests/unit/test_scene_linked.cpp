@@ -376,9 +376,8 @@ std::vector<BadLinked> bad_cases() {
        {"s.json: /bodies/1/name: duplicate body name \"r\" (also made by /bodies/0)"}},
       {"BadKind",
        scene_text(R"({"kind": "curtain", "shape": {"type": "particle"}})"),
-       {"s.json: /bodies/0/kind: must be \"dynamic\", \"static\", \"soft\", \"cloth\" or \"rope\", "
-        "got "
-        "\"curtain\""}},
+       {"s.json: /bodies/0/kind: must be \"dynamic\", \"static\", \"soft\", \"cloth\", \"rope\" or "
+        "\"fluid\", got \"curtain\""}},
       {"MaxParticles",
        scene_text(ball + ", " + rope(R"(, "particles": 100)"), R"("max_particles": 100)"),
        {"s.json: /bodies/1: the scene would have 101 particles, more than "

@@ -578,8 +578,8 @@ const BadCase kBadCases[] = {
     {"shape_too_small.json", {": /bodies/0/shape: ", "no particle fits"}},
     {"zero_axis.json", {": /bodies/0/rotation/axis: must be a non-zero vector"}},
     {"bad_kind.json",
-     {": /bodies/0/kind: must be \"dynamic\", \"static\", \"soft\", \"cloth\" or \"rope\", got "
-      "\"kinematic\""}},
+     {": /bodies/0/kind: must be \"dynamic\", \"static\", \"soft\", \"cloth\", \"rope\" or "
+      "\"fluid\", got \"kinematic\""}},
     {"camera_same_point.json", {": /camera/target: must differ from /camera/position"}},
     {"camera_bad_fov.json",
      {": /camera/fov: must be a vertical field of view in degrees between 0 and 180", "got 200"}},

@@ -29,6 +29,13 @@ struct Material {
   /// Impulse contacts (Settings::contact_model): coefficient of restitution e in [0, 1] (a pair
   /// takes the mean of its two materials').
   double restitution = 0.0;
+  /// Fluids (issue 29, docs/fluids.md; a fluid body of this material): the rest density rho_0
+  /// (kg/m^3); 0: `density`.
+  double rest_density = 0.0;
+  double viscosity = 0.01;  ///< fluids: XSPH viscosity c (dimensionless, 0 to 1)
+  double vorticity = 0.0;   ///< fluids: vorticity confinement eps (m/s)
+  double cohesion = 0.0;    ///< fluids: Akinci et al. 2013's cohesion gamma
+  double adhesion = 0.0;    ///< fluids: Akinci et al. 2013's adhesion beta (to solids)
 };
 
 /// How rigid bodies meet each other and the planes (docs/architecture.md, "Impulse contacts" and
@@ -164,6 +171,18 @@ struct LinkedSpec {
   std::optional<Eigen::Vector3d> color;  ///< sRGB, each 0..1, for pictures
 };
 
+/// A volume of liquid (issue 29, docs/fluids.md): equal particles on a cubic lattice of spacing
+/// `diameter` (the rest spacing), each of mass rest_density x diameter^3, filling a box or a
+/// sphere. Loaded and checked; Simulation::create does not run fluids yet (it says so).
+struct FluidSpec {
+  std::string name;
+  int material = 0;                     ///< index into Scene::materials (its fluid fields)
+  double diameter = 0.0;                ///< particle diameter = rest spacing d (m)
+  std::vector<Eigen::Vector3d> points;  ///< world positions of the particles
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  std::optional<Eigen::Vector3d> color;  ///< sRGB, each 0..1, for pictures
+};
+
 /// A static analytic half-space: solid below the plane (opposite to the normal).
 struct PlaneSpec {
   std::string name;
@@ -186,6 +205,7 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<BodySpec> bodies;
   std::vector<LinkedSpec> linked;  ///< cloth and ropes; in outputs they follow the bodies
+  std::vector<FluidSpec> fluids;   ///< liquids ("kind": "fluid"; not simulated yet)
   std::vector<PlaneSpec> planes;
   std::optional<CameraSpec> camera;  ///< none: pictures fit a camera to the particles
 

@@ -1,0 +1,144 @@
+// Fluids in a scene file: an entry of "bodies" with "kind": "fluid" (issue 29; docs/fluids.md,
+// docs/scene-format.md "Fluids"): a box or a sphere filled with particles on a cubic lattice at the
+// rest spacing.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+
+#include "scene_parts.h"
+
+namespace motes::scene_detail {
+
+namespace {
+
+/// Lattice steps of spacing d that fit in a length (a particle's extent within it); the epsilon
+/// keeps a box of exactly n diameters at n.
+std::int64_t steps_within(double length, double d) {
+  return static_cast<std::int64_t>(std::floor(length / d + 1e-9));
+}
+
+void check_count(const Node& where, double count, const ShapeCache& cache) {
+  if (count > static_cast<double>(cache.max_particles)) {
+    where.fail(
+        fmt::format("the fluid would have {} particles, more than settings.max_particles ({})",
+                    count, cache.max_particles));
+  }
+}
+
+/// A box [min, max]: the lattice's first particle touches min on every axis, and every particle
+/// lies inside the box.
+std::vector<Eigen::Vector3d> fill_box(const Node& fluid, double d, const ShapeCache& cache) {
+  const Eigen::Vector3d lo = fluid.at("min").vec3();
+  const Node max_node = fluid.at("max");
+  const Eigen::Vector3d hi = max_node.vec3();
+  Eigen::Matrix<std::int64_t, 3, 1> n;
+  for (int i = 0; i < 3; ++i) {
+    const Node axis = max_node.at(static_cast<std::size_t>(i));
+    if (!(hi[i] > lo[i])) {
+      axis.fail(fmt::format("must be greater than min[{}] ({} <= {})", i, hi[i], lo[i]));
+    }
+    n[i] = steps_within(hi[i] - lo[i], d);
+    if (n[i] < 1) {
+      axis.fail(
+          fmt::format("the box is {} m wide on this axis, less than one particle diameter "
+                      "({} m)",
+                      hi[i] - lo[i], d));
+    }
+  }
+  check_count(fluid,
+              static_cast<double>(n[0]) * static_cast<double>(n[1]) * static_cast<double>(n[2]),
+              cache);
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(static_cast<std::size_t>(n[0] * n[1] * n[2]));
+  for (std::int64_t z = 0; z < n[2]; ++z) {
+    for (std::int64_t y = 0; y < n[1]; ++y) {
+      for (std::int64_t x = 0; x < n[0]; ++x) {
+        points.push_back(lo + d * (Eigen::Vector3d(static_cast<double>(x), static_cast<double>(y),
+                                                   static_cast<double>(z)) +
+                                   Eigen::Vector3d::Constant(0.5)));
+      }
+    }
+  }
+  return points;
+}
+
+/// A sphere: the lattice centred on its centre, every particle lying inside it.
+std::vector<Eigen::Vector3d> fill_sphere(const Node& fluid, double d, const ShapeCache& cache) {
+  const Eigen::Vector3d centre = fluid.at("center").vec3();
+  const Node radius_node = fluid.at("radius");
+  const double radius = radius_node.number(Sign::Positive);
+  const double reach = radius - 0.5 * d;
+  if (!(reach >= 0.0)) {
+    radius_node.fail(
+        fmt::format("a sphere of radius {} m holds no particle of diameter {} m", radius, d));
+  }
+  const std::int64_t k = steps_within(reach, d);
+  const double side = static_cast<double>(2 * k + 1);
+  check_count(fluid, side * side * side * std::acos(-1.0) / 6.0, cache);
+  std::vector<Eigen::Vector3d> points;
+  for (std::int64_t z = -k; z <= k; ++z) {
+    for (std::int64_t y = -k; y <= k; ++y) {
+      for (std::int64_t x = -k; x <= k; ++x) {
+        const Eigen::Vector3d offset =
+            d *
+            Eigen::Vector3d(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
+        if (offset.norm() <= reach * (1.0 + 1e-12)) points.push_back(centre + offset);
+      }
+    }
+  }
+  return points;
+}
+
+}  // namespace
+
+bool is_fluid(const Node& entry) {
+  const Json& json = entry.json();
+  if (!json.is_object()) return false;
+  const auto kind = json.find("kind");
+  return kind != json.end() && kind->is_string() && *kind == "fluid";
+}
+
+FluidSpec read_fluid(const Node& entry, std::size_t index, const ShapeCache& cache,
+                     const Scene& scene) {
+  entry.expect_object({"name", "kind", "material", "fluid", "velocity", "color"});
+  if (scene.settings.contact_model != ContactModel::Positions) {
+    entry.at("kind").fail(
+        "a fluid needs \"contact_model\": \"position\" in /settings (its density constraint is "
+        "solved in the position solver's substeps: docs/fluids.md)");
+  }
+  FluidSpec spec;
+  spec.name = entry.has("name") ? entry.at("name").string() : fmt::format("body{}", index);
+  spec.material = entry.has("material") ? find_material(entry.at("material"), scene.materials) : 0;
+  if (auto v = entry.find("velocity")) spec.velocity = v->vec3();
+  if (auto c = entry.find("color")) spec.color = read_color(*c);
+
+  const Node fluid = entry.at("fluid");
+  const std::string type = fluid.has("type") ? fluid.at("type").string() : "";
+  if (type == "box") {
+    fluid.expect_object({"type", "min", "max", "diameter"});
+  } else if (type == "sphere") {
+    fluid.expect_object({"type", "center", "radius", "diameter"});
+  } else if (fluid.has("type")) {
+    fluid.at("type").fail(
+        fmt::format("unknown fluid volume \"{}\" (allowed: box, sphere; a mesh volume and "
+                    "emitters are not built yet)",
+                    type));
+  } else {
+    fluid.expect_object({"type", "min", "max", "center", "radius", "diameter"});
+    fluid.fail("missing required key \"type\" (the volume the fluid fills: \"box\" or \"sphere\")");
+  }
+  spec.diameter = cache.default_diameter;
+  if (auto d = fluid.find("diameter")) spec.diameter = d->number(Sign::Positive);
+  spec.points = type == "box" ? fill_box(fluid, spec.diameter, cache)
+                              : fill_sphere(fluid, spec.diameter, cache);
+  if (spec.points.empty()) fluid.fail("the volume holds no particle");
+  for (const Eigen::Vector3d& p : spec.points) {
+    if (!(p.cwiseAbs().maxCoeff() <= static_cast<double>(std::numeric_limits<float>::max()))) {
+      fluid.fail("the volume lies outside the float range");
+    }
+  }
+  return spec;
+}
+
+}  // namespace motes::scene_detail
