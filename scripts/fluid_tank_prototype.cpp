@@ -75,12 +75,14 @@ int main(int argc, char** argv) {
   // A wall's part of the density (WALLS = 1): rho_0 times poly6's share beyond the plane, and its
   // slope (shared/fluid.h, fluid_plane_share).
   std::vector<float> rho(n), lambda(n), lambda_sum(n);
-  std::vector<vec3> wall_gradient(n);
+  std::vector<vec3> wall_gradient(n), shift_own(n), shift_neighbours(n), shift_scorr(n);
   std::vector<std::vector<std::size_t>> near(n);
   const float hs = (1.0f / 60.0f) / static_cast<float>(substeps);
   const long total = std::lround(seconds * 60.0f) * substeps;
   const auto cell = [&](float c) { return static_cast<long long>(std::floor(c / h)) + 1000; };
   const auto key = [&](long long a, long long b, long long c) { return (a * 4096 + b) * 4096 + c; };
+  const long window = std::min(total, std::lround(0.25f * 60.0f) * substeps);
+  std::vector<float> lambda_mean(n, 0.0f), height_mean(n, 0.0f);
   for (long s = 0; s < total; ++s) {
     for (std::size_t i = 0; i < n; ++i) {
       v[i].y += g * hs;
@@ -106,6 +108,11 @@ int main(int argc, char** argv) {
       std::sort(near[i].begin(), near[i].end());
     }
     std::fill(lambda_sum.begin(), lambda_sum.end(), 0.0f);
+    // The substep's shifts by source (the last substep's are reported): lambda_i's own terms,
+    // the neighbours' lambda_j, s_corr, the wall clamps.
+    std::fill(shift_own.begin(), shift_own.end(), vec3(0.0f));
+    std::fill(shift_neighbours.begin(), shift_neighbours.end(), vec3(0.0f));
+    std::fill(shift_scorr.begin(), shift_scorr.end(), vec3(0.0f));
     for (int it = 0; it < sweeps; ++it) {
       for (std::size_t i = 0; i < n; ++i) {
         float r = m * sh::fluid_poly6(0.0f, h);
@@ -137,8 +144,11 @@ int main(int argc, char** argv) {
         for (std::size_t j : near[i]) {
           const vec3 rij = p[i] - p[j];
           const float s_corr = k_scorr > 0.0f ? sh::fluid_s_corr(sh::dot(rij, rij), m, f) : 0.0f;
-          dp[i] += sh::fluid_shift_term(lambda[i], lambda[j], m, m, s_corr,
-                                        sh::fluid_spiky_gradient(rij, h), rho0);
+          const vec3 grad = sh::fluid_spiky_gradient(rij, h);
+          dp[i] += sh::fluid_shift_term(lambda[i], lambda[j], m, m, s_corr, grad, rho0);
+          shift_own[i] += sh::fluid_shift_term(lambda[i], 0.0f, m, m, 0.0f, grad, rho0);
+          shift_neighbours[i] += sh::fluid_shift_term(0.0f, lambda[j], m, m, 0.0f, grad, rho0);
+          shift_scorr[i] += sh::fluid_shift_term(0.0f, 0.0f, m, m, s_corr, grad, rho0);
           const float c = contact * d;
           const float r2 = sh::dot(rij, rij);
           if (r2 < c * c && r2 > 0.0f) {
@@ -159,42 +169,109 @@ int main(int argc, char** argv) {
       v[i] = (p[i] - x[i]) / hs;
       x[i] = p[i];
     }
+    // The last quarter second's means of each particle's Lambda and height (the pressure is
+    // measured on them: one substep's Lambda carries the particles' accelerations too).
+    if (s >= total - window) {
+      for (std::size_t i = 0; i < n; ++i) {
+        lambda_mean[i] += lambda_sum[i] / static_cast<float>(window);
+        height_mean[i] += x[i].y / static_cast<float>(window);
+      }
+    }
   }
   // The surface: the 97th percentile of the heights (a splashed particle does not move it).
   std::vector<float> heights;
   for (const vec3& q : x) heights.push_back(q.y);
   std::sort(heights.begin(), heights.end());
   const float top = heights[static_cast<std::size_t>(0.97 * static_cast<double>(n - 1))];
-  double sum = 0.0, worst = 0.0, vmax = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+  const auto pressure = [&](std::size_t i) {
+    return static_cast<double>(sh::fluid_pressure(lambda_mean[i], rho0, m, hs));
+  };
+  // Least squares of three readings of the pressure (of the last quarter second's mean Lambda,
+  // against the mean depth) over the bulk: [0] the
+  // Shepard-filtered p (sum_j p_j W_ij / sum_j W_ij, i included: removes the null modes, Lambda
+  // alternating layer by layer or column by column, which exerts no force on a lattice and so
+  // stays), [1] the raw p_i, [2] p_i (rho_i / rho_0)^2 (the reading docs/fluids.md had first).
+  double sx = 0.0, sxx = 0.0, sy[3] = {0.0, 0.0, 0.0}, sxy[3] = {0.0, 0.0, 0.0};
+  double sum = 0.0, worst = 0.0, myy = 0.0, own = 0.0, neighbours = 0.0, scorr = 0.0;
+  double vmax = 0.0, v2 = 0.0;
   int count = 0;
   for (std::size_t i = 0; i < n; ++i) {
     vmax = std::max(vmax, static_cast<double>(sh::length(v[i])));
+    v2 += static_cast<double>(sh::dot(v[i], v[i]));
     const vec3& q = x[i];
     const bool bulk =
         q.y > h && q.y < top - h && q.x > h && q.x < wx - h && q.z > h && q.z < wz - h;
     if (!bulk) continue;
+    // The kernel gradient's moment in the vertical (fluid_gradient_moment_term): 1 in the
+    // continuum, 0.956 on the cubic lattice at h = 2 d; the lambdas' pressure reads rho g / M_yy.
+    double pw = 0.0, ww = 0.0;
+    for (std::size_t j = 0; j <= near[i].size(); ++j) {
+      const std::size_t k = j < near[i].size() ? near[i][j] : i;
+      const vec3 rik = x[i] - x[k];
+      myy += static_cast<double>(sh::fluid_gradient_moment_term(rik, m, rho0, h).y);
+      const double w = static_cast<double>(sh::fluid_poly6(sh::dot(rik, rik), h));
+      pw += w * pressure(k);
+      ww += w;
+    }
+    own += static_cast<double>(shift_own[i].y);
+    neighbours += static_cast<double>(shift_neighbours[i].y);
+    scorr += static_cast<double>(shift_scorr[i].y);
     const double e = static_cast<double>(rho[i] / rho0) - 1.0;
     sum += e;
     worst = std::max(worst, std::abs(e));
     ++count;
-    const double depth = static_cast<double>(top - q.y);
-    const double pressure =
-        static_cast<double>(sh::fluid_pressure(lambda_sum[i], rho[i], rho0, m, hs));
+    const double depth = static_cast<double>(top - height_mean[i]);
+    const double ratio = static_cast<double>(rho[i] / rho0);
+    const double reading[3] = {pw / ww, pressure(i), pressure(i) * ratio * ratio};
     sx += depth;
-    sy += pressure;
     sxx += depth * depth;
-    sxy += depth * pressure;
+    for (int r = 0; r < 3; ++r) {
+      sy[r] += reading[r];
+      sxy[r] += depth * reading[r];
+    }
   }
-  const double slope = (count * sxy - sx * sy) / (count * sxx - sx * sx);
   const double rho_g = static_cast<double>(rho0) * 9.81;
+  const double moment = myy / count;
+  double slope[3];
+  for (int r = 0; r < 3; ++r) {
+    slope[r] = (count * sxy[r] - sx * sy[r]) / (count * sxx - sx * sx) / rho_g - 1.0;
+  }
   std::printf(
-      "substeps %d sweeps %d s_corr k %.3g cfm %.3g contact %.3g d, %.1f s, %zu particles: bulk "
-      "%d, "
-      "density %+.3f%% mean, %.3f%% worst; pressure slope %.0f Pa/m (rho g %+.2f%%); surface "
-      "%.4f m (filled %.4f); fastest %.4f m/s\n",
+      "substeps %d sweeps %d s_corr k %.3g cfm %.3g contact %.3g d walls %d, %.1f s, %zu "
+      "particles: bulk %d, density %+.3f%% mean, %.3f%% worst; pressure slope M_yy %.4f x "
+      "filtered %+.2f%% of rho_0 g (filtered %+.2f%%, raw %+.2f%%, with rho_i^2 %+.2f%%); "
+      "surface %.4f m (filled %.4f); speed rms %.4f, fastest %.4f m/s\n",
       substeps, sweeps, static_cast<double>(k_scorr), static_cast<double>(cfm),
-      static_cast<double>(contact), static_cast<double>(seconds), n, count, 100.0 * sum / count,
-      100.0 * worst, slope, 100.0 * (slope / rho_g - 1.0), static_cast<double>(top),
-      (static_cast<double>(ny) - 0.5) * static_cast<double>(d), vmax);
+      static_cast<double>(contact), walls_count ? 1 : 0, static_cast<double>(seconds), n, count,
+      100.0 * sum / count, 100.0 * worst, moment, 100.0 * ((1.0 + slope[0]) * moment - 1.0),
+      100.0 * slope[0], 100.0 * slope[1], 100.0 * slope[2], static_cast<double>(top),
+      (static_cast<double>(ny) - 0.5) * static_cast<double>(d),
+      std::sqrt(v2 / static_cast<double>(n)), vmax);
+  // The bulk's force balance in the last substep: its shifts up, in g h_s^2 (1 at rest).
+  const double weight = 9.81 * static_cast<double>(hs * hs) * count;
+  std::printf(
+      "  last substep's shifts up in the bulk, in g h_s^2: lambda_i's terms %.3f, the "
+      "neighbours' lambda_j %.3f, s_corr %.3f, sum %.3f\n",
+      own / weight, neighbours / weight, scorr / weight, (own + neighbours + scorr) / weight);
+  if (std::getenv("PROFILE") != nullptr) {
+    // Per layer (1 d bins of height) of the columns more than h from the side walls: mean
+    // rho / rho_0 - 1, mean raw pressure against rho_0 g depth.
+    for (int layer = 0; layer < ny + 2; ++layer) {
+      double sr = 0.0, sp = 0.0, syl = 0.0;
+      int c = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (static_cast<int>(std::floor(x[i].y / d)) != layer) continue;
+        if (x[i].x > h && x[i].x < wx - h && x[i].z > h && x[i].z < wz - h) {
+          sr += static_cast<double>(rho[i] / rho0) - 1.0;
+          sp += pressure(i);
+          syl += static_cast<double>(x[i].y);
+          ++c;
+        }
+      }
+      if (c == 0) continue;
+      std::printf("  layer %2d: %3d at y %.4f: C %+.4f, p %7.1f Pa (rho_0 g depth %7.1f)\n", layer,
+                  c, syl / c, sr / c, sp / c, rho_g * (static_cast<double>(top) - syl / c));
+    }
+  }
   return 0;
 }
