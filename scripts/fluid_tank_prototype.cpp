@@ -4,18 +4,21 @@
 // parameters phase 2 starts from (docs/fluids.md, "Measured with the serial prototype").
 //
 //   g++ -O2 -std=c++20 -Ishaders scripts/fluid_tank_prototype.cpp -o /tmp/fluid_tank
-//   /tmp/fluid_tank SUBSTEPS SWEEPS S_CORR_K SECONDS LAYERS CFM CONTACT WALLS
+//   /tmp/fluid_tank SUBSTEPS SWEEPS S_CORR_K SECONDS LAYERS CFM CONTACT WALLS XSPH
+//   (PROFILE=1 in the environment adds the bulk's layers, JACOBI=1 the sweep's stability on the
+//   lattice)
 //
 // CFM: alpha~ as a multiple of the denominator of a lattice particle at rest; CONTACT: a minimum
 // distance between fluid particles, in diameters (0: none); WALLS: 1 to count the walls in the
 // density (the half-space integral of poly6: fluid_plane_share), 0 not to. Differences from the
 // plan: the neighbours (within 1.1 h) are found anew every substep from a hash of h-sized cells;
 // the tank's five walls are planes that clamp the particles' centres half a diameter inside; no
-// solids.
+// solids. XSPH: the viscosity c of the velocity pass (fluid_xsph_term, once a substep; 0: none).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <numbers>
 #include <unordered_map>
 #include <vector>
 
@@ -43,6 +46,7 @@ int main(int argc, char** argv) {
   const float cfm = arg(argc, argv, 6, 1.0f);
   const float contact = arg(argc, argv, 7, 0.0f);
   const bool walls_count = arg(argc, argv, 8, 0.0f) != 0.0f;
+  const float xsph = arg(argc, argv, 9, 0.0f);
   const float d = 0.01f, h = 2.0f * d, rho0 = 1000.0f, m = rho0 * d * d * d, g = -9.81f;
   FluidMaterial f;
   f.density_h = vec4(rho0, h, m, 0.0f);
@@ -72,6 +76,52 @@ int main(int argc, char** argv) {
     }
   }
   const float alpha = cfm * (rest.w + sh::dot(sh::xyz(rest), sh::xyz(rest)) / m);
+  if (std::getenv("JACOBI") != nullptr) {
+    // The Jacobi sweep on the lattice at rest: mode k's error is multiplied by
+    // 1 - mu(k) / (1 + cfm), mu(k) = |sum_r grad W(r) sin(k . r)|^2 / sum_r |grad W(r)|^2 (0 for
+    // k in (pi / d) {0, 1}^3: the null modes); scanned over k in [0, pi / d]^3 (a 40^3 grid, the
+    // symbol being even in each component and symmetric under their permutations). Also
+    // K = d^8 sum_r |grad W(r)|^2, the rest denominator in units of m / (rho_0^2 d^8).
+    double sum2 = 0.0, best = 0.0, best_k = 0.0;
+    std::vector<std::pair<vec3, vec3>> terms;
+    for (int a = -2; a <= 2; ++a) {
+      for (int b = -2; b <= 2; ++b) {
+        for (int c = -2; c <= 2; ++c) {
+          const vec3 r(static_cast<float>(a), static_cast<float>(b), static_cast<float>(c));
+          const vec3 gw = sh::fluid_spiky_gradient(r, 2.0f);
+          sum2 += static_cast<double>(sh::dot(gw, gw));
+          terms.emplace_back(r, gw);
+        }
+      }
+    }
+    const int grid = 40;
+    const double kPi = std::numbers::pi;
+    for (int a = 0; a <= grid; ++a) {
+      for (int b = 0; b <= a; ++b) {
+        for (int c = 0; c <= b; ++c) {
+          const double k[3] = {kPi * a / grid, kPi * b / grid, kPi * c / grid};
+          double sx = 0.0, sy = 0.0, sz = 0.0;
+          for (const auto& [r, gw] : terms) {
+            const double sn =
+                std::sin(k[0] * static_cast<double>(r.x) + k[1] * static_cast<double>(r.y) +
+                         k[2] * static_cast<double>(r.z));
+            sx += sn * static_cast<double>(gw.x);
+            sy += sn * static_cast<double>(gw.y);
+            sz += sn * static_cast<double>(gw.z);
+          }
+          const double mu = (sx * sx + sy * sy + sz * sz) / sum2;
+          if (mu > best) {
+            best = mu;
+            best_k = k[0];
+          }
+        }
+      }
+    }
+    std::printf(
+        "lattice at h = 2 d: K = %.4f, Jacobi's largest mu %.3f at k = (%.3f, %.3f, %.3f) "
+        "/ d, stable for cfm > %.3f\n",
+        sum2, best, best_k, best_k, best_k, best / 2.0 - 1.0);
+  }
   // A wall's part of the density (WALLS = 1): rho_0 times poly6's share beyond the plane, and its
   // slope (shared/fluid.h, fluid_plane_share).
   std::vector<float> rho(n), lambda(n), lambda_sum(n);
@@ -169,6 +219,19 @@ int main(int argc, char** argv) {
       v[i] = (p[i] - x[i]) / hs;
       x[i] = p[i];
     }
+    if (xsph > 0.0f) {
+      // XSPH viscosity (fluid_xsph_term), a gather over the substep's lists from the velocities
+      // before the pass (FluidVelOld in the plan).
+      const std::vector<vec3> old_v = v;
+      for (std::size_t i = 0; i < n; ++i) {
+        vec3 dv(0.0f);
+        for (std::size_t j : near[i]) {
+          const vec3 rij = x[i] - x[j];
+          dv += sh::fluid_xsph_term(old_v[i], old_v[j], m, rho[j], sh::dot(rij, rij), h);
+        }
+        v[i] += dv * xsph;
+      }
+    }
     // The last quarter second's means of each particle's Lambda and height (the pressure is
     // measured on them: one substep's Lambda carries the particles' accelerations too).
     if (s >= total - window) {
@@ -237,14 +300,15 @@ int main(int argc, char** argv) {
     slope[r] = (count * sxy[r] - sx * sy[r]) / (count * sxx - sx * sx) / rho_g - 1.0;
   }
   std::printf(
-      "substeps %d sweeps %d s_corr k %.3g cfm %.3g contact %.3g d walls %d, %.1f s, %zu "
+      "substeps %d sweeps %d s_corr k %.3g cfm %.3g contact %.3g d walls %d xsph %.3g, %.1f s, %zu "
       "particles: bulk %d, density %+.3f%% mean, %.3f%% worst; pressure slope M_yy %.4f x "
       "filtered %+.2f%% of rho_0 g (filtered %+.2f%%, raw %+.2f%%, with rho_i^2 %+.2f%%); "
       "surface %.4f m (filled %.4f); speed rms %.4f, fastest %.4f m/s\n",
       substeps, sweeps, static_cast<double>(k_scorr), static_cast<double>(cfm),
-      static_cast<double>(contact), walls_count ? 1 : 0, static_cast<double>(seconds), n, count,
-      100.0 * sum / count, 100.0 * worst, moment, 100.0 * ((1.0 + slope[0]) * moment - 1.0),
-      100.0 * slope[0], 100.0 * slope[1], 100.0 * slope[2], static_cast<double>(top),
+      static_cast<double>(contact), walls_count ? 1 : 0, static_cast<double>(xsph),
+      static_cast<double>(seconds), n, count, 100.0 * sum / count, 100.0 * worst, moment,
+      100.0 * ((1.0 + slope[0]) * moment - 1.0), 100.0 * slope[0], 100.0 * slope[1],
+      100.0 * slope[2], static_cast<double>(top),
       (static_cast<double>(ny) - 0.5) * static_cast<double>(d),
       std::sqrt(v2 / static_cast<double>(n)), vmax);
   // The bulk's force balance in the last substep: its shifts up, in g h_s^2 (1 at rest).
