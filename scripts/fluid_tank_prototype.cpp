@@ -1,10 +1,11 @@
 // A serial prototype of docs/fluids.md's density constraint (issue 29), outside the library and
 // its tests: a tank of fluid at rest, position-based fluids in the position solver's substeps with
 // shared/fluid.h's math, measured as the hydrostatic validation will measure it. It chooses the
-// parameters phase 2 starts from (docs/fluids.md, "Measured with the serial prototype").
+// parameters phase 2 starts from (docs/fluids.md, "Measured with the serial prototype" and
+// "Settled with the prototype", whose table gives the arguments of each run).
 //
 //   g++ -O2 -std=c++20 -Ishaders scripts/fluid_tank_prototype.cpp -o /tmp/fluid_tank
-//   /tmp/fluid_tank SUBSTEPS SWEEPS S_CORR_K SECONDS LAYERS CFM CONTACT WALLS XSPH
+//   /tmp/fluid_tank SUBSTEPS SWEEPS S_CORR_K SECONDS LAYERS CFM CONTACT WALLS XSPH LENGTH
 //   (PROFILE=1 in the environment adds the bulk's layers, JACOBI=1 the sweep's stability on the
 //   lattice)
 //
@@ -14,6 +15,7 @@
 // plan: the neighbours (within 1.1 h) are found anew every substep from a hash of h-sized cells;
 // the tank's five walls are planes that clamp the particles' centres half a diameter inside; no
 // solids. XSPH: the viscosity c of the velocity pass (fluid_xsph_term, once a substep; 0: none).
+// LENGTH: the tank's length in diameters; longer than the block (8 d), a dam break (below).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -51,7 +53,12 @@ int main(int argc, char** argv) {
   FluidMaterial f;
   f.density_h = vec4(rho0, h, m, 0.0f);
   f.s_corr = vec4(k_scorr, 4.0f, 0.2f * h, 1.0f);
-  const float wx = static_cast<float>(nx) * d, wz = static_cast<float>(nz) * d;
+  // LENGTH (10th argument, in diameters) longer than the block: a dam break (Martin and Moyce
+  // 1952): the block of a = 8 d by 2 a (n^2 = 2) is released at t = 0 in a tank LENGTH d long, and
+  // the front (the farthest particle's edge, x / a) is printed against T = t sqrt(2 g / a).
+  const int length = std::max(nx, static_cast<int>(arg(argc, argv, 10, 0.0f)));
+  const bool dam_break = length > nx;
+  const float wx = static_cast<float>(length) * d, wz = static_cast<float>(nz) * d;
   std::vector<vec3> x, v, p;
   for (int k = 0; k < nz; ++k) {
     for (int j = 0; j < ny; ++j) {
@@ -133,7 +140,22 @@ int main(int argc, char** argv) {
   const auto key = [&](long long a, long long b, long long c) { return (a * 4096 + b) * 4096 + c; };
   const long window = std::min(total, std::lround(0.25f * 60.0f) * substeps);
   std::vector<float> lambda_mean(n, 0.0f), height_mean(n, 0.0f);
+  const float a_column = static_cast<float>(nx) * d;
+  const long every = std::max(1L, std::lround(0.01f * 60.0f * static_cast<float>(substeps)));
   for (long s = 0; s < total; ++s) {
+    if (dam_break && s % every == 0) {
+      // The front: the farthest particle's edge, and the 99th percentile's (a few particles
+      // squeezed out ahead do not move it).
+      std::vector<float> xs;
+      for (const vec3& q : x) xs.push_back(q.x + 0.5f * d);
+      std::sort(xs.begin(), xs.end());
+      const float front = xs.back();
+      const float front99 = xs[static_cast<std::size_t>(0.99 * static_cast<double>(n - 1))];
+      const float t = static_cast<float>(s) * (1.0f / 60.0f) / static_cast<float>(substeps);
+      std::printf("dam break: T %.3f Z %.3f (99th percentile %.3f)\n",
+                  static_cast<double>(t * std::sqrt(2.0f * 9.81f / a_column)),
+                  static_cast<double>(front / a_column), static_cast<double>(front99 / a_column));
+    }
     for (std::size_t i = 0; i < n; ++i) {
       v[i].y += g * hs;
       p[i] = x[i] + v[i] * hs;
