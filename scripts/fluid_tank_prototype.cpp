@@ -15,7 +15,8 @@
 // plan: the neighbours (within 1.1 h) are found anew every substep from a hash of h-sized cells;
 // the tank's five walls are planes that clamp the particles' centres half a diameter inside; no
 // solids. XSPH: the viscosity c of the velocity pass (fluid_xsph_term, once a substep; 0: none).
-// LENGTH: the tank's length in diameters; longer than the block (8 d), a dam break (below).
+// LENGTH: the tank's length in diameters; longer than the block (8 d), a dam break (below;
+// SETTLE=seconds in the environment rests the block behind a wall first).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -142,8 +143,15 @@ int main(int argc, char** argv) {
   std::vector<float> lambda_mean(n, 0.0f), height_mean(n, 0.0f);
   const float a_column = static_cast<float>(nx) * d;
   const long every = std::max(1L, std::lround(0.01f * 60.0f * static_cast<float>(substeps)));
-  for (long s = 0; s < total; ++s) {
-    if (dam_break && s % every == 0) {
+  // SETTLE (seconds, in the environment; dam break only): the block first rests that long behind
+  // a wall at x = a, which is then removed (t = 0 at the removal).
+  const long settle =
+      dam_break && std::getenv("SETTLE") != nullptr
+          ? std::lround(std::strtof(std::getenv("SETTLE"), nullptr) * 60.0f) * substeps
+          : 0;
+  for (long s = -settle; s < total; ++s) {
+    const float gate = s < 0 ? a_column : wx;
+    if (dam_break && s >= 0 && s % every == 0) {
       // The front: the farthest particle's edge, and the 99th percentile's (a few particles
       // squeezed out ahead do not move it).
       std::vector<float> xs;
@@ -196,7 +204,7 @@ int main(int argc, char** argv) {
         }
         vec3 wg(0.0f);
         if (walls_count) {
-          const float dist[5] = {p[i].y, p[i].x, wx - p[i].x, p[i].z, wz - p[i].z};
+          const float dist[5] = {p[i].y, p[i].x, gate - p[i].x, p[i].z, wz - p[i].z};
           const vec3 normal[5] = {vec3(0, 1, 0), vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 0, 1),
                                   vec3(0, 0, -1)};
           for (int w = 0; w < 5; ++w) {
@@ -233,7 +241,7 @@ int main(int argc, char** argv) {
         p[i] += dp[i] + wall_gradient[i] * (lambda[i] / m);
         const float r = 0.5f * d;
         p[i].y = std::max(p[i].y, r);
-        p[i].x = std::clamp(p[i].x, r, wx - r);
+        p[i].x = std::clamp(p[i].x, r, gate - r);
         p[i].z = std::clamp(p[i].z, r, wz - r);
       }
     }

@@ -22,7 +22,9 @@ MOTES_SHARED_BEGIN
 /// One fluid material, in the FluidMaterials table (docs/fluids.md, "Particles and buffers").
 struct FluidMaterial {
   vec4 density_h;  // x: rest density rho_0 (kg/m^3), y: support h (m), z: particle mass (kg),
-                   // w: alpha~, the constraint force mixing term (compliance / h_s^2, > 0)
+                   // w: alpha~, the constraint force mixing term (> 0): Jacobi's
+                   // under-relaxation, a fixed fraction of a lattice particle's denominator at
+                   // rest (0.5: docs/fluids.md, "Settled with the prototype")
   vec4 s_corr;     // x: k (dimensionless), y: n (a whole number >= 1), z: dq (m), w: solid scale s
   vec4 velocity;   // x: XSPH viscosity c, y: vorticity eps (m/s), z: cohesion gamma,
                    // w: adhesion beta
