@@ -22,7 +22,9 @@ MOTES_SHARED_BEGIN
 /// One fluid material, in the FluidMaterials table (docs/fluids.md, "Particles and buffers").
 struct FluidMaterial {
   vec4 density_h;  // x: rest density rho_0 (kg/m^3), y: support h (m), z: particle mass (kg),
-                   // w: alpha~, the constraint force mixing term (compliance / h_s^2, > 0)
+                   // w: alpha~, the constraint force mixing term (> 0): Jacobi's
+                   // under-relaxation, a fixed fraction of a lattice particle's denominator at
+                   // rest (0.5: docs/fluids.md, "Settled with the prototype")
   vec4 s_corr;     // x: k (dimensionless), y: n (a whole number >= 1), z: dq (m), w: solid scale s
   vec4 velocity;   // x: XSPH viscosity c, y: vorticity eps (m/s), z: cohesion gamma,
                    // w: adhesion beta
@@ -142,11 +144,25 @@ MOTES_FN vec3 fluid_rigid_reaction(vec3 shift_term_i, float mi, float hs) {
   return shift_term_i * (-mi / hs);
 }
 
-/// The pressure of the substep's summed lambdas: the constraint's force on i,
-/// lambda grad_i C_i / h_s^2, read as SPH's -m_i (p_i / rho_i^2) sum_j m_j grad W_ij, gives
-/// p_i = -Lambda_i rho_i^2 / (rho_0 m_i h_s^2).
-MOTES_FN float fluid_pressure(float lambda_sum, float rho, float rho0, float mi, float hs) {
-  return -lambda_sum * (rho * rho) / (rho0 * mi * (hs * hs));
+/// The pressure of the substep's summed lambdas Lambda_i (docs/fluids.md, "Pressure"): the
+/// constraint's force on i, (1 / (rho_0 h_s^2)) sum_j (Lambda_i + Lambda_j) m_j grad W_ij, is SPH's
+/// symmetric pressure force -m_i sum_j m_j (p_i + p_j) / rho_0^2 grad W_ij with the rest volume
+/// m / rho_0 that the constraint's gradient uses (not m / rho_i: reading it with rho_i^2 raised a
+/// tank's pressure slope by 4 times its mean compression), so p_i = -Lambda_i rho_0 / (m_i h_s^2).
+/// On particles the spiky gradient's moment (fluid_gradient_moment_term) is below 1, and this p
+/// reads rho g depth / M: a hydrostatic check multiplies it by the measured moment.
+MOTES_FN float fluid_pressure(float lambda_sum, float rho0, float mi, float hs) {
+  return -lambda_sum * rho0 / (mi * (hs * hs));
+}
+
+/// A neighbour j's part of the diagonal of the kernel gradient's first moment,
+/// M_i = sum_j (m_j / rho_0) (x_j - x_i) (x) grad W_ij: the identity in the continuum (by parts,
+/// -int r (x) grad W dV = I), 0.9563 I on a cubic lattice of spacing h / 2 (FluidMath.
+/// GradientMomentOnTheLattice). SPH's gradient of a linear field reads M times its slope, so the
+/// lambdas' pressure of a column at rest reads rho g / M_yy.
+MOTES_FN vec3 fluid_gradient_moment_term(vec3 rij, float mj, float rho0, float h) {
+  vec3 g = fluid_spiky_gradient(rij, h);
+  return vec3(-rij.x * g.x, -rij.y * g.y, -rij.z * g.z) * (mj / rho0);
 }
 
 /// XSPH viscosity: a neighbour's part of sum_j (m_j / rho_j) (v_j - v_i) W_ij, which the particle

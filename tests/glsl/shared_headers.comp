@@ -62,7 +62,8 @@ void main() {
             fluid_cohesion_term(rij, 1.0f, 1.0f, 1.0f, fluid_normal_term(1.0f, 1.0f, g, 1.0f), g,
                                 1.0f, fm.velocity.z, fm.density_h.y, p.gravity_dt.w) +
             fluid_adhesion_term(rij, 1.0f, fm.velocity.w, fm.density_h.y, p.gravity_dt.w) *
-                fluid_pressure(lambda, 1.0f, 1.0f, 1.0f, 1.0f) +
+                fluid_pressure(lambda, 1.0f, 1.0f, 1.0f) +
+            fluid_gradient_moment_term(rij, 1.0f, 1.0f, fm.density_h.y) +
             g * (fluid_plane_share(a.y, fm.density_h.y) +
                  fluid_plane_share_slope(a.y, fm.density_h.y));
   result[i] = vec4(x + particle_torque(a, body, vec4(f, 0.0f)) + e + fl,

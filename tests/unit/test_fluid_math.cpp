@@ -221,15 +221,56 @@ TEST(FluidMath, ArtificialPressure) {
 }
 
 // A column of fluid at rest under gravity: over a substep h_s the prediction moves each particle
-// g h_s^2 down and the constraint's force brings it back, lambda grad C / h_s^2 = m g; read as SPH
-// pressure, p = -Lambda rho^2 / (rho0 m h_s^2). Check the formula's units and sign by hand numbers.
+// g h_s^2 down and the constraint's force brings it back, (1 / (rho_0 h_s^2)) sum_j (Lambda_i +
+// Lambda_j) m grad W_ij = m g; read as SPH's symmetric pressure force at the rest volume m / rho_0,
+// p = -Lambda rho_0 / (m h_s^2). Check the formula's units and sign by hand numbers.
 TEST(FluidMath, PressureFromLambda) {
   const float rho0 = 1000.0f;
   const float m = 1e-3f;
   const float hs = 1.0f / 480.0f;
-  EXPECT_NEAR(D(sh::fluid_pressure(-2e-9f, rho0, rho0, m, hs)),
-              2e-9 * 1000.0 / (1e-3 * D(hs) * D(hs)), 1e-4);
-  EXPECT_EQ(sh::fluid_pressure(0.0f, rho0, rho0, m, hs), 0.0f);
+  EXPECT_NEAR(D(sh::fluid_pressure(-2e-9f, rho0, m, hs)), 2e-9 * 1000.0 / (1e-3 * D(hs) * D(hs)),
+              1e-4);
+  EXPECT_EQ(sh::fluid_pressure(0.0f, rho0, m, hs), 0.0f);
+}
+
+// The spiky gradient's first moment: in the continuum, by parts, -int r (x) grad W dV = I (its
+// trace, -int r W'(r) 4 pi r^2 dr, is 3 int W dV = 3); on a cubic lattice of spacing d = h / 2,
+// (m / rho_0 = d^3) its yy entry is (45 / (16 pi)) (2 (1/4) + 8 (1 - 1/sqrt 2)^2 / sqrt 2 +
+// 8 (1 - sqrt 3 / 2)^2 / sqrt 3) = 0.95629 (6 neighbours at d, 2 of them along y; 12 at sqrt 2 d,
+// 8 with a y offset; 8 at sqrt 3 d; those at 2 d = h add nothing). The lambdas' pressure of a
+// column at rest reads rho g / M_yy (docs/fluids.md, "Pressure").
+TEST(FluidMath, GradientMomentOnTheLattice) {
+  const float h = 0.02f;
+  const float rho0 = 1000.0f;
+  const double trace = radial_integral(
+      [&](double r) {
+        const vec3 t =
+            sh::fluid_gradient_moment_term(vec3(static_cast<float>(r), 0.0f, 0.0f), rho0, rho0, h);
+        return D(t.x + t.y + t.z);
+      },
+      D(h));
+  EXPECT_NEAR(trace, 3.0, 1e-3);
+  const float d = 0.5f * h;
+  const float m = rho0 * d * d * d;
+  vec3 moment(0.0f);
+  for (int x = -2; x <= 2; ++x) {
+    for (int y = -2; y <= 2; ++y) {
+      for (int z = -2; z <= 2; ++z) {
+        const vec3 r(static_cast<float>(x) * d, static_cast<float>(y) * d,
+                     static_cast<float>(z) * d);
+        moment += sh::fluid_gradient_moment_term(r, m, rho0, h);
+      }
+    }
+  }
+  const double s2 = std::sqrt(2.0);
+  const double s3 = std::sqrt(3.0);
+  const double expected = 45.0 / (16.0 * kPi) *
+                          (0.5 + 8.0 * (1.0 - 1.0 / s2) * (1.0 - 1.0 / s2) / s2 +
+                           8.0 * (1.0 - s3 / 2.0) * (1.0 - s3 / 2.0) / s3);
+  EXPECT_NEAR(expected, 0.95629, 1e-5);
+  EXPECT_NEAR(D(moment.x), expected, 1e-5);
+  EXPECT_NEAR(D(moment.y), expected, 1e-5);
+  EXPECT_NEAR(D(moment.z), expected, 1e-5);
 }
 
 TEST(FluidMath, XsphPullsTowardsTheNeighboursVelocity) {
