@@ -69,13 +69,7 @@ CudaShare::CudaShare(const Gpu& gpu, Simulation& sim, bool velocities)
   exported.sType = VK_STRUCTURE_TYPE_EXPORT_MEMORY_ALLOCATE_INFO;
   exported.pNext = &dedicated;
   exported.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
-  VkMemoryAllocateInfo alloc{};
-  alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-  alloc.pNext = &exported;
-  alloc.allocationSize = req.size;
-  alloc.memoryTypeIndex = gpu_.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  check(gpu_.vk.vkAllocateMemory(gpu_.device, &alloc, nullptr, &memory_),
-        "vkAllocateMemory (shared)");
+  memory_ = gpu_.allocate(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, &exported);
   check(gpu_.vk.vkBindBufferMemory(gpu_.device, buffer_, memory_, 0), "vkBindBufferMemory");
   size_ = req.size;
   VkMemoryGetFdInfoKHR get{};
@@ -113,38 +107,43 @@ void CudaShare::copy(Simulation& sim) {
 #endif
 }
 
-void CudaShare::record_acquire(VkCommandBuffer cmd) const {
+namespace {
+
+/// The whole of `buffer` passed between queue families `from` and `to` (one of them
+/// VK_QUEUE_FAMILY_EXTERNAL: CUDA's side); `reads`: the accesses of the viewer's side.
+VkBufferMemoryBarrier ownership(VkBuffer buffer, std::uint32_t from, std::uint32_t to,
+                                VkAccessFlags reads) {
   VkBufferMemoryBarrier b{};
   b.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER;
-  b.srcAccessMask = 0;
-  b.dstAccessMask = VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_SHADER_READ_BIT;
-  b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_EXTERNAL;
-  b.dstQueueFamilyIndex = gpu_.family;
-  b.buffer = buffer_;
+  b.srcAccessMask = 0;  // CUDA's writes are finished and visible (the host waited for them)
+  b.dstAccessMask = reads;
+  b.srcQueueFamilyIndex = from;
+  b.dstQueueFamilyIndex = to;
+  b.buffer = buffer;
   b.offset = 0;
   b.size = VK_WHOLE_SIZE;
-  gpu_.vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
-                               VK_PIPELINE_STAGE_VERTEX_INPUT_BIT |
-                                   VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
-                                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                               0, 0, nullptr, 1, &b, 0, nullptr);
+  return b;
+}
+
+constexpr VkPipelineStageFlags kReadStages = VK_PIPELINE_STAGE_VERTEX_INPUT_BIT |
+                                             VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
+                                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+
+}  // namespace
+
+void CudaShare::record_acquire(VkCommandBuffer cmd) const {
+  const VkBufferMemoryBarrier b =
+      ownership(buffer_, VK_QUEUE_FAMILY_EXTERNAL, gpu_.family,
+                VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
+  gpu_.vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, kReadStages, 0, 0, nullptr,
+                               1, &b, 0, nullptr);
 }
 
 void CudaShare::record_release(VkCommandBuffer cmd) const {
-  VkBufferMemoryBarrier b{};
-  b.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER;
-  b.srcAccessMask = 0;  // reads only: nothing to make available
-  b.dstAccessMask = 0;
-  b.srcQueueFamilyIndex = gpu_.family;
-  b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_EXTERNAL;
-  b.buffer = buffer_;
-  b.offset = 0;
-  b.size = VK_WHOLE_SIZE;
-  gpu_.vk.vkCmdPipelineBarrier(
-      cmd,
-      VK_PIPELINE_STAGE_VERTEX_INPUT_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
-          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-      VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, 0, 0, nullptr, 1, &b, 0, nullptr);
+  // Reads only: nothing to make available.
+  const VkBufferMemoryBarrier b = ownership(buffer_, gpu_.family, VK_QUEUE_FAMILY_EXTERNAL, 0);
+  gpu_.vk.vkCmdPipelineBarrier(cmd, kReadStages, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, 0, 0,
+                               nullptr, 1, &b, 0, nullptr);
 }
 
 }  // namespace motes::viewer

@@ -303,9 +303,11 @@ std::uint32_t Gpu::memory_type(std::uint32_t bits, VkMemoryPropertyFlags flags) 
   throw std::runtime_error("viewer: no suitable Vulkan memory type");
 }
 
-VkDeviceMemory Gpu::allocate(const VkMemoryRequirements& req, VkMemoryPropertyFlags flags) const {
+VkDeviceMemory Gpu::allocate(const VkMemoryRequirements& req, VkMemoryPropertyFlags flags,
+                             const void* next) const {
   VkMemoryAllocateInfo alloc{};
   alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  alloc.pNext = next;
   alloc.allocationSize = req.size;
   alloc.memoryTypeIndex = memory_type(req.memoryTypeBits, flags);
   VkDeviceMemory memory = VK_NULL_HANDLE;

@@ -50,9 +50,10 @@ class Gpu {
 
   /// A memory type index with `flags` among `bits`; throws when none.
   std::uint32_t memory_type(std::uint32_t bits, VkMemoryPropertyFlags flags) const;
-  /// Memory for `req` of a type with `flags` (a buffer's or image's, then bound to it); throws
-  /// when there is none.
-  VkDeviceMemory allocate(const VkMemoryRequirements& req, VkMemoryPropertyFlags flags) const;
+  /// Memory for `req` of a type with `flags` (a buffer's or image's, then bound to it), with
+  /// `next` as VkMemoryAllocateInfo's pNext chain (export, dedicated); throws when there is none.
+  VkDeviceMemory allocate(const VkMemoryRequirements& req, VkMemoryPropertyFlags flags,
+                          const void* next = nullptr) const;
 
   VkInstance instance = VK_NULL_HANDLE;
   VkPhysicalDevice physical = VK_NULL_HANDLE;
