@@ -350,7 +350,7 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
   const std::string backend = sim->device().info().backend;
   // Zero copy or the CUDA copy: the picture comes from the device; `frame` is read back only
   // when the host needs it (picking and pulling), and is stale in between.
-  const bool zero_copy = surface.attached();
+  const bool on_device = surface.attached();
   const std::string path = surface.path();
   bool frame_current = true;
   auto current_frame = [&]() -> const Snapshot& {
@@ -420,7 +420,7 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
         frame_current = true;
         style.look = render::look_from_scene(reloaded.value());
         surface.restyle(style, frame);
-        if (zero_copy) {  // the new simulation's buffers
+        if (on_device) {  // the new simulation's buffers
           if (std::string why = surface.attach(*sim, frame); !why.empty()) fail(why);
         }
         owed_steps = 0.0;
@@ -474,7 +474,7 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
       frame_current = false;
     }
     const auto t1 = Clock::now();
-    if (!zero_copy) current_frame();  // the staged path draws from the host's copy
+    if (!on_device) current_frame();  // the staged path draws from the host's copy
     if (grid_wireframe || contact_wireframe) {
       viewer::Segments lines;
       if (grid_wireframe) {
@@ -501,7 +501,7 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
     const auto t2 = Clock::now();
     const bool keep = in.screenshot || (last && !args.screenshot.empty()) || recorder.on();
     render::Image picture;
-    surface.draw(orbit.camera(), zero_copy ? nullptr : &frame, keep ? &picture : nullptr);
+    surface.draw(orbit.camera(), on_device ? nullptr : &frame, keep ? &picture : nullptr);
     if (in.screenshot) {
       const std::string file = numbered_file("png");
       must_write(file, picture);
@@ -549,7 +549,7 @@ void run_view(const ViewArgs& args, Surface& surface, viewer::Style style,
   }
   if (!args.screenshot.empty()) {
     if (last_picture.rgb.empty()) {
-      surface.draw(orbit.camera(), zero_copy ? nullptr : &current_frame(), &last_picture);
+      surface.draw(orbit.camera(), on_device ? nullptr : &current_frame(), &last_picture);
     }
     must_write(args.screenshot, last_picture);
   }
