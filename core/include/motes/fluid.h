@@ -20,8 +20,12 @@ constexpr double kFluidSupportDiameters = 2.0;
 /// Substeps of a step with fluid when the scene does not give them (16 x 2 sweeps of 1/60 s
 /// steps met the hydrostatic bounds).
 constexpr int kFluidSubsteps = 16;
-/// Jacobi sweeps of the density constraint per substep (settings `fluid_iterations`).
+/// Jacobi sweeps of the density constraint per substep (settings `fluid_iterations`'s default;
+/// SceneFluid.SettingsDefaultToTheSettledSetWithFluid checks that they agree).
 constexpr int kFluidIterations = 2;
+/// List entries per particle in a scene with fluid when the scene does not give them (a fluid
+/// particle at rest has 32 neighbours within h + skin).
+constexpr int kFluidNeighbourCapacity = 64;
 /// alpha~ as a fraction of a lattice particle's denominator at rest (Jacobi's under-relaxation:
 /// stable above 0.41).
 constexpr double kFluidRelaxation = 0.5;
