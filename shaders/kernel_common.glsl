@@ -8,6 +8,7 @@
 #include "shared/params.h"
 #include "shared/shape_matching.h"
 #include "shared/impulse.h"
+#include "shared/fluid.h"
 #include "vulkan_bindings.h"
 
 layout(local_size_x = WORKGROUP_SIZE) in;
@@ -67,6 +68,10 @@ layout(std430, binding = B_PARTITION_CHECK) buffer PartitionCheckBuf { uint part
 layout(std430, binding = B_BODY_VEL_PUSH) buffer BodyVelPushBuf { vec4 body_vel_push[]; };
 layout(std430, binding = B_BODY_ANGMOM_PUSH) buffer BodyAngMomPushBuf { vec4 body_angmom_push[]; };
 layout(std430, binding = B_ENERGY_PARTIALS) buffer EnergyPartialsBuf { uint energy_partials[]; };
+layout(std430, binding = B_FLUID_STATE) buffer FluidStateBuf { vec4 fluid_state[]; };
+layout(std430, binding = B_FLUID_MATERIALS) readonly buffer FluidMaterialsBuf {
+  FluidMaterial fluid_materials[];
+};
 layout(std430, binding = B_GRID_ARRIVAL) buffer GridArrivalBuf { uint grid_arrival[]; };
 layout(std430, binding = B_GRID_UNSORTED) buffer GridUnsortedBuf { uint grid_unsorted[]; };
 layout(std430, binding = B_SCAN_SCRATCH) buffer ScanScratchBuf { uint scan_scratch[]; };

@@ -30,6 +30,7 @@ void main() {
     bool same = true;
     if (particle_vel[i].w != 0.0f) {  // static particles never move and get no force
       uint body_i = particle_body[i];
+      float support_i = neighbour_fluid_support(pi, i, p.fluid_first, p.fluid_count);
       uint lo[27];
       uint hi[27];
       int ranges = grid_walk(pi, lo, hi);
@@ -37,7 +38,9 @@ void main() {
         for (uint t = lo[r]; t < hi[r]; ++t) {
           uint j = grid_order[t];
           if (contact_skipped(body_i, sorted_body[t], i, j) ||
-              !neighbour_within(pi, sorted_pos[t], p.neighbour_skin)) {
+              !neighbour_within(pi, sorted_pos[t], p.neighbour_skin,
+                                max(support_i, neighbour_fluid_support(sorted_pos[t], j, p.fluid_first,
+                                                                p.fluid_count)))) {
             continue;
           }
           if (c < p.neighbour_capacity) {

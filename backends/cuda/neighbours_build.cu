@@ -60,13 +60,18 @@ __global__ void neighbours_build_kernel(shared::StepParams p, BuildInputs in, Bu
     bool same = true;
     if (in.vel[i].w != 0.0f) {  // static particles never move and get no force
       const uint body_i = in.body[i];
+      const float support_i =
+          shared::neighbour_fluid_support(pi, uint(i), p.fluid_first, p.fluid_count);
       const std::size_t stride = p.particle_count;
       shared::grid_walk(p, pi, in.cell_start, [&](uint lo, uint hi) {
         for (uint t = lo; t < hi; ++t) {
           const uint j = in.order[t];
           if (shared::contact_skipped(body_i, in.sbody[t], uint(i), j, in.exclusions,
                                       p.particle_count, p.linked_first) ||
-              !shared::neighbour_within(pi, in.spos[t], p.neighbour_skin)) {
+              !shared::neighbour_within(
+                  pi, in.spos[t], p.neighbour_skin,
+                  shared::max(support_i, shared::neighbour_fluid_support(
+                                             in.spos[t], j, p.fluid_first, p.fluid_count)))) {
             continue;
           }
           if (c < p.neighbour_capacity) {

@@ -1,6 +1,6 @@
 // neighbours_build: every dynamic particle's list of the particles of other bodies closer than
-// r_i + r_j + skin, in the canonical order of the 27-cell walk over the grid that grid_build has
-// just made.
+// max(r_i + r_j, h) + skin (h: a fluid particle's support), in the canonical order of the 27-cell
+// walk over the grid that grid_build has just made.
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -52,6 +52,8 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
       continue;
     }
     const uint body_i = body[i];
+    const float support_i =
+        shared::neighbour_fluid_support(pi, uint(i), p.fluid_first, p.fluid_count);
     const uint old_count = count[i];
     bool same = true;
     uint c = 0;
@@ -60,7 +62,10 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
         const uint j = order[t];
         if (shared::contact_skipped(body_i, sbody[t], uint(i), j, exclusions, p.particle_count,
                                     p.linked_first) ||
-            !shared::neighbour_within(pi, spos[t], p.neighbour_skin)) {
+            !shared::neighbour_within(
+                pi, spos[t], p.neighbour_skin,
+                shared::max(support_i, shared::neighbour_fluid_support(spos[t], j, p.fluid_first,
+                                                                       p.fluid_count)))) {
           continue;
         }
         if (c < capacity) {

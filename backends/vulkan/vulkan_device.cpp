@@ -45,6 +45,8 @@ static_assert(B_BODY_POS_LOW == static_cast<int>(Buffer::BodyPosLow));
 static_assert(B_BODY_VEL_PUSH == static_cast<int>(Buffer::BodyVelPush));
 static_assert(B_BODY_ANGMOM_PUSH == static_cast<int>(Buffer::BodyAngMomPush));
 static_assert(B_ENERGY_PARTIALS == static_cast<int>(Buffer::EnergyPartials));
+static_assert(B_FLUID_STATE == static_cast<int>(Buffer::FluidState));
+static_assert(B_FLUID_MATERIALS == static_cast<int>(Buffer::FluidMaterials));
 static_assert(B_GRID_ARRIVAL == static_cast<int>(Buffer::Count));
 
 namespace {

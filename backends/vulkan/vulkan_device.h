@@ -53,7 +53,8 @@ struct PushConstants {
   shared::StepParams params;
   std::uint32_t args[4];
 };
-static_assert(sizeof(PushConstants) == 112, "PushConstants layout");
+// 128 bytes: the most push constants every Vulkan device takes (maxPushConstantsSize >= 128).
+static_assert(sizeof(PushConstants) == 128, "PushConstants layout");
 
 class VulkanDevice final : public Device {
  public:

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "shared/energy.h"
+#include "shared/fluid.h"
 #include "shared/halo.h"
 #include "shared/links.h"
 #include "shared/shape_matching.h"
@@ -95,6 +96,10 @@ const char* buffer_name(Buffer b) {
       return "ContactImpulseSplit";
     case Buffer::BodyPosLow:
       return "BodyPosLow";
+    case Buffer::FluidState:
+      return "FluidState";
+    case Buffer::FluidMaterials:
+      return "FluidMaterials";
     case Buffer::ImpulseStamp:
       return "ImpulseStamp";
     case Buffer::MotionCheck:
@@ -251,6 +256,10 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
       return {kVec4, s.partition != 0 ? std::size_t{s.particles} : 0};
     case Buffer::PartitionCheck:
       return {kUint, s.partition != 0 ? std::size_t{1} : 0};
+    case Buffer::FluidState:
+      return {kVec4, s.fluid_particles};
+    case Buffer::FluidMaterials:
+      return {sizeof(shared::FluidMaterial), s.fluid_particles > 0 ? std::size_t{s.materials} : 0};
     case Buffer::EnergyPartials:
       return {kUint, MOTES_ENERGY_HEADER +
                          std::size_t{MOTES_ENERGY_WORDS} *
@@ -289,6 +298,7 @@ Sizes scale_sizes(const Sizes& sizes, std::uint32_t particles) {
   s.rigid_particles = scale(sizes.rigid_particles);
   s.bodies = scale(sizes.bodies);
   s.soft_particles = scale(sizes.soft_particles);
+  s.fluid_particles = scale(sizes.fluid_particles);
   s.constraints = scale(sizes.constraints);
   s.clusters = scale(sizes.clusters);
   s.cluster_members = scale(sizes.cluster_members);

@@ -13,6 +13,7 @@
 
 #include "contact_laws.h"
 #include "motes/checkpoint.h"
+#include "motes/fluid.h"
 #include "shared/halo.h"
 
 namespace motes {
@@ -154,6 +155,9 @@ Result<SceneCounts> count_scene(const Scene& scene, const SceneBodies& bodies,
   // every rank and a particle meets its partners in the same order at any rank count.
   c.max_diameter = bodies.largest_diameter;
   if (halo != nullptr) c.max_diameter = std::max(c.max_diameter, halo->scene_diameter);
+  for (const FluidSpec& f : scene.fluids) {
+    c.max_fluid_support = std::max(c.max_fluid_support, kFluidSupportDiameters * f.diameter);
+  }
   return c;
 }
 
@@ -238,9 +242,11 @@ shared::StepParams build_params(const Settings& settings, const SceneCounts& cou
   p.body_count = sizes.bodies;
   p.table_mask = sizes.table - 1;
   p.plane_count = sizes.planes;
-  // Cells hold every pair a list can hold: cell edge = largest diameter + skin.
-  p.cell_size = static_cast<float>(counts.max_diameter + skin);
-  p.inv_cell_size = static_cast<float>(1.0 / (counts.max_diameter + skin));
+  // Cells hold every pair a list can hold: cell edge = max(largest diameter, largest fluid
+  // support h) + skin (without fluid, largest diameter + skin as before).
+  const double reach = std::max(counts.max_diameter, counts.max_fluid_support);
+  p.cell_size = static_cast<float>(reach + skin);
+  p.inv_cell_size = static_cast<float>(1.0 / (reach + skin));
   p.material_count = sizes.materials;
   p.flags = (settings.clamp_attraction ? MOTES_FLAG_CLAMP_ATTRACTION : 0u) |
             (counts.impulses ? MOTES_FLAG_IMPULSE : 0u);
@@ -261,7 +267,13 @@ Fingerprint fingerprint(const Settings& settings, const HostLayout& layout) {
   // was before they existed, and the halo's sizes, which change with every partition of a run
   // over MPI ranks, say nothing about the physics.
   std::uint64_t h = fnv1a64(&layout.sizes, kSizesBeforeMpi);
-  h = fnv1a64(&layout.params, sizeof layout.params, h);
+  // StepParams up to the fluid's fields, which join the hash only in a scene with fluid (a scene
+  // without keeps the fingerprint it had before they existed).
+  h = fnv1a64(&layout.params, offsetof(shared::StepParams, fluid_first), h);
+  if (layout.params.fluid_count != 0) {
+    h = fnv1a64(&layout.params.fluid_first,
+                sizeof layout.params - offsetof(shared::StepParams, fluid_first), h);
+  }
   const std::int64_t counts[2] = {settings.substeps, settings.constraint_iterations};
   h = fnv1a64(counts, sizeof counts, h);
   h = fnv1a64(&settings.dt, sizeof settings.dt, h);

@@ -40,6 +40,9 @@ struct SceneCounts {
   /// The grid's largest particle diameter: the scene's, or on a rank of a run over MPI ranks the
   /// whole scene's (HaloLists::scene_diameter) when that is larger.
   double max_diameter = 0.0;
+  /// The fluids' largest support h = 2 d (docs/fluids.md, "Support radius and the neighbour
+  /// lists"); 0 without fluid.
+  double max_fluid_support = 0.0;
   bool impulses = false;  ///< settings.contact_model is Impulses
 };
 

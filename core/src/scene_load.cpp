@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "motes/fluid.h"
 #include "motes/scene.h"
 #include "scene_parts.h"
 
@@ -65,7 +66,7 @@ void read_settings(const Node& node, Settings& s, std::int64_t& max_particles) {
                       "duration", "output_interval", "max_particles", "neighbour_skin",
                       "neighbour_capacity", "constraint_iterations", "link_damping",
                       "contact_model", "impulse_iterations", "impulse_substeps",
-                      "impulse_memory_across_builds", "contact"});
+                      "impulse_memory_across_builds", "contact", "fluid_iterations"});
   if (auto v = node.find("dt")) s.dt = v->number(Sign::Positive);
   if (auto v = node.find("substeps")) s.substeps = static_cast<int>(v->integer(1, 1'000'000));
   if (auto v = node.find("gravity")) s.gravity = v->vec3();
@@ -81,6 +82,9 @@ void read_settings(const Node& node, Settings& s, std::int64_t& max_particles) {
     s.constraint_iterations = static_cast<int>(v->integer(1, 1000));
   }
   if (auto v = node.find("link_damping")) s.link_damping = v->number(Sign::NonNegative);
+  if (auto v = node.find("fluid_iterations")) {
+    s.fluid_iterations = static_cast<int>(v->integer(1, 100));
+  }
   if (auto v = node.find("contact_model")) {
     const std::string model = v->string();
     if (model == "dem") {
@@ -279,6 +283,15 @@ Scene read_scene(const Json& doc, const std::string& source, const std::string& 
   cache.max_particles = max_particles;
   std::vector<scene_detail::BodyEntry> entries;
   read_bodies(root.at("bodies"), cache, scene, entries);
+  if (!scene.fluids.empty()) {
+    // A scene with fluid: the settled parameter set's substeps and list capacity unless the file
+    // gives them (docs/fluids.md, "Settled with the prototype").
+    const std::optional<Node> settings = root.find("settings");
+    if (!settings || !settings->find("substeps")) scene.settings.substeps = kFluidSubsteps;
+    if (!settings || !settings->find("neighbour_capacity")) {
+      scene.settings.neighbour_capacity = kFluidNeighbourCapacity;
+    }
+  }
 
   if (auto camera = root.find("camera")) scene.camera = read_camera(*camera);
 

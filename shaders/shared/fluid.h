@@ -247,6 +247,32 @@ MOTES_FN vec3 fluid_adhesion_term(vec3 rib, float psib, float beta, float h, flo
   return rib * (-hs * beta * psib * fluid_adhesion_kernel(r, h) / r);
 }
 
+/// Whether particle `index` is a fluid particle: in StepParams' range [fluid_first,
+/// fluid_first + fluid_count).
+MOTES_FN bool fluid_particle(uint index, uint fluid_first, uint fluid_count) {
+  return index - fluid_first < fluid_count;
+}
+
+/// The mass a neighbour j counts with in fluid particle i's sums (fluid_density, fluid_update):
+/// a fluid j its own material's mass (m_fluid_j), a solid j of radius r_j the fluid mass its
+/// lattice cell would hold, psi_j = s rho_0 (2 r_j)^3 with i's material's s and rho_0 (Macklin
+/// 2014, section 7.1).
+MOTES_FN float fluid_neighbour_mass(bool j_fluid, float m_fluid_j, float rj,
+                                    MOTES_IN(FluidMaterial) fi) {
+  float d = 2.0f * rj;
+  return j_fluid ? m_fluid_j : fi.s_corr.w * fi.density_h.x * (d * d * d);
+}
+
+/// A plane's part of fluid particle i's density gather at the distance z = dot(n, x_i) - offset of
+/// its centre: xyz, its part of grad_i C_i (the share's slope times n); w, its part of rho_i
+/// (rho_0 times poly6's share beyond the plane, as fluid filling the solid side would give).
+MOTES_FN vec4 fluid_plane_density(vec4 normal_offset, vec3 xi, MOTES_IN(FluidMaterial) fi) {
+  float z = dot(xyz(normal_offset), xi) - normal_offset.w;
+  float h = fi.density_h.y;
+  return vec4(xyz(normal_offset) * fluid_plane_share_slope(z, h),
+              fi.density_h.x * fluid_plane_share(z, h));
+}
+
 MOTES_SHARED_END
 
 #ifdef __cplusplus

@@ -72,13 +72,13 @@ struct StepParams {
   uint body_count;            // B: rigid bodies; they own particles [0, rigid_particle_count)
   uint table_mask;            // T - 1; the hashed grid has T = 2^k buckets
   uint plane_count;           // P
-  float cell_size;            // grid cell edge (m) = largest particle diameter + neighbour_skin
+  float cell_size;            // grid cell edge (m) = max(largest diameter, largest fluid h) + skin
   float inv_cell_size;        // 1 / cell_size
   uint material_count;        // M; pair table has M*M entries
   uint flags;                 // MOTES_FLAG_*
   uint rigid_particle_count;  // Nr: particles [Nr, N) are free spheres, integrated as particles
   uint neighbour_capacity;    // K: list entries kept per particle
-  float neighbour_skin;       // s (m): lists hold pairs closer than r_i + r_j + s
+  float neighbour_skin;       // s (m): lists hold pairs closer than max(r_i + r_j, h) + s
   uint linked_first;          // Nl: particles [Nl, N) are cloth and rope particles (shared/links.h)
   float linked_damping;       // fraction of their velocity the linked particles lose per substep
   uint constraint_first;      // constraints_solve: the colour's first constraint
@@ -88,6 +88,10 @@ struct StepParams {
   uint halo_particles;        // halo_pack, halo_unpack: particle entries (shared/halo.h)
   uint halo_bodies;           // halo_pack, halo_unpack: rigid body entries after them
   uint halo_first;            // halo_pack, halo_unpack: their first word in HaloIndex
+  uint fluid_first;           // Nf: particles [Nf, Nf + fluid_count) are fluid (docs/fluids.md),
+  uint fluid_count;           // a range of free particles ending at Ns; 0: no fluid
+  uint reserved0;             // 0
+  uint reserved1;             // 0
 };
 
 /// Contact law of one pair of materials (symmetric): F_n = k d - gamma_n m* v_n,
@@ -116,7 +120,7 @@ struct PlaneData {
 MOTES_SHARED_END
 
 #ifdef __cplusplus
-static_assert(sizeof(motes::shared::StepParams) == 96, "StepParams layout");
+static_assert(sizeof(motes::shared::StepParams) == 112, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, particle_count) == 16, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, flags) == 44, "StepParams layout");
 static_assert(offsetof(motes::shared::StepParams, neighbour_skin) == 56, "StepParams layout");
@@ -124,7 +128,8 @@ static_assert(offsetof(motes::shared::StepParams, constraint_count) == 72, "Step
 static_assert(offsetof(motes::shared::StepParams, cluster_count) == 80, "StepParams layout");
 // No padding bytes: queued calls are compared with memcmp to find the step's repeating cycle
 // (kernel_queue.cpp), and a padding byte's garbage would hide it (every flush a new graph).
-static_assert(offsetof(motes::shared::StepParams, halo_first) + sizeof(motes::shared::uint) ==
+static_assert(offsetof(motes::shared::StepParams, fluid_first) == 96, "StepParams layout");
+static_assert(offsetof(motes::shared::StepParams, reserved1) + sizeof(motes::shared::uint) ==
                   sizeof(motes::shared::StepParams),
               "StepParams must have no padding");
 static_assert(sizeof(motes::shared::ContactLaw) == 32, "ContactLaw layout");

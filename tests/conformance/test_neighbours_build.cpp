@@ -18,6 +18,7 @@
 // bitwise.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 #include <utility>
 #include <vector>
@@ -219,6 +220,34 @@ TEST_P(NeighboursBuild, MeshLinked1234) {
   };
   ASSERT_GE(listed(open), listed(w.particles) + 100);  // 148 pairs fewer here
   run_case("mesh_linked", w);
+}
+
+TEST_P(NeighboursBuild, Fluid1234) {
+  // Fluid particles (docs/fluids.md, "Support radius and the neighbour lists"): the second half of
+  // the free particles, whose pairs are listed closer than max(r_i + r_j, 4 r_fluid) + skin; the
+  // cell edge grows to the largest such reach.
+  World w = random_world(214, 1234, 0, kTestSkin);
+  const uint nr = w.params.rigid_particle_count;
+  const uint n = w.params.particle_count;
+  w.params.fluid_first = nr + (n - nr) / 2;
+  w.params.fluid_count = n - w.params.fluid_first;
+  float reach = w.params.cell_size - w.params.neighbour_skin;
+  for (uint i = w.params.fluid_first; i < n; ++i) {
+    reach = std::max(reach, MOTES_FLUID_SUPPORT_RADII * w.particles.pos[i].w);
+  }
+  w.params.cell_size = reach + w.params.neighbour_skin;
+  w.params.inv_cell_size = 1.0f / w.params.cell_size;
+  // The fluid's reach must list pairs the contact reach does not, or the case proves little.
+  const auto listed = [&](const motes::shared::StepParams& p) {
+    std::size_t total = 0;
+    const motes_ref::Grid g = motes_ref::grid_build(w.particles, p);
+    for (uint c : motes_ref::neighbours_build(w.particles, g, p).count) total += c;
+    return total;
+  };
+  motes::shared::StepParams solid = w.params;
+  solid.fluid_count = 0;
+  ASSERT_GE(listed(w.params), listed(solid) + 200);
+  run_case("fluid", w);
 }
 
 INSTANTIATE_TEST_SUITE_P(Conformance, NeighboursBuild, testing::ValuesIn(device_params()),

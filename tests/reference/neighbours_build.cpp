@@ -42,15 +42,19 @@ Neighbours neighbours_build(const Particles& particles, const Grid& grid, const 
     const std::vector<uint> walk = walk_buckets(particles.pos[i], p);
     std::vector<std::pair<std::size_t, uint>> found;  // (place on the walk, slot) of each j
     const vec4 xi = particles.pos[i];
+    const float support_i =
+        motes::shared::neighbour_fluid_support(xi, uint(i), p.fluid_first, p.fluid_count);
     for (std::size_t j = 0; j < n; ++j) {
       // Every test must pass, so the cheapest (the distance) goes first: at 20,000 particles the
       // walk's search and the set lookup for every pair were most of the conformance suite's time.
       // Apart along x by the cutoff or more: neighbour_within says no (dx * dx alone reaches it).
       const vec4 xj = particles.pos[j];
       const float dx = xj.x - xi.x;
-      const float cutoff = (xi.w + xj.w) + p.neighbour_skin;
+      const float h = std::max(support_i, motes::shared::neighbour_fluid_support(
+                                              xj, uint(j), p.fluid_first, p.fluid_count));
+      const float cutoff = std::max(xi.w + xj.w, h) + p.neighbour_skin;
       if (dx >= cutoff || -dx >= cutoff) continue;
-      if (!motes::shared::neighbour_within(xi, xj, p.neighbour_skin)) continue;
+      if (!motes::shared::neighbour_within(xi, xj, p.neighbour_skin, h)) continue;
       if (motes::shared::contact_excluded(particles.body[j], particles.body[i]) ||
           particles.never_touch.count({uint(i), uint(j)}) != 0) {
         continue;  // j == i, or j never touches i

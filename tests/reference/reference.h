@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "shared/common.h"
+#include "shared/fluid.h"
 #include "shared/links.h"
 #include "shared/params.h"
 #include "shared/shape_matching.h"
@@ -276,5 +277,24 @@ uint particles_displacement(const std::vector<vec4>& pos, const std::vector<vec4
 /// contacts do not need them).
 void step(Particles& particles, Bodies& bodies, const std::vector<ContactLaw>& laws,
           const std::vector<PlaneData>& planes, const StepParams& p);
+
+/// fluid_density (docs/fluids.md): FluidState of the fluid particles [p.fluid_first, +
+/// p.fluid_count): (rho_i, lambda_i, Lambda_i, 0), rho_i = m_i W(0) + sum over nb.lists[i] of
+/// m_j W_ij (a solid j: psi_j = s rho_0 (2 r_j)^3) + rho_0 times each plane's share,
+/// lambda_i = shared::fluid_lambda of the unilateral constraint with grad_i C_i and the
+/// denominator gathered by shared::fluid_gradient_term (a solid's w 0) and the planes' slopes;
+/// Lambda_i = lambda_i with MOTES_FLAG_POSITION_FIRST, else state's + lambda_i.
+std::vector<vec4> fluid_density(const Particles& particles, const Neighbours& nb,
+                                const std::vector<PlaneData>& planes,
+                                const std::vector<motes::shared::FluidMaterial>& fluids,
+                                const std::vector<vec4>& state, const StepParams& p);
+/// fluid_update: ParticleForce of every particle: a fluid particle's (dx_i, 1), dx_i the sum
+/// over nb.lists[i] of shared::fluid_shift_term (lambda from state's y; a solid j: lambda_j 0,
+/// s_corr 0, m_j = psi_j) then each plane's slope times lambda_i w_i along its normal; every
+/// other particle's 0.
+std::vector<vec4> fluid_update(const Particles& particles, const Neighbours& nb,
+                               const std::vector<PlaneData>& planes,
+                               const std::vector<motes::shared::FluidMaterial>& fluids,
+                               const std::vector<vec4>& state, const StepParams& p);
 
 }  // namespace motes_ref

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "motes/devices.h"
+#include "motes/fluid.h"
 #include "motes/scene.h"
 #include "motes/simulation.h"
 
@@ -49,6 +50,37 @@ TEST(SceneFluid, BoxIsFilledAtTheRestSpacingInsideTheBox) {
   ASSERT_TRUE(coarse) << coarse.message();
   EXPECT_EQ(coarse->fluids[0].points.size(), 8u);
   EXPECT_EQ(coarse->fluids[0].name, "body0");
+}
+
+TEST(SceneFluid, SettingsDefaultToTheSettledSetWithFluid) {
+  // 16 substeps and 64 list entries unless the file gives them; fluid_iterations 2
+  // (docs/fluids.md).
+  const std::string water =
+      R"({"kind": "fluid", "fluid": {"type": "box", "min": [0, 0, 0], "max": [0.02, 0.02, 0.02]}})";
+  Result<Scene> r = load_fluid_text(fluid_scene(water));
+  ASSERT_TRUE(r) << r.message();
+  EXPECT_EQ(r->settings.substeps, 16);
+  EXPECT_EQ(r->settings.neighbour_capacity, 64);
+  EXPECT_EQ(r->settings.fluid_iterations, 2);
+  EXPECT_EQ(Settings{}.fluid_iterations, kFluidIterations);
+  Result<Scene> given = load_fluid_text(
+      fluid_scene(water, "{}",
+                  R"("contact_model": "position", "substeps": 12, "neighbour_capacity": 40,
+         "fluid_iterations": 3)"));
+  ASSERT_TRUE(given) << given.message();
+  EXPECT_EQ(given->settings.substeps, 12);
+  EXPECT_EQ(given->settings.neighbour_capacity, 40);
+  EXPECT_EQ(given->settings.fluid_iterations, 3);
+  // Without fluid the position model's defaults stay.
+  Result<Scene> dry =
+      load_fluid_text(fluid_scene(R"({"shape": {"type": "particle"}, "position": [0, 1, 0]})"));
+  ASSERT_TRUE(dry) << dry.message();
+  EXPECT_EQ(dry->settings.substeps, 8);
+  EXPECT_EQ(dry->settings.neighbour_capacity, 16);
+  Result<Scene> bad = load_fluid_text(
+      fluid_scene(water, "{}", R"("contact_model": "position", "fluid_iterations": 0)"));
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.message().find("/settings/fluid_iterations"), std::string::npos) << bad.message();
 }
 
 TEST(SceneFluid, SphereIsFilledOnALatticeAboutItsCentre) {

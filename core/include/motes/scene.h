@@ -71,6 +71,9 @@ struct Settings {
   int neighbour_capacity = 16;  ///< list entries per particle; beyond, a particle walks the grid
   /// Cloth and ropes: relaxation sweeps over every constraint colour per substep (Jakobsen).
   int constraint_iterations = 8;
+  /// Fluids: Jacobi sweeps of the density constraint per substep (docs/fluids.md; motes/fluid.h
+  /// kFluidIterations).
+  int fluid_iterations = 2;
   /// Cloth and ropes: their particles' velocities decay at this rate (1/s); 0 = none.
   double link_damping = 0.0;
   /// Rigid-body contacts by forces (default), by impulses ("contact_model": "impulse") or by

@@ -108,6 +108,14 @@ enum class Buffer : std::uint32_t {
   /// (shared/body_math.h: body_push_pose), so that a body far from the origin moves by less than
   /// the spacing of floats there. w: 0.
   BodyPosLow,
+  // Fluids (docs/fluids.md): their particles are [Nf, Nf + Sizes::fluid_particles)
+  // (StepParams.fluid_first, fluid_count); empty without fluid.
+  /// vec4 (fluid particles): fluid_density's rho_i, lambda_i of the last sweep, Lambda_i (the
+  /// substep's sum of lambda_i, for the pressure), 0.
+  FluidState,
+  /// FluidMaterial (M with fluid, else 0): each material's fluid parameters (shared/fluid.h;
+  /// 0 for a material no fluid uses), written once by the host (motes/fluid.h).
+  FluidMaterials,
   Count
 };
 
@@ -158,9 +166,10 @@ struct Sizes {
   std::uint32_t absorb = 0;  ///< 1: cloth or ropes attached to rigid bodies (ParticleMoment)
   std::uint32_t link_exclusions = 0;  ///< words of LinkExclusions: 0 without a mesh cloth
   // Runs over MPI ranks (0 in one process): see HaloIndex, HaloData, PartitionRefPos.
-  std::uint32_t halo_index = 0;  ///< words of HaloIndex
-  std::uint32_t halo_data = 0;   ///< vec4s of HaloData
-  std::uint32_t partition = 0;   ///< 1: PartitionRefPos (N) and PartitionCheck (1) exist
+  std::uint32_t halo_index = 0;       ///< words of HaloIndex
+  std::uint32_t halo_data = 0;        ///< vec4s of HaloData
+  std::uint32_t partition = 0;        ///< 1: PartitionRefPos (N) and PartitionCheck (1) exist
+  std::uint32_t fluid_particles = 0;  ///< particles of fluids (FluidState; FluidMaterials when > 0)
 };
 
 /// Bytes of one element and number of elements of a buffer.
@@ -176,9 +185,9 @@ std::uint64_t buffers_bytes(const Sizes& sizes);
 /// Hash-table size the core uses for n particles: the power of two >= 4n, at least 64.
 std::uint32_t grid_table_size(std::uint32_t particles);
 
-/// `sizes` for `particles` particles in the same proportions: rigid particles, bodies, soft
-/// particles, constraints, clusters and their members, and the mesh-cloth exclusion lists scaled
-/// with N (rounded down), materials, planes and the neighbour capacity kept, the table
+/// `sizes` for `particles` particles in the same proportions: rigid particles, bodies, soft and
+/// fluid particles, constraints, clusters and their members, and the mesh-cloth exclusion lists
+/// scaled with N (rounded down), materials, planes and the neighbour capacity kept, the table
 /// grid_table_size(particles). What "the largest particle count that fits" is counted in.
 Sizes scale_sizes(const Sizes& sizes, std::uint32_t particles);
 

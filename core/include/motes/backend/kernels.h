@@ -73,6 +73,18 @@
 //   MOTES_FLAG_POSITION_GRAM (a counting pass) the sums are each particle's n n^T, and
 //   BodyAngVelStart.w gets the body's contact Gram bound from them and ParticlePos
 //   (shared/contact_gram.h); nothing is applied.
+// fluid_density (docs/fluids.md; shared/fluid.h): every fluid particle [p.fluid_first,
+//   + p.fluid_count) gathers over its list in list order (over capacity: the 27 cells of the last
+//   build from its NeighbourRefPos, whose particles beyond h add zeros), then over the planes:
+//   rho_i = m_i W(0) + sum_j m_j W_ij (a solid j counts psi_j = s rho_0 (2 r_j)^3) + rho_0 times
+//   each plane's share (fluid_plane_density), and lambda_i = fluid_lambda of the unilateral
+//   constraint with grad_i C_i and the denominator (fluid_gradient_term; a solid's w 0; the
+//   planes' slopes in grad_i C_i) and alpha~; FluidState[i - Nf] = (rho_i, lambda_i, Lambda_i, 0),
+//   Lambda_i = lambda_i with MOTES_FLAG_POSITION_FIRST, else the old Lambda_i + lambda_i.
+// fluid_update: ParticleForce of every particle: a fluid particle's (dx_i, 1), dx_i the sum over
+//   the same neighbours in the same order of fluid_shift_term (lambda_j from FluidState; a solid
+//   j: lambda_j 0, s_corr 0, m_j = psi_j), then each plane's slope along its normal times
+//   lambda_i w_i; every other particle's 0 (a rigid particle's reaction: not yet).
 // particles_check (not part of a step: the motion guard): MotionCheck gets the largest
 //   (|v| / d)^2 of a finite particle of [0, particle_count), the first particle with it and its
 //   |v|^2, and the first particle whose position or velocity is not finite
@@ -146,6 +158,16 @@
      BodyVelPush, BodyAngMomPush, ParticlePos),                                                  \
     (BodyPos, BodyQuat, BodyVel, BodyAngMom, BodyAngVel, BodyVelStart, BodyAngVelStart,          \
      ImpulseStamp, BodyVelPush, BodyAngMomPush))                                                 \
+  X(FluidDensity, fluid_density,                                                                 \
+    (ParticlePos, ParticleVel, ParticleBody, ParticleMaterial, GridOrder, GridCellStart,         \
+     SortedBody, NeighbourList, NeighbourCount, NeighbourRefPos, Planes, LinkExclusions,         \
+     FluidMaterials, FluidState),                                                                \
+    (FluidState))                                                                                \
+  X(FluidUpdate, fluid_update,                                                                   \
+    (ParticlePos, ParticleVel, ParticleBody, ParticleMaterial, GridOrder, GridCellStart,         \
+     SortedBody, NeighbourList, NeighbourCount, NeighbourRefPos, Planes, LinkExclusions,         \
+     FluidMaterials, FluidState),                                                                \
+    (ParticleForce))                                                                             \
   X(ParticlesCheck, particles_check, (ParticlePos, ParticleVel), (MotionCheck))                  \
   X(EnergyReduce, energy_reduce,                                                                 \
     (ParticlePos, ParticleVel, BodyPos, BodyVel, BodyAngMom, BodyAngVel, EnergyPartials),        \

@@ -1,0 +1,86 @@
+// fluid_update: every fluid particle's correction dx_i of the density constraint, a gather over
+// its neighbour list in list order (over capacity: the 27 cells of the last build, whose extra
+// particles beyond h add zeros), then the planes' slope terms, as a shift in ParticleForce
+// (w = 1); every other particle's ParticleForce 0 (shared/fluid.h).
+#include <chrono>
+#include <cstdint>
+
+#include "openmp_device.h"
+#include "shared/fluid.h"
+#include "shared/grid_walk.h"
+#include "shared/links.h"
+
+namespace motes::openmp {
+
+using shared::uint;
+using shared::vec3;
+using shared::vec4;
+
+void OpenMPDevice::fluid_update(const shared::StepParams& p) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto n = static_cast<std::int64_t>(p.particle_count);
+  const std::size_t stride = p.particle_count;
+  const vec4* pos = buf<vec4>(Buffer::ParticlePos);
+  const vec4* vel = buf<vec4>(Buffer::ParticleVel);
+  const uint* body = buf<uint>(Buffer::ParticleBody);
+  const uint* material = buf<uint>(Buffer::ParticleMaterial);
+  const uint* list = buf<uint>(Buffer::NeighbourList);
+  const uint* count = buf<uint>(Buffer::NeighbourCount);
+  const vec4* ref = buf<vec4>(Buffer::NeighbourRefPos);
+  const uint* order = buf<uint>(Buffer::GridOrder);
+  const uint* cell_start = buf<uint>(Buffer::GridCellStart);
+  const uint* sbody = buf<uint>(Buffer::SortedBody);
+  const uint* exclusions = buf<uint>(Buffer::LinkExclusions);
+  const auto* planes = buf<shared::PlaneData>(Buffer::Planes);
+  const auto* fluids = buf<shared::FluidMaterial>(Buffer::FluidMaterials);
+  const vec4* state = buf<vec4>(Buffer::FluidState);
+  vec4* force = buf<vec4>(Buffer::ParticleForce);
+
+  for_items(n, parallel(n), [&](std::int64_t item) {
+    const auto i = static_cast<std::size_t>(item);
+    if (!shared::fluid_particle(uint(i), p.fluid_first, p.fluid_count)) {
+      force[i] = vec4(0.0f);  // the rigid particles' reaction: not yet (docs/fluids.md)
+      return;
+    }
+    const vec4 pi = pos[i];
+    const vec3 xi = shared::xyz(pi);
+    const shared::FluidMaterial f = fluids[material[i]];
+    const float rho0 = f.density_h.x;
+    const float h = f.density_h.y;
+    const float mi = f.density_h.z;
+    const float lambda_i = state[i - p.fluid_first].y;
+    vec3 dx(0.0f);
+    auto add = [&](uint j) {
+      const vec3 rij = xi - shared::xyz(pos[j]);
+      const bool fluid_j = shared::fluid_particle(j, p.fluid_first, p.fluid_count);
+      const float mj =
+          shared::fluid_neighbour_mass(fluid_j, fluids[material[j]].density_h.z, pos[j].w, f);
+      const float lambda_j = fluid_j ? state[j - p.fluid_first].y : 0.0f;
+      const float s_corr = fluid_j ? shared::fluid_s_corr(shared::dot(rij, rij), mi, f) : 0.0f;
+      dx += shared::fluid_shift_term(lambda_i, lambda_j, mi, mj, s_corr,
+                                     shared::fluid_spiky_gradient(rij, h), rho0);
+    };
+    const uint c = count[i];
+    if (c <= p.neighbour_capacity) {
+      for (uint s = 0; s < c; ++s) add(list[std::size_t{s} * stride + i]);
+    } else {
+      const shared::GridRanges ranges = shared::grid_ranges(p, ref[i], cell_start);
+      for (int r = 0; r < ranges.count; ++r) {
+        for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
+          if (!shared::contact_skipped(body[i], sbody[t], uint(i), order[t], exclusions,
+                                       p.particle_count, p.linked_first)) {
+            add(order[t]);
+          }
+        }
+      }
+    }
+    for (uint s = 0; s < p.plane_count; ++s) {
+      const vec4 wall = shared::fluid_plane_density(planes[s].normal_offset, xi, f);
+      dx += shared::xyz(wall) * (lambda_i * vel[i].w);
+    }
+    force[i] = vec4(dx, 1.0f);
+  });
+  record(Kernel::FluidUpdate, start);
+}
+
+}  // namespace motes::openmp
