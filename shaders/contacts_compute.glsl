@@ -22,6 +22,7 @@ vec4 stored(vec4 f) { return f; }
 // (shared/particle_shift.h), or for a rigid body's particle the reaction of its contact with
 // another kind's particle; both particles' contacts within reach (ni, nj) for mass splitting.
 vec4 contact_term(uint i, uint j, vec3 xi, vec3 ui, float ri, float wi, float ni, uint law_base) {
+  if (shift_pair_skipped(i, j, p.fluid_first, p.fluid_count)) return vec4(0.0f);
   vec4 pj = particle_pos[j];
   vec4 vj = particle_vel[j];
   float nj = particle_shift_count(neighbour_count[j], p.plane_count);

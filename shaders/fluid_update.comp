@@ -2,8 +2,9 @@
 // fluid_update: one thread per particle; a fluid particle's correction dx_i of the density
 // constraint, a gather over its neighbour list in list order (over capacity: the 27 cells of the
 // last build, whose extra particles beyond h add zeros), then the planes' slope terms, as a shift
-// in ParticleForce (w = 1); every other particle's ParticleForce 0 (shared/fluid.h). As
-// backends/openmp/fluid_update.cpp.
+// in ParticleForce (w = 1); a dynamic rigid particle's reaction to its fluid neighbours
+// (fluid_solid_reaction, the same walk), every other particle's ParticleForce 0 (shared/fluid.h).
+// As backends/openmp/fluid_update.cpp.
 #extension GL_GOOGLE_include_directive : require
 #include "kernel_common.glsl"
 #include "shared/fluid.h"
@@ -23,11 +24,42 @@ vec3 shift_term(uint j, vec3 xi, float lambda_i, FluidMaterial f) {
                           fluid_spiky_gradient(rij, f.density_h.y), f.density_h.x);
 }
 
+// Fluid particle j's part of rigid particle b's reaction (0 for any other j).
+vec3 reaction_term(uint j, vec3 xb, float rb) {
+  if (!fluid_particle(j, p.fluid_first, p.fluid_count)) return vec3(0.0f);
+  return fluid_solid_reaction(xyz(particle_pos[j]), fluid_state[j - p.fluid_first].y, xb, rb,
+                              fluid_materials[particle_material[j]], p.gravity_dt.w);
+}
+
+// A dynamic rigid particle's reaction, over the same walk as a fluid particle's correction.
+vec3 rigid_reaction(uint b) {
+  vec3 xb = xyz(particle_pos[b]);
+  float rb = particle_pos[b].w;
+  vec3 sum = vec3(0.0f);
+  uint c = neighbour_count[b];
+  if (c <= p.neighbour_capacity) {
+    for (uint s = 0u; s < c; ++s) sum += reaction_term(neighbour_list[s * p.particle_count + b], xb, rb);
+    return sum;
+  }
+  uint body_b = particle_body[b];
+  uint lo[27];
+  uint hi[27];
+  int ranges = grid_walk(neighbour_ref_pos[b], lo, hi);
+  for (int r = 0; r < ranges; ++r) {
+    for (uint t = lo[r]; t < hi[r]; ++t) {
+      uint j = grid_order[t];
+      if (!contact_skipped(body_b, sorted_body[t], b, j)) sum += reaction_term(j, xb, rb);
+    }
+  }
+  return sum;
+}
+
 void main() {
   uint i = thread_index();
   if (i >= p.particle_count) return;
   if (!fluid_particle(i, p.fluid_first, p.fluid_count)) {
-    particle_force[i] = vec4(0.0f);  // the rigid particles' reaction: not yet (docs/fluids.md)
+    bool reacts = i < p.rigid_particle_count && particle_vel[i].w != 0.0f;
+    particle_force[i] = vec4(reacts ? rigid_reaction(i) : vec3(0.0f), 0.0f);
     return;
   }
   vec3 xi = xyz(particle_pos[i]);

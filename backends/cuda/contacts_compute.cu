@@ -48,6 +48,7 @@ __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
     const vec4 pj = in.pos[j];
     const vec4 vj = in.vel[j];
     if constexpr (kShifts) {
+      if (shared::shift_pair_skipped(uint(i), j, p.fluid_first, p.fluid_count)) return;
       // A rigid body's particle gathers the reactions of its contacts with other kinds'.
       const float nj = shared::particle_shift_count(in.count[j], p.plane_count);
       if (i < p.rigid_particle_count) {

@@ -1,8 +1,9 @@
 // fluid_update: one thread per particle; a fluid particle's correction dx_i of the density
 // constraint, a gather over its neighbour list in list order (over capacity: the 27 cells of the
 // last build, whose extra particles beyond h add zeros), then the planes' slope terms, as a shift
-// in ParticleForce (w = 1); every other particle's ParticleForce 0 (shared/fluid.h). As
-// backends/openmp/fluid_update.cpp.
+// in ParticleForce (w = 1); a dynamic rigid particle's reaction to its fluid neighbours
+// (fluid_solid_reaction, the same walk), every other particle's ParticleForce 0 (shared/fluid.h).
+// As backends/openmp/fluid_update.cpp.
 #include "cuda_device.h"
 #include "shared/fluid.h"
 #include "shared/grid_walk.h"
@@ -38,32 +39,14 @@ __global__ void fluid_update_kernel(shared::StepParams p, FluidUpdateInputs in,
   const std::uint64_t item = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
   if (item >= p.particle_count) return;
   const uint i = uint(item);
-  if (!shared::fluid_particle(i, p.fluid_first, p.fluid_count)) {
-    force[i] = vec4(0.0f);  // the rigid particles' reaction: not yet (docs/fluids.md)
-    return;
-  }
-  const vec3 xi = shared::xyz(in.pos[i]);
-  const shared::FluidMaterial f = in.fluids[in.material[i]];
-  const float rho0 = f.density_h.x;
-  const float h = f.density_h.y;
-  const float mi = f.density_h.z;
-  const float lambda_i = in.state[i - p.fluid_first].y;
-  vec3 dx(0.0f);
-  const auto add = [&](uint j) {
-    const vec3 rij = xi - shared::xyz(in.pos[j]);
-    const bool fluid_j = shared::fluid_particle(j, p.fluid_first, p.fluid_count);
-    const float mj = shared::fluid_neighbour_mass(fluid_j, in.fluids[in.material[j]].density_h.z,
-                                                  in.pos[j].w, f);
-    const float lambda_j = fluid_j ? in.state[j - p.fluid_first].y : 0.0f;
-    const float s_corr = fluid_j ? shared::fluid_s_corr(shared::dot(rij, rij), mi, f) : 0.0f;
-    dx += shared::fluid_shift_term(lambda_i, lambda_j, mi, mj, s_corr,
-                                   shared::fluid_spiky_gradient(rij, h), rho0);
-  };
-  const uint c = in.count[i];
-  if (c <= p.neighbour_capacity) {
-    const std::size_t stride = p.particle_count;
-    for (uint s = 0; s < c; ++s) add(in.list[std::size_t{s} * stride + i]);
-  } else {
+  // Particle i's neighbours, in list order (over capacity: the 27 cells of the last build).
+  const auto each_neighbour = [&](auto&& add) {
+    const uint c = in.count[i];
+    if (c <= p.neighbour_capacity) {
+      const std::size_t stride = p.particle_count;
+      for (uint s = 0; s < c; ++s) add(in.list[std::size_t{s} * stride + i]);
+      return;
+    }
     const uint body_i = in.body[i];
     shared::grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
       for (uint t = lo; t < hi; ++t) {
@@ -74,7 +57,38 @@ __global__ void fluid_update_kernel(shared::StepParams p, FluidUpdateInputs in,
         }
       }
     });
+  };
+  const vec4 pi = in.pos[i];
+  const vec3 xi = shared::xyz(pi);
+  if (!shared::fluid_particle(i, p.fluid_first, p.fluid_count)) {
+    vec3 reaction(0.0f);
+    if (i < p.rigid_particle_count && in.vel[i].w != 0.0f) {
+      each_neighbour([&](uint j) {
+        if (!shared::fluid_particle(j, p.fluid_first, p.fluid_count)) return;
+        reaction +=
+            shared::fluid_solid_reaction(shared::xyz(in.pos[j]), in.state[j - p.fluid_first].y, xi,
+                                         pi.w, in.fluids[in.material[j]], p.gravity_dt.w);
+      });
+    }
+    force[i] = vec4(reaction, 0.0f);
+    return;
   }
+  const shared::FluidMaterial f = in.fluids[in.material[i]];
+  const float rho0 = f.density_h.x;
+  const float h = f.density_h.y;
+  const float mi = f.density_h.z;
+  const float lambda_i = in.state[i - p.fluid_first].y;
+  vec3 dx(0.0f);
+  each_neighbour([&](uint j) {
+    const vec3 rij = xi - shared::xyz(in.pos[j]);
+    const bool fluid_j = shared::fluid_particle(j, p.fluid_first, p.fluid_count);
+    const float mj = shared::fluid_neighbour_mass(fluid_j, in.fluids[in.material[j]].density_h.z,
+                                                  in.pos[j].w, f);
+    const float lambda_j = fluid_j ? in.state[j - p.fluid_first].y : 0.0f;
+    const float s_corr = fluid_j ? shared::fluid_s_corr(shared::dot(rij, rij), mi, f) : 0.0f;
+    dx += shared::fluid_shift_term(lambda_i, lambda_j, mi, mj, s_corr,
+                                   shared::fluid_spiky_gradient(rij, h), rho0);
+  });
   for (uint s = 0; s < p.plane_count; ++s) {
     const vec4 wall = shared::fluid_plane_density(in.planes[s].normal_offset, xi, f);
     dx += shared::xyz(wall) * (lambda_i * in.vel[i].w);

@@ -47,6 +47,7 @@ void OpenMPDevice::contacts_shift(const shared::StepParams& p) {
     const bool rigid = uint(i) < p.rigid_particle_count;
     auto add_contact = [&](uint j) {
       if (by_impulse && j < p.rigid_particle_count) return;
+      if (shared::shift_pair_skipped(uint(i), j, p.fluid_first, p.fluid_count)) return;
       const vec4 pj = in.pos[j];
       const vec4 vj = in.vel[j];
       const float nj = shared::particle_shift_count(in.count[j], p.plane_count);

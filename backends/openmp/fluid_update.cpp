@@ -1,7 +1,8 @@
 // fluid_update: every fluid particle's correction dx_i of the density constraint, a gather over
 // its neighbour list in list order (over capacity: the 27 cells of the last build, whose extra
 // particles beyond h add zeros), then the planes' slope terms, as a shift in ParticleForce
-// (w = 1); every other particle's ParticleForce 0 (shared/fluid.h).
+// (w = 1); a dynamic rigid particle's reaction to its fluid neighbours (fluid_solid_reaction, the
+// same walk), every other particle's ParticleForce 0 (shared/fluid.h).
 #include <chrono>
 #include <cstdint>
 
@@ -36,21 +37,48 @@ void OpenMPDevice::fluid_update(const shared::StepParams& p) {
   const vec4* state = buf<vec4>(Buffer::FluidState);
   vec4* force = buf<vec4>(Buffer::ParticleForce);
 
-  for_items(n, parallel(n), [&](std::int64_t item) {
-    const auto i = static_cast<std::size_t>(item);
-    if (!shared::fluid_particle(uint(i), p.fluid_first, p.fluid_count)) {
-      force[i] = vec4(0.0f);  // the rigid particles' reaction: not yet (docs/fluids.md)
+  // Particle i's neighbours, in list order (over capacity: the 27 cells of the last build).
+  const auto each_neighbour = [&](std::size_t i, auto&& add) {
+    const uint c = count[i];
+    if (c <= p.neighbour_capacity) {
+      for (uint s = 0; s < c; ++s) add(list[std::size_t{s} * stride + i]);
       return;
     }
+    const shared::GridRanges ranges = shared::grid_ranges(p, ref[i], cell_start);
+    for (int r = 0; r < ranges.count; ++r) {
+      for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
+        if (!shared::contact_skipped(body[i], sbody[t], uint(i), order[t], exclusions,
+                                     p.particle_count, p.linked_first)) {
+          add(order[t]);
+        }
+      }
+    }
+  };
+  const float hs = p.gravity_dt.w;
+
+  for_items(n, parallel(n), [&](std::int64_t item) {
+    const auto i = static_cast<std::size_t>(item);
     const vec4 pi = pos[i];
     const vec3 xi = shared::xyz(pi);
+    if (!shared::fluid_particle(uint(i), p.fluid_first, p.fluid_count)) {
+      vec3 reaction(0.0f);
+      if (i < p.rigid_particle_count && vel[i].w != 0.0f) {
+        each_neighbour(i, [&](uint j) {
+          if (!shared::fluid_particle(j, p.fluid_first, p.fluid_count)) return;
+          reaction += shared::fluid_solid_reaction(shared::xyz(pos[j]), state[j - p.fluid_first].y,
+                                                   xi, pi.w, fluids[material[j]], hs);
+        });
+      }
+      force[i] = vec4(reaction, 0.0f);
+      return;
+    }
     const shared::FluidMaterial f = fluids[material[i]];
     const float rho0 = f.density_h.x;
     const float h = f.density_h.y;
     const float mi = f.density_h.z;
     const float lambda_i = state[i - p.fluid_first].y;
     vec3 dx(0.0f);
-    auto add = [&](uint j) {
+    each_neighbour(i, [&](uint j) {
       const vec3 rij = xi - shared::xyz(pos[j]);
       const bool fluid_j = shared::fluid_particle(j, p.fluid_first, p.fluid_count);
       const float mj =
@@ -59,21 +87,7 @@ void OpenMPDevice::fluid_update(const shared::StepParams& p) {
       const float s_corr = fluid_j ? shared::fluid_s_corr(shared::dot(rij, rij), mi, f) : 0.0f;
       dx += shared::fluid_shift_term(lambda_i, lambda_j, mi, mj, s_corr,
                                      shared::fluid_spiky_gradient(rij, h), rho0);
-    };
-    const uint c = count[i];
-    if (c <= p.neighbour_capacity) {
-      for (uint s = 0; s < c; ++s) add(list[std::size_t{s} * stride + i]);
-    } else {
-      const shared::GridRanges ranges = shared::grid_ranges(p, ref[i], cell_start);
-      for (int r = 0; r < ranges.count; ++r) {
-        for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
-          if (!shared::contact_skipped(body[i], sbody[t], uint(i), order[t], exclusions,
-                                       p.particle_count, p.linked_first)) {
-            add(order[t]);
-          }
-        }
-      }
-    }
+    });
     for (uint s = 0; s < p.plane_count; ++s) {
       const vec4 wall = shared::fluid_plane_density(planes[s].normal_offset, xi, f);
       dx += shared::xyz(wall) * (lambda_i * vel[i].w);

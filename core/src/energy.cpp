@@ -17,6 +17,7 @@
 
 #include "contact_laws.h"
 #include "motes/cloth.h"
+#include "motes/fluid.h"
 #include "motes/shapes.h"
 #include "motes/simulation.h"
 #include "shared/links.h"
@@ -83,7 +84,7 @@ MechanicalEnergy mechanical_energy(const Snapshot& state, std::span<const BodyIn
   for (std::size_t b = 0; b < bodies.size() && b < state.body_pos.size(); ++b) {
     const BodyInfo& info = bodies[b];
     const auto body = static_cast<std::uint32_t>(b);
-    if (info.linked || info.soft) {  // by its particles
+    if (info.linked || info.soft || info.fluid) {  // by its particles
       for (std::uint32_t k = info.first_particle;
            k < info.first_particle + info.particle_count && k < state.particle_pos.size(); ++k) {
         const vec4& x = state.particle_pos[k];
@@ -131,6 +132,7 @@ EnergyModel energy_model(const Scene& scene) {
   std::size_t particles = 0;
   for (const BodySpec& b : scene.bodies) particles += b.shape ? b.shape->points.size() : 0;
   for (const LinkedSpec& l : scene.linked) particles += l.points.size();
+  for (const FluidSpec& f : scene.fluids) particles += f.points.size();
   m.contact_word.reserve(particles);
   m.material.reserve(particles);
   m.by_impulse.reserve(particles);
@@ -207,6 +209,26 @@ EnergyModel energy_model(const Scene& scene) {
     const auto free = static_cast<double>(std::count(pinned.begin(), pinned.end(), false));
     m.dynamic_mass += mass * free;
     if (free > 0.0) add_item(mass, 1.0);
+  }
+  // Fluids (after the cloths and ropes): free particles whose only contacts are position
+  // contacts, each its own body (none of them stores energy in a spring).
+  for (std::size_t fi = 0; fi < scene.fluids.size(); ++fi) {
+    const FluidSpec& f = scene.fluids[fi];
+    const auto material = static_cast<std::uint32_t>(std::max(f.material, 0));
+    for (std::size_t k = 0; k < f.points.size(); ++k) {
+      m.contact_word.push_back(
+          static_cast<std::uint32_t>(scene.bodies.size() + scene.linked.size() + fi));
+      m.material.push_back(material);
+      m.by_impulse.push_back(1u);
+      if (any_mesh) {
+        m.exclusion_start.push_back(static_cast<std::uint32_t>(m.exclusion_list.size()));
+      }
+    }
+    m.largest_diameter = std::max(m.largest_diameter, f.diameter);
+    if (material >= scene.materials.size()) continue;
+    const double mass = fluid_particle_mass(scene.materials[material], f.diameter);
+    m.dynamic_mass += mass * static_cast<double>(f.points.size());
+    add_item(mass, 1.0);
   }
   if (any_mesh) m.exclusion_start.push_back(static_cast<std::uint32_t>(m.exclusion_list.size()));
   for (const auto& [mass, c] : items) {

@@ -29,10 +29,15 @@ double fluid_rest_denominator(double rest_density, double diameter) {
   return mass / (rest_density * rest_density) * sum;
 }
 
+double fluid_particle_mass(const Material& m, double diameter) {
+  const double rho0 = m.rest_density > 0.0 ? m.rest_density : m.density;
+  return rho0 * diameter * diameter * diameter;
+}
+
 shared::FluidMaterial fluid_material(const Material& m, double diameter, double substep) {
   const double rho0 = m.rest_density > 0.0 ? m.rest_density : m.density;
   const double h = kFluidSupportDiameters * diameter;
-  const double mass = rho0 * diameter * diameter * diameter;
+  const double mass = fluid_particle_mass(m, diameter);
   const double alpha = kFluidRelaxation * fluid_rest_denominator(rho0, diameter);
   const double k = kFluidScorrK * substep / kFluidReferenceSubstep;
   const auto f = [](double v) { return static_cast<float>(v); };

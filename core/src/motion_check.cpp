@@ -56,8 +56,7 @@ std::pair<std::uint32_t, std::uint32_t> Simulation::locate_particle(std::uint32_
   for (std::uint32_t b = 0; b < bodies_.size(); ++b) {
     const BodyInfo& info = bodies_[b];
     const std::uint32_t at = device_index_[b];
-    const std::uint32_t first =
-        info.free_sphere || info.linked || info.soft ? at : rigid_first_[at];
+    const std::uint32_t first = !info.has_body_state() ? at : rigid_first_[at];
     if (i >= first && i - first < info.particle_count) {
       return {b, info.first_particle + (i - first)};
     }

@@ -20,7 +20,7 @@ namespace motes {
 
 SceneBodies scene_bodies(const Scene& scene) {
   SceneBodies out;
-  out.bodies.reserve(scene.bodies.size() + scene.linked.size());
+  out.bodies.reserve(scene.bodies.size() + scene.linked.size() + scene.fluids.size());
   for (const BodySpec& b : scene.bodies) {
     BodyInfo info;
     info.name = b.name;
@@ -40,6 +40,16 @@ SceneBodies scene_bodies(const Scene& scene) {
     info.particle_count = static_cast<std::uint32_t>(l.points.size());
     out.particles += l.points.size();
     out.largest_diameter = std::max(out.largest_diameter, l.diameter);
+    out.bodies.push_back(std::move(info));
+  }
+  for (const FluidSpec& f : scene.fluids) {
+    BodyInfo info;
+    info.name = f.name;
+    info.fluid = true;
+    info.first_particle = static_cast<std::uint32_t>(out.particles);
+    info.particle_count = static_cast<std::uint32_t>(f.points.size());
+    out.particles += f.points.size();
+    out.largest_diameter = std::max(out.largest_diameter, f.diameter);
     out.bodies.push_back(std::move(info));
   }
   return out;
@@ -135,6 +145,17 @@ Result<SceneCounts> count_scene(const Scene& scene, const SceneBodies& bodies,
   c.impulses = rigid_contacts_without_forces(scene.settings.contact_model);
   if (Status st = count_bodies(scene, c); !st) return st;
   if (Status st = count_linked(scene, c); !st) return st;
+  for (const FluidSpec& f : scene.fluids) {
+    if (f.points.empty()) {
+      return Status::error(fmt::format("{}: fluid '{}' has no particles", scene.source, f.name));
+    }
+    if (f.material < 0 || static_cast<std::size_t>(f.material) >= scene.materials.size()) {
+      return Status::error(
+          fmt::format("{}: fluid '{}' has no valid material", scene.source, f.name));
+    }
+    c.fluid_particles += f.points.size();
+  }
+  c.body_particles += c.fluid_particles;
   c.particles = bodies.particles;
   if (c.particles > std::numeric_limits<std::uint32_t>::max() / 2) {
     return Status::error(fmt::format("{}: {} particles is more than motes supports (2^31)",
@@ -175,6 +196,7 @@ Sizes count_sizes(const Scene& scene, const SceneCounts& counts, const HaloLists
       std::min<std::uint64_t>(counts.constraints, std::numeric_limits<std::uint32_t>::max()));
   s.soft_particles = static_cast<std::uint32_t>(counts.soft_particles);
   s.impulse = counts.impulses ? 1u : 0u;
+  s.fluid_particles = static_cast<std::uint32_t>(counts.fluid_particles);
   return s;
 }
 
@@ -256,6 +278,8 @@ shared::StepParams build_params(const Settings& settings, const SceneCounts& cou
   p.linked_first = static_cast<std::uint32_t>(counts.body_particles);
   p.soft_first = static_cast<std::uint32_t>(counts.body_particles - counts.soft_particles);
   p.cluster_count = static_cast<std::uint32_t>(layout.soft.clusters.clusters.size());
+  p.fluid_count = static_cast<std::uint32_t>(counts.fluid_particles);
+  p.fluid_first = counts.fluid_particles == 0 ? 0u : p.soft_first - p.fluid_count;
   p.linked_damping =
       static_cast<float>(-std::expm1(-settings.link_damping * settings.dt / settings.substeps));
   return p;
@@ -299,6 +323,12 @@ Fingerprint fingerprint(const Settings& settings, const HostLayout& layout) {
   add(layout.soft.clusters.members);
   add(layout.soft.gather);
   add(layout.linked.exclusions);
+  if (!layout.fluid_materials.empty()) {
+    // The fluids' materials and sweeps (not hashed in a scene without fluid).
+    add(layout.fluid_materials);
+    const std::int64_t sweeps = settings.fluid_iterations;
+    h = fnv1a64(&sweeps, sizeof sweeps, h);
+  }
   for (const auto& [body, q] : layout.sphere_turns) {
     h = fnv1a64(&body, sizeof body, h);
     h = fnv1a64(&q, sizeof q, h);

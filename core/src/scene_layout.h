@@ -17,6 +17,7 @@
 #include "motes/soft.h"
 #include "motes/status.h"
 #include "shared/common.h"
+#include "shared/fluid.h"
 #include "shared/params.h"
 #include "shared/shape_matching.h"
 
@@ -33,8 +34,9 @@ struct SceneCounts {
   std::uint64_t particles = 0;        ///< N
   std::uint64_t rigid_particles = 0;  ///< Nr: the rigid bodies' particles
   std::uint64_t rigid_bodies = 0;     ///< B
-  std::uint64_t soft_particles = 0;   ///< Ns: the soft bodies' particles
-  /// Every scene body's particles: the cloths and ropes come after them (Nl).
+  std::uint64_t soft_particles = 0;   ///< the soft bodies' particles (Nl - Ns)
+  std::uint64_t fluid_particles = 0;  ///< the fluids' particles (Ns - Nf)
+  /// Every scene body's and fluid's particles: the cloths and ropes come after them (Nl).
   std::uint64_t body_particles = 0;
   std::uint64_t constraints = 0;  ///< the cloths' and ropes' links and attachments
   /// The grid's largest particle diameter: the scene's, or on a rank of a run over MPI ranks the
@@ -59,8 +61,8 @@ Sizes count_sizes(const Scene& scene, const SceneCounts& counts, const HaloLists
 /// impulse contacts, where an impulse at the contact point makes any sphere spin.
 bool is_free_sphere(const BodySpec& body, bool impulses);
 
-/// Every particle in device order: rigid [0, Nr), free spheres [Nr, Ns), soft [Ns, Nl), cloth
-/// and rope [Nl, N) (ParticlePos, ParticleVel, ParticleBody, ParticleMaterial).
+/// Every particle in device order: rigid [0, Nr), free spheres [Nr, Nf), fluid [Nf, Ns), soft
+/// [Ns, Nl), cloth and rope [Nl, N) (ParticlePos, ParticleVel, ParticleBody, ParticleMaterial).
 struct ParticleLayout {
   std::vector<shared::vec4> pos, vel;
   std::vector<std::uint32_t> body, material;
@@ -117,6 +119,8 @@ struct HostLayout {
   SoftLayout soft;
   LinkedLayout linked;
   TableLayout tables;
+  /// FluidMaterials: one entry per material with fluid, none without (motes/fluid.h).
+  std::vector<shared::FluidMaterial> fluid_materials;
   HaloLayout halo;
 };
 
@@ -127,6 +131,9 @@ Status build_bodies(const Scene& scene, const SceneCounts& counts, HostLayout& o
 /// The cloths and ropes after them (build_bodies first: attachments hold on to its bodies):
 /// their particles, masses, constraints and link exclusions; sizes absorb and link_exclusions.
 Status build_linked(const Scene& scene, const SceneCounts& counts, HostLayout& out);
+/// The fluids (after build_linked: their scene entries follow the cloths' and ropes'): their
+/// particles [Nf, Ns), one body word each, the FluidMaterials table; sizes fluid_particles.
+Status build_fluids(const Scene& scene, const SceneCounts& counts, HostLayout& out);
 /// The contact laws of every pair of materials, and the planes.
 TableLayout build_tables(const Scene& scene);
 /// A rank's halo lists (after build_bodies and build_linked); sizes halo_index, halo_data and

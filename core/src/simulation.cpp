@@ -73,6 +73,7 @@ Status write_layout(Device& d, const layout::HostLayout& host) {
       of(Buffer::ClusterGather, host.soft.gather),
       of(Buffer::LinkExclusions, host.linked.exclusions),
       of(Buffer::HaloIndex, host.halo.index),
+      of(Buffer::FluidMaterials, host.fluid_materials),
   };
   // A rank of a run over MPI ranks: the partition's reference positions.
   if (host.sizes.partition != 0) uploads.push_back(of(Buffer::PartitionRefPos, p.pos));
@@ -141,14 +142,6 @@ std::unique_ptr<Device> Simulation::take_device(std::unique_ptr<Simulation> sim)
 }
 
 Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
-  // Fluids load and are checked (docs/scene-format.md, "Fluids"), but no kernel runs them yet:
-  // refused here with the reason, rather than run without their liquid.
-  if (!scene.fluids.empty()) {
-    return Status::error(fmt::format(
-        "{}: fluid \"{}\": fluids are not simulated yet (issue 29: the scene format is built, "
-        "the density constraint's kernels are not; docs/fluids.md)",
-        scene.source, scene.fluids.front().name));
-  }
   settings_ = scene.settings;
   // Count first, so an impossible size is refused before anything is allocated.
   SceneBodies order = scene_bodies(scene);
@@ -181,6 +174,7 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
   host.bodies = std::move(order.bodies);
   if (Status st = layout::build_bodies(scene, counts, host); !st) return st;
   if (Status st = layout::build_linked(scene, counts, host); !st) return st;
+  if (Status st = layout::build_fluids(scene, counts, host); !st) return st;
   host.tables = layout::build_tables(scene);
   host.params = layout::build_params(settings_, counts, host);
   if (halo != nullptr) {
@@ -435,6 +429,7 @@ void Simulation::step_positions(const shared::StepParams& lists) {
     }
     relax_constraints();
     if (sizes_.absorb != 0) absorb_attachments();
+    if (sizes_.fluid_particles != 0) relax_fluids(bodies);
     for (int it = 0; it < kParticleShiftSweeps; ++it) {
       d.enqueue(Kernel::ContactsCompute, project);
       d.enqueue(Kernel::ParticlesIntegrate, shift);
@@ -446,6 +441,35 @@ void Simulation::step_positions(const shared::StepParams& lists) {
     }
   }
   if (bodies) d.enqueue(Kernel::ParticlesUpdate, params_);
+}
+
+void Simulation::relax_fluids(bool bodies) {
+  // Each sweep (docs/fluids.md, "The substep"): every fluid particle's density and lambda
+  // (fluid_density; the substep's first sweep restarts the summed Lambda), its correction and the
+  // rigid particles' reactions (fluid_update), the fluid moved by its corrections
+  // (particles_integrate's shift: every other particle's is 0), and the rigid bodies take their
+  // reactions as the contact shifts' do.
+  Device& d = *device_;
+  shared::StepParams sweep = params_;
+  sweep.flags |= MOTES_FLAG_POSITION;
+  shared::StepParams first = sweep;
+  first.flags |= MOTES_FLAG_POSITION_FIRST;
+  shared::StepParams shift = sweep;
+  shift.flags |= MOTES_FLAG_PARTICLE_SHIFT;
+  shared::StepParams react = shift;
+  react.flags |= MOTES_FLAG_ABSORB;
+  shared::StepParams react_apply = sweep;
+  react_apply.flags |= MOTES_FLAG_ABSORB;
+  for (int it = 0; it < settings_.fluid_iterations; ++it) {
+    d.enqueue(Kernel::FluidDensity, it == 0 ? first : sweep);
+    d.enqueue(Kernel::FluidUpdate, sweep);
+    d.enqueue(Kernel::ParticlesIntegrate, shift);
+    if (bodies) {
+      d.enqueue(Kernel::ParticlesUpdate, react);
+      d.enqueue(Kernel::ImpulsesApply, react_apply);
+      d.enqueue(Kernel::ParticlesUpdate, params_);
+    }
+  }
 }
 
 Status Simulation::clear_contact_history() {
@@ -464,8 +488,7 @@ std::vector<std::uint32_t> Simulation::scene_particle_order() const {
   for (std::uint32_t b = 0; b < bodies_.size(); ++b) {
     const BodyInfo& info = bodies_[b];
     const std::uint32_t at = device_index_[b];
-    const std::uint32_t first =
-        info.free_sphere || info.linked || info.soft ? at : rigid_first_[at];
+    const std::uint32_t first = !info.has_body_state() ? at : rigid_first_[at];
     for (std::uint32_t k = 0; k < info.particle_count; ++k) {
       order[first + k] = info.first_particle + k;
     }
@@ -509,14 +532,13 @@ Result<Snapshot> Simulation::snapshot() {
   for (std::size_t b = 0; b < scene_bodies; ++b) {
     const BodyInfo& info = bodies_[b];
     const std::uint32_t at = device_index_[b];
-    const std::uint32_t first =
-        info.free_sphere || info.linked || info.soft ? at : rigid_first_[at];
+    const std::uint32_t first = !info.has_body_state() ? at : rigid_first_[at];
     for (std::uint32_t k = 0; k < info.particle_count; ++k) {
       s.particle_pos[info.first_particle + k] = ppos[first + k];
       s.particle_vel[info.first_particle + k] = pvel[first + k];
       s.particle_body[info.first_particle + k] = static_cast<std::uint32_t>(b);
     }
-    if (info.linked || info.soft) {  // the mean of its particles, in double
+    if (info.linked || info.soft || info.fluid) {  // the mean of its particles, in double
       Eigen::Vector3d x = Eigen::Vector3d::Zero();
       Eigen::Vector3d v = Eigen::Vector3d::Zero();
       for (std::uint32_t k = 0; k < info.particle_count; ++k) {
@@ -590,7 +612,7 @@ Status Simulation::read_plane_impulses(Snapshot& state) {
   state.plane_impulse.assign(std::size_t{sizes_.particles} * sizes_.planes, vec4(0.0f));
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     const BodyInfo& info = bodies_[b];
-    if (info.free_sphere || info.linked || info.soft) continue;
+    if (!info.has_body_state()) continue;
     const std::uint32_t first = rigid_first_[device_index_[b]];
     for (std::uint32_t k = 0; k < info.particle_count; ++k) {
       for (std::uint32_t q = 0; q < sizes_.planes; ++q) {
@@ -612,13 +634,12 @@ Status Simulation::restore(const Snapshot& state, bool rebuild) {
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     const BodyInfo& info = bodies_[b];
     const std::uint32_t at = device_index_[b];
-    const std::uint32_t first =
-        info.free_sphere || info.linked || info.soft ? at : rigid_first_[at];
+    const std::uint32_t first = !info.has_body_state() ? at : rigid_first_[at];
     for (std::uint32_t k = 0; k < info.particle_count; ++k) {
       ppos[first + k] = state.particle_pos[info.first_particle + k];
       pvel[first + k] = state.particle_vel[info.first_particle + k];
     }
-    if (info.free_sphere || info.linked || info.soft) continue;
+    if (!info.has_body_state()) continue;
     bpos[at] = state.body_pos[b];
     bquat[at] = state.body_quat[b];
     bvel[at] = state.body_vel[b];
@@ -645,7 +666,7 @@ Status Simulation::restore(const Snapshot& state, bool rebuild) {
                     buffer_layout(Buffer::ContactImpulse, sizes_).count);
     for (std::size_t b = 0; s && b < bodies_.size(); ++b) {
       const BodyInfo& info = bodies_[b];
-      if (info.free_sphere || info.linked || info.soft) continue;
+      if (!info.has_body_state()) continue;
       const std::uint32_t first = rigid_first_[device_index_[b]];
       for (std::uint32_t k = 0; k < info.particle_count; ++k) {
         for (std::uint32_t q = 0; q < sizes_.planes; ++q) {
@@ -687,12 +708,15 @@ Status Simulation::set_body_velocities(const std::vector<Eigen::Vector3d>& veloc
           fmt::format("set_body_velocities: body {} '{}' is static: its velocity stays zero", b,
                       bodies_[b].name));
     }
-    if ((bodies_[b].free_sphere || bodies_[b].linked) && !angular.empty() &&
+    if ((bodies_[b].free_sphere || bodies_[b].linked || bodies_[b].fluid) && !angular.empty() &&
         !angular[b].isZero(0.0)) {
       return Status::error(fmt::format(
           "set_body_velocities: body {} '{}' is a {}, which has no angular velocity of its own: "
           "give its particles velocities instead",
-          b, bodies_[b].name, bodies_[b].linked ? "cloth or rope" : "free sphere"));
+          b, bodies_[b].name,
+          bodies_[b].linked  ? "cloth or rope"
+          : bodies_[b].fluid ? "fluid"
+                             : "free sphere"));
     }
   }
   Result<Snapshot> snap = snapshot();
@@ -701,7 +725,7 @@ Status Simulation::set_body_velocities(const std::vector<Eigen::Vector3d>& veloc
   for (std::size_t b = 0; b < count; ++b) {
     const BodyInfo& info = bodies_[b];
     const vec4 v = to_vec4(velocity[b], 0.0);
-    if (info.free_sphere || info.linked || info.soft) {  // every particle that is not pinned
+    if (!info.has_body_state()) {  // every particle that is not pinned
       // A soft body turns about the mean of its particles: v + w x (x - mean).
       const vec4 mean = state.body_pos[b];
       const Eigen::Vector3d w =

@@ -239,12 +239,12 @@ Result<std::unique_ptr<DistributedSimulation>> DistributedSimulation::create(
   MPI_Comm_size(comm, &d->size_);
   d->open_device_ = std::move(open_device);
   d->scene_ = std::move(whole);
-  // Every rank refuses a scene with fluids, as Simulation::create does (no kernel runs them yet:
-  // docs/fluids.md); the ranks' own scenes would otherwise leave the liquid out.
+  // Every rank refuses a scene with fluids: the partition and the halo carry bodies, and a rank's
+  // own scene would leave the liquid out (fluids run in one process: docs/fluids.md).
   if (!d->scene_.fluids.empty()) {
     return Status::error(
-        fmt::format("{}: fluid \"{}\": fluids are not simulated yet (issue 29; "
-                    "docs/fluids.md)",
+        fmt::format("{}: fluid \"{}\": fluids do not run over MPI ranks yet (one process runs "
+                    "them: docs/fluids.md)",
                     d->scene_.source, d->scene_.fluids.front().name));
   }
   // The impulse contacts' memory is each rank's own and does not travel with a partition (which

@@ -273,6 +273,21 @@ MOTES_FN vec4 fluid_plane_density(vec4 normal_offset, vec3 xi, MOTES_IN(FluidMat
               fi.density_h.x * fluid_plane_share(z, h));
 }
 
+/// A dynamic rigid particle b's reaction to its pair with fluid particle i (fluid_update): minus
+/// the momentum i gains from the pair's term of its correction dx_i, computed as i computes it
+/// (fluid_shift_term with b's lambda 0, no s_corr and b's mass psi_b of i's material,
+/// fluid_neighbour_mass), over the substep h_s; summed over b's fluid neighbours, its body takes
+/// it (particles_update with MOTES_FLAG_ABSORB | MOTES_FLAG_PARTICLE_SHIFT), so the pair keeps its
+/// momentum.
+MOTES_FN vec3 fluid_solid_reaction(vec3 xi, float lambda_i, vec3 xb, float rb,
+                                   MOTES_IN(FluidMaterial) fi, float hs) {
+  float mi = fi.density_h.z;
+  float psi = fluid_neighbour_mass(false, 0.0f, rb, fi);
+  vec3 term = fluid_shift_term(lambda_i, 0.0f, mi, psi, 0.0f,
+                               fluid_spiky_gradient(xi - xb, fi.density_h.y), fi.density_h.x);
+  return fluid_rigid_reaction(term, mi, hs);
+}
+
 MOTES_SHARED_END
 
 #ifdef __cplusplus

@@ -83,6 +83,13 @@ MOTES_FN float shift_partner_inverse_mass(uint j, uint rigid_count, float wj) {
   return j < rigid_count ? 0.0f : wj;
 }
 
+/// Two fluid particles have no position contact: the density constraint sets their spacing, and
+/// a contact at d would fight its equilibrium where the liquid is compressed (docs/fluids.md, "The
+/// substep", 6). Fluid against any other kind keeps it. [fluid_first, + fluid_count): StepParams'.
+MOTES_FN bool shift_pair_skipped(uint i, uint j, uint fluid_first, uint fluid_count) {
+  return i - fluid_first < fluid_count && j - fluid_first < fluid_count;
+}
+
 /// A particle's contacts within reach for the shares above: its list's count and the planes.
 MOTES_FN float particle_shift_count(uint listed, uint planes) { return float(listed + planes); }
 

@@ -28,7 +28,9 @@
 
 #include "physics/physics_scenes.h"
 
-namespace {
+// A named namespace: the unity build compiles this file with its neighbours, whose anonymous
+// namespaces have constants of the same names (kFrame, kDensity).
+namespace position_physics {
 
 using motes_test::to_vec3;
 
@@ -521,4 +523,4 @@ TEST(PositionContact, CollisionWithoutGravityKeepsMomentum) {
   EXPECT_LT((p1 - p0).norm(), 1e-6 * p0.norm()) << p0.transpose() << " -> " << p1.transpose();
 }
 
-}  // namespace
+}  // namespace position_physics

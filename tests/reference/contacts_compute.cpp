@@ -41,6 +41,10 @@ std::vector<vec4> contacts_compute(const Particles& particles, const std::vector
     const bool by_impulse = motes::shared::impulse_particle(p.flags, uint(i), rigid);
     for (std::size_t j = 0; j < n; ++j) {
       if (by_impulse && j < rigid) continue;
+      if (positions &&
+          motes::shared::shift_pair_skipped(uint(i), uint(j), p.fluid_first, p.fluid_count)) {
+        continue;  // two fluid particles: the density constraint's
+      }
       const vec4 xj = particles.pos[j];
       // Apart along x by the radii's sum or more: the term is 0 (its float
       // dx * dx alone reaches rsum * rsum), which adds nothing.

@@ -1,6 +1,7 @@
 // The oracle of fluid_update (docs/fluids.md): each fluid particle's correction summed over the
 // oracle's own full lists (motes_ref::neighbours_build), in list order, then the planes in order,
-// with shared/fluid.h's terms; every other particle's 0.
+// with shared/fluid.h's terms; a dynamic rigid particle's reaction to its fluid neighbours over its
+// list (fluid_solid_reaction); every other particle's 0.
 #include "reference.h"
 #include "shared/fluid.h"
 
@@ -62,6 +63,18 @@ std::vector<vec4> fluid_update(const Particles& particles, const Neighbours& nb,
             (sh::fluid_plane_share_slope(z, h) * (lambda_i * particles.vel[i].w));
     }
     out[i] = vec4(dx, 1.0f);
+  }
+  for (std::size_t b = 0; b < p.rigid_particle_count; ++b) {
+    if (particles.vel[b].w == 0.0f) continue;
+    const vec3 xb = sh::xyz(particles.pos[b]);
+    vec3 reaction(0.0f);
+    for (const uint j : nb.lists[b]) {
+      if (!is_fluid(j, p)) continue;
+      reaction += sh::fluid_solid_reaction(sh::xyz(particles.pos[j]), state[j - p.fluid_first].y,
+                                           xb, particles.pos[b].w, fluids[particles.material[j]],
+                                           p.gravity_dt.w);
+    }
+    out[b] = vec4(reaction, 0.0f);
   }
   return out;
 }

@@ -1,6 +1,6 @@
 // Fluids in scene files (issue 29; docs/scene-format.md, "Fluids"): the box and sphere fills at the
 // rest spacing, the material's fluid fields and their defaults, the located errors, and the
-// clear refusal of Simulation::create while no kernel runs a fluid.
+// fluid's place among a Simulation's bodies.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -184,18 +184,48 @@ TEST(SceneFluid, ErrorsNameTheFileThePlaceAndTheReason) {
   }
 }
 
-TEST(SceneFluid, SimulationSaysFluidsAreNotRunYet) {
+TEST(SceneFluid, SimulationLaysTheFluidOutAfterTheBodiesInTheSceneOrder) {
+  // A rigid box, a free sphere and a fluid: the fluid is the scene's third entry, its particles
+  // follow the bodies' in a Snapshot, where they keep the fill's places, velocity and mass.
   Result<Scene> r = load_fluid_text(fluid_scene(
-      R"({"name": "water", "kind": "fluid", "fluid": {"type": "box", "min": [0, 0, 0],
-          "max": [0.02, 0.02, 0.02]}})"));
+      R"({"name": "box", "shape": {"type": "box", "size": [0.02, 0.02, 0.02]},
+          "position": [0.5, 0.5, 0.5]},
+         {"name": "ball", "shape": {"type": "sphere", "radius": 0.005}, "position": [-0.5, 0, 0]},
+         {"name": "water", "kind": "fluid", "velocity": [0.25, 0, 0], "material": "water",
+          "fluid": {"type": "box", "min": [0, 0, 0], "max": [0.02, 0.02, 0.03]}})",
+      R"({"water": {"density": 1000, "rest_density": 998}})"));
   ASSERT_TRUE(r) << r.message();
   auto device = open_device("openmp");
   ASSERT_TRUE(device) << device.message();
-  auto sim = Simulation::create(r.value(), std::move(device).value());
-  ASSERT_FALSE(sim);
-  EXPECT_NE(sim.message().find("s.json: fluid \"water\": fluids are not simulated yet"),
-            std::string::npos)
-      << sim.message();
+  auto created = Simulation::create(r.value(), std::move(device).value());
+  ASSERT_TRUE(created) << created.message();
+  Simulation& sim = *created.value();
+  const std::vector<BodyInfo>& bodies = sim.bodies();
+  ASSERT_EQ(bodies.size(), 3u);
+  const BodyInfo& water = bodies[2];
+  EXPECT_EQ(water.name, "water");
+  EXPECT_TRUE(water.fluid);
+  EXPECT_FALSE(water.has_body_state());
+  ASSERT_EQ(water.particle_count, 12u);
+  EXPECT_EQ(water.first_particle, bodies[1].first_particle + bodies[1].particle_count);
+  const double mass = 998.0 * 1e-6;  // rest density x d^3
+  EXPECT_NEAR(water.mass, 12.0 * mass, 1e-12);
+  EXPECT_EQ(sim.sizes().fluid_particles, 12u);
+  auto snap = sim.snapshot();
+  ASSERT_TRUE(snap) << snap.message();
+  const FluidSpec& spec = r.value().fluids[0];
+  for (std::uint32_t k = 0; k < water.particle_count; ++k) {
+    const shared::vec4 x = snap->particle_pos[water.first_particle + k];
+    const shared::vec4 v = snap->particle_vel[water.first_particle + k];
+    EXPECT_TRUE(Eigen::Vector3d(x.x, x.y, x.z).isApprox(spec.points[k], 1e-6)) << k;
+    EXPECT_FLOAT_EQ(x.w, 0.005f);
+    EXPECT_FLOAT_EQ(v.x, 0.25f);
+    EXPECT_NEAR(1.0 / static_cast<double>(v.w), mass, 1e-6 * mass);
+    EXPECT_EQ(snap->particle_body[water.first_particle + k], 2u);
+  }
+  EXPECT_NEAR(snap->body_vel[2].x, 0.25f, 1e-6f);  // its mean
+  // A step runs (the density constraint's kernels on the OpenMP device).
+  ASSERT_TRUE(sim.step(1));
 }
 
 }  // namespace

@@ -37,6 +37,10 @@ constexpr int kFluidScorrPower = 4;       ///< s_corr's n
 constexpr double kFluidScorrDq = 0.2;     ///< s_corr's dq / h
 constexpr double kFluidSolidScale = 1.0;  ///< psi_b = s rho_0 d_b^3
 
+/// A fluid particle's mass, rho_0 d^3 (rho_0 the material's rest_density, else its density): the
+/// rest lattice of spacing d holds the rest density.
+double fluid_particle_mass(const Material& m, double diameter);
+
 /// The denominator sum_k w_k |grad_k C_i|^2 of a particle of the rest lattice (spacing d, h = 2 d,
 /// mass rho_0 d^3: grad_i C_i vanishes by symmetry, so (m / rho_0^2) sum_j |grad W_ij|^2 =
 /// 0.3734 m / (rho_0^2 d^8)), summed in double over the lattice.

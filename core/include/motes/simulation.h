@@ -63,6 +63,9 @@ struct BodyInfo {
   /// A soft body (shape matching): like a cloth, its body state in a Snapshot is the mean
   /// position and velocity of its particles.
   bool soft = false;
+  /// A fluid (Scene::fluids; they follow the cloths and ropes): like a soft body, its body state
+  /// in a Snapshot is the mean position and velocity of its particles.
+  bool fluid = false;
   /// A soft body's shape-matching clusters: Snapshot::cluster_rotation [first_cluster,
   /// + cluster_count).
   std::uint32_t first_cluster = 0;
@@ -70,14 +73,14 @@ struct BodyInfo {
 
   /// A rigid body on the device, a static one too: it has body state (BodyPos ... BodyAngVel),
   /// and in a halo its five vectors travel after its particles' (shared/halo.h).
-  [[nodiscard]] bool has_body_state() const { return !free_sphere && !linked && !soft; }
+  [[nodiscard]] bool has_body_state() const { return !free_sphere && !linked && !soft && !fluid; }
 };
 
-/// A scene's bodies, then its cloths and ropes, in the scene's order with the particle ranges of
-/// a Snapshot (BodyInfo's name, kind, first_particle, particle_count, soft, linked; a body's
-/// mass, free_sphere and clusters are the Simulation's: Simulation::bodies), with the particle
-/// count and the largest particle diameter. Simulation::create lays a scene out from it; a run
-/// over MPI ranks describes the whole scene with it.
+/// A scene's bodies, then its cloths and ropes, then its fluids, in the scene's order with the
+/// particle ranges of a Snapshot (BodyInfo's name, kind, first_particle, particle_count, soft,
+/// linked; a body's mass, free_sphere and clusters are the Simulation's: Simulation::bodies), with
+/// the particle count and the largest particle diameter. Simulation::create lays a scene out from
+/// it; a run over MPI ranks describes the whole scene with it.
 struct SceneBodies {
   std::vector<BodyInfo> bodies;
   std::uint64_t particles = 0;
@@ -324,6 +327,10 @@ class Simulation {
   void relax_constraints();
   /// Cloth and ropes attached to rigid bodies: the bodies take the constraints' pull.
   void absorb_attachments();
+  /// The fluids' density constraint in a substep of step_positions (docs/fluids.md, "The
+  /// substep", 5): settings.fluid_iterations Jacobi sweeps; with dynamic rigid bodies each takes
+  /// its particles' reactions to the liquid (`bodies`).
+  void relax_fluids(bool bodies);
   /// Impulse contacts: every contact's accumulated impulse to zero and its list slots void (a
   /// new state has no contact history to warm-start from).
   Status clear_contact_history();

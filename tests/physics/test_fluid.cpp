@@ -1,0 +1,213 @@
+// Position-based fluids (issue 29; docs/fluids.md) on the OpenMP device, against answers that do
+// not come from motes:
+// - hydrostatics: a tank of 12 x 14 x 12 particles (d = 1 cm, the settled parameter set: 16
+//   substeps of 1/60 s, 2 sweeps) at rest for 2 s: the bulk's mean density within 1% of the rest
+//   density (the bulk: particles more than h = 2 d from the walls, the floor and the surface, the
+//   97th percentile of the heights; the surface layer is excluded), and the pressure of the last
+//   0.25 s's mean summed lambda (fluid_pressure), Shepard-filtered, fitted against the depth and
+//   times the bulk's mean kernel-gradient moment M_yy, within 5% of rho_0 g (docs/fluids.md,
+//   "Settled with the prototype", says why each step of this reading is needed);
+// - momentum: a ball of liquid thrown without gravity at a free rigid box: the linear momentum of
+//   the liquid and the box kept to 1e-6 relative (the box takes the reaction of each fluid
+//   particle's shift, fluid_solid_reaction, and of the contacts).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "motes/fluid.h"
+#include "physics/physics_scenes.h"
+#include "shared/fluid.h"
+
+namespace fluid_physics {
+
+using motes_test::to_vec3;
+
+constexpr double kFluidFrame = 1.0 / 60.0;
+constexpr double kFluidD = 0.01;
+
+motes::Material water() {
+  motes::Material m = motes_test::material(1000.0, 0.0, 0.0, 0.0, 0.0);
+  m.name = "water";
+  return m;
+}
+
+/// A scene of position contacts with the settled fluid defaults (16 substeps, 2 sweeps, 64 list
+/// entries) and a water material (0).
+motes::Scene fluid_scene(const Eigen::Vector3d& gravity) {
+  motes::Scene scene = motes_test::scene_with(kFluidFrame, gravity, water());
+  scene.settings.contact_model = motes::ContactModel::Positions;
+  scene.settings.substeps = motes::kFluidSubsteps;
+  scene.settings.fluid_iterations = motes::kFluidIterations;
+  scene.settings.neighbour_capacity = motes::kFluidNeighbourCapacity;
+  return scene;
+}
+
+/// A block of nx x ny x nz fluid particles on the rest lattice, its lowest corner particle's
+/// centre at `corner`.
+motes::FluidSpec fluid_block(int nx, int ny, int nz, const Eigen::Vector3d& corner) {
+  motes::FluidSpec f;
+  f.name = "water";
+  f.diameter = kFluidD;
+  for (int x = 0; x < nx; ++x) {
+    for (int y = 0; y < ny; ++y) {
+      for (int z = 0; z < nz; ++z) f.points.push_back(corner + kFluidD * Eigen::Vector3d(x, y, z));
+    }
+  }
+  return f;
+}
+
+TEST(Fluid, TankAtRestHoldsItsDensityAndItsPressureGrowsWithDepth) {
+  constexpr int kSide = 12;
+  constexpr int kLayers = 14;
+  const double width = kSide * kFluidD;
+  motes::Scene scene = fluid_scene(Eigen::Vector3d(0.0, -9.81, 0.0));
+  scene.fluids.push_back(
+      fluid_block(kSide, kLayers, kSide, Eigen::Vector3d::Constant(0.5 * kFluidD)));
+  scene.planes.push_back(motes_test::plane({0, 1, 0}, {0, 0, 0}));
+  scene.planes.push_back(motes_test::plane({1, 0, 0}, {0, 0, 0}));
+  scene.planes.push_back(motes_test::plane({-1, 0, 0}, {width, 0, 0}));
+  scene.planes.push_back(motes_test::plane({0, 0, 1}, {0, 0, 0}));
+  scene.planes.push_back(motes_test::plane({0, 0, -1}, {0, 0, width}));
+  auto sim_r = motes_test::simulate(scene, 2);
+  ASSERT_TRUE(sim_r) << sim_r.status().message();
+  motes::Simulation& sim = *sim_r.value();
+
+  // The fluid is the scene's only object: device particle k is the scene's k, FluidState[k].
+  const std::size_t n = scene.fluids[0].points.size();
+  const double hs = kFluidFrame / motes::kFluidSubsteps;
+  const motes::shared::FluidMaterial f = motes::fluid_material(water(), kFluidD, hs);
+  const double rho0 = f.density_h.x;
+  const double h = f.density_h.y;
+  const double m = f.density_h.z;
+  constexpr int kFluidFrames = 120;  // 2 s
+  constexpr int kMeanFrames = 15;    // the last 0.25 s
+  std::vector<double> lambda_sum(n, 0.0);
+  std::vector<motes::shared::vec4> state;
+  for (int frame = 0; frame < kFluidFrames; ++frame) {
+    ASSERT_TRUE(sim.step(1));
+    if (frame < kFluidFrames - kMeanFrames) continue;
+    auto read = motes_test::read_vec4(sim, motes::Buffer::FluidState);
+    ASSERT_TRUE(read) << read.status().message();
+    state = read.value();
+    for (std::size_t k = 0; k < n; ++k) lambda_sum[k] += static_cast<double>(state[k].z);
+  }
+  auto snap = sim.snapshot();
+  ASSERT_TRUE(snap) << snap.status().message();
+  std::vector<Eigen::Vector3d> x(n);
+  std::vector<double> heights(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    x[k] = to_vec3(snap.value().particle_pos[k]);
+    heights[k] = x[k].y();
+    ASSERT_TRUE(x[k].allFinite());
+  }
+  std::vector<double> sorted = heights;
+  std::sort(sorted.begin(), sorted.end());
+  const double surface = sorted[static_cast<std::size_t>(0.97 * static_cast<double>(n - 1))];
+  // The column stands where it was filled (14 layers: 0.14 m) within a layer.
+  EXPECT_NEAR(surface, kLayers * kFluidD - 0.5 * kFluidD, kFluidD)
+      << "surface (97th percentile of centres)";
+
+  // The bulk, the pressure (Shepard-filtered) and the kernel gradient's moment, over all pairs.
+  std::vector<double> pressure(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    pressure[k] = static_cast<double>(
+        motes::shared::fluid_pressure(static_cast<float>(lambda_sum[k] / kMeanFrames),
+                                      f.density_h.x, f.density_h.z, static_cast<float>(hs)));
+  }
+  double density_sum = 0.0;
+  double worst_density = 0.0;
+  double myy_sum = 0.0;
+  std::vector<double> depth, filtered;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d& xi = x[i];
+    const bool bulk = xi.x() > h && xi.x() < width - h && xi.z() > h && xi.z() < width - h &&
+                      xi.y() > h && xi.y() < surface - h;
+    if (!bulk) continue;
+    double wsum = 0.0;
+    double psum = 0.0;
+    double myy = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+      const Eigen::Vector3d r = xi - x[j];
+      const double r2 = r.squaredNorm();
+      if (r2 >= h * h) continue;
+      const double w = static_cast<double>(
+          motes::shared::fluid_poly6(static_cast<float>(r2), static_cast<float>(h)));
+      wsum += w;
+      psum += w * pressure[j];
+      if (j == i) continue;
+      const motes::shared::vec3 term = motes::shared::fluid_gradient_moment_term(
+          motes::shared::vec3(static_cast<float>(r.x()), static_cast<float>(r.y()),
+                              static_cast<float>(r.z())),
+          static_cast<float>(m), static_cast<float>(rho0), static_cast<float>(h));
+      myy += static_cast<double>(term.y);
+    }
+    const double c = static_cast<double>(state[i].x) / rho0 - 1.0;
+    density_sum += c;
+    worst_density = std::max(worst_density, std::abs(c));
+    myy_sum += myy;
+    depth.push_back(surface - xi.y());
+    filtered.push_back(psum / wsum);
+  }
+  const auto bulk = static_cast<double>(depth.size());
+  ASSERT_GT(bulk, 200.0) << "too few bulk particles to measure";
+  const double mean_density = density_sum / bulk;
+  EXPECT_LT(std::abs(mean_density), 0.01) << "bulk density error (mean), worst " << worst_density;
+  // Least squares of the filtered pressure against the depth.
+  double sd = 0.0, sp = 0.0, sdd = 0.0, sdp = 0.0;
+  for (std::size_t k = 0; k < depth.size(); ++k) {
+    sd += depth[k];
+    sp += filtered[k];
+    sdd += depth[k] * depth[k];
+    sdp += depth[k] * filtered[k];
+  }
+  const double slope = (bulk * sdp - sd * sp) / (bulk * sdd - sd * sd);
+  const double myy = myy_sum / bulk;
+  const double measured = slope * myy / (rho0 * 9.81);
+  EXPECT_NEAR(measured, 1.0, 0.05) << "pressure slope x M_yy / (rho_0 g); raw slope / rho_0 g "
+                                   << slope / (rho0 * 9.81) << ", M_yy " << myy;
+  std::printf(
+      "tank: %zu particles, bulk %zu, density %+.3f%% (worst %.2f%%), slope x M_yy / "
+      "rho_0 g %.4f (M_yy %.4f), surface %.4f m\n",
+      n, depth.size(), 100.0 * mean_density, 100.0 * worst_density, measured, myy, surface);
+}
+
+TEST(Fluid, ASplashOnAFreeBoxKeepsMomentum) {
+  motes::Scene scene = fluid_scene(Eigen::Vector3d::Zero());
+  // A 4 x 4 x 4 box of particles of d, at rest, and a 6 x 6 x 6 block of water moving at it.
+  motes::BodySpec box =
+      motes_test::body(motes_test::lattice(4, 4, 4, kFluidD), Eigen::Vector3d(0.1, 0.0, 0.0));
+  box.name = "box";
+  scene.bodies.push_back(box);
+  motes::FluidSpec ball = fluid_block(6, 6, 6, Eigen::Vector3d(-0.025, -0.02, -0.03));
+  ball.velocity = Eigen::Vector3d(1.0, 0.1, 0.0);
+  scene.fluids.push_back(ball);
+  auto sim_r = motes_test::simulate(scene, 2);
+  ASSERT_TRUE(sim_r) << sim_r.status().message();
+  motes::Simulation& sim = *sim_r.value();
+  const std::vector<motes::BodyInfo>& bodies = sim.bodies();
+  ASSERT_EQ(bodies.size(), 2u);
+  ASSERT_TRUE(bodies[1].fluid);
+  const auto momentum = [&](const motes::Snapshot& s) {
+    Eigen::Vector3d p = bodies[0].mass * to_vec3(s.body_vel[0]);
+    for (std::uint32_t k = 0; k < bodies[1].particle_count; ++k) {
+      const motes::shared::vec4 v = s.particle_vel[bodies[1].first_particle + k];
+      p += to_vec3(v) / static_cast<double>(v.w);
+    }
+    return p;
+  };
+  auto start = sim.snapshot();
+  ASSERT_TRUE(start);
+  const Eigen::Vector3d p0 = momentum(start.value());
+  ASSERT_TRUE(sim.step(12));  // 0.2 s: the liquid reaches the box and splashes on it
+  auto end = sim.snapshot();
+  ASSERT_TRUE(end);
+  const Eigen::Vector3d p1 = momentum(end.value());
+  const double box_speed = to_vec3(end.value().body_vel[0]).x();
+  EXPECT_GT(box_speed, 0.05) << "the liquid pushed the box";
+  EXPECT_LT((p1 - p0).norm(), 1e-6 * p0.norm())
+      << "momentum before " << p0.transpose() << ", after " << p1.transpose();
+}
+
+}  // namespace fluid_physics
