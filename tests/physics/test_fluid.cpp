@@ -7,6 +7,12 @@
 //   0.25 s's mean summed lambda (fluid_pressure), Shepard-filtered, fitted against the depth and
 //   times the bulk's mean kernel-gradient moment M_yy, within 5% of rho_0 g (docs/fluids.md,
 //   "Settled with the prototype", says why each step of this reading is needed);
+// - the dam break of Martin and Moyce (1952), n^2 = 2: a column a = 8 d wide and 2 a high, rested
+//   1 s behind a wall that is then taken away; its surge front (the 99th percentile of the
+//   particles' leading edges, so that the few squeezed out along the floor do not lead it) over
+//   the floor, Z = x / a against T = t sqrt(2 g / a), within 10% of every point of both of their
+//   series up to T = 9.2 (figure 3, a = 1.125 and 2.25 in, as digitized in PySPH's
+//   db_exp_data.py); the largest density error of any particle at the end of a frame below 2%;
 // - momentum: a ball of liquid thrown without gravity at a free rigid box: the linear momentum of
 //   the liquid and the box kept to 1e-6 relative (the box takes the reaction of each fluid
 //   particle's shift, fluid_solid_reaction, and of the contacts).
@@ -171,6 +177,90 @@ TEST(Fluid, TankAtRestHoldsItsDensityAndItsPressureGrowsWithDepth) {
       "tank: %zu particles, bulk %zu, density %+.3f%% (worst %.2f%%), slope x M_yy / "
       "rho_0 g %.4f (M_yy %.4f), surface %.4f m\n",
       n, depth.size(), 100.0 * mean_density, 100.0 * worst_density, measured, myy, surface);
+}
+
+/// Martin and Moyce 1952, figure 3, n^2 = 2: (T, Z) of the surge front for a = 1.125 in and
+/// a = 2.25 in (digitized in PySPH's pysph/examples/db_exp_data.py).
+constexpr double kMartinMoyce[][2] = {
+    {0.849, 1.245}, {1.212, 1.443},  {1.602, 1.884},  {2.283, 2.689},  {2.950, 3.728},
+    {3.598, 4.528}, {3.905, 4.999},  {4.592, 5.841},  {4.961, 6.271},  {5.316, 6.717},
+    {0.832, 1.217}, {1.219, 1.474},  {1.997, 2.292},  {2.547, 2.995},  {3.345, 4.134},
+    {4.034, 4.944}, {4.418, 5.881},  {5.091, 6.980},  {5.685, 7.945},  {6.306, 8.966},
+    {6.822, 9.986}, {7.439, 10.963}, {8.031, 11.977}, {8.633, 13.005}, {9.237, 13.970}};
+
+TEST(Fluid, DamBreakFrontFollowsMartinAndMoyce) {
+  constexpr int kWide = 8;  // a = 8 d
+  const double a = kWide * kFluidD;
+  const double length = 130 * kFluidD;
+  const double depth = 8 * kFluidD;
+  motes::Scene scene = fluid_scene(Eigen::Vector3d(0.0, -9.81, 0.0));
+  scene.fluids.push_back(
+      fluid_block(kWide, 2 * kWide, 8, Eigen::Vector3d::Constant(0.5 * kFluidD)));
+  scene.planes.push_back(motes_test::plane({0, 1, 0}, {0, 0, 0}));
+  scene.planes.push_back(motes_test::plane({1, 0, 0}, {0, 0, 0}));
+  scene.planes.push_back(motes_test::plane({-1, 0, 0}, {length, 0, 0}));
+  scene.planes.push_back(motes_test::plane({0, 0, 1}, {0, 0, 0}));
+  scene.planes.push_back(motes_test::plane({0, 0, -1}, {0, 0, depth}));
+  motes::Scene held = scene;
+  held.planes.push_back(motes_test::plane({-1, 0, 0}, {a, 0, 0}));  // the dam
+  auto rest_r = motes_test::simulate(held, 2);
+  ASSERT_TRUE(rest_r) << rest_r.status().message();
+  ASSERT_TRUE(rest_r.value()->step(60));  // 1 s at rest behind the dam
+  auto rested = rest_r.value()->snapshot();
+  ASSERT_TRUE(rested) << rested.status().message();
+  auto sim_r = motes_test::simulate(scene, 2);
+  ASSERT_TRUE(sim_r) << sim_r.status().message();
+  motes::Simulation& sim = *sim_r.value();
+  motes::Snapshot start = rested.value();
+  start.time = 0.0;
+  start.step = 0;
+  ASSERT_TRUE(sim.write_state(start));
+
+  const std::size_t n = scene.fluids[0].points.size();
+  const double rho0 = 1000.0;
+  const double t_scale = std::sqrt(2.0 * 9.81 / a);
+  std::vector<double> times{0.0}, fronts;
+  const auto front = [&](const motes::Snapshot& s) {
+    std::vector<double> edge(n);
+    for (std::size_t k = 0; k < n; ++k)
+      edge[k] = static_cast<double>(s.particle_pos[k].x) + 0.5 * kFluidD;
+    std::sort(edge.begin(), edge.end());
+    return edge[static_cast<std::size_t>(0.99 * static_cast<double>(n - 1))] / a;
+  };
+  fronts.push_back(front(start));
+  double worst_density = 0.0;
+  constexpr int kFrames = 38;  // 0.63 s: T = 9.9
+  for (int frame = 1; frame <= kFrames; ++frame) {
+    ASSERT_TRUE(sim.step(1));
+    auto state = motes_test::read_vec4(sim, motes::Buffer::FluidState);
+    ASSERT_TRUE(state) << state.status().message();
+    double largest = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      largest = std::max(largest, static_cast<double>(state.value()[k].x) / rho0 - 1.0);
+    }
+    auto snap = sim.snapshot();
+    ASSERT_TRUE(snap);
+    times.push_back(frame * kFluidFrame * t_scale);
+    fronts.push_back(front(snap.value()));
+    worst_density = std::max(worst_density, largest);
+    std::printf("dam break: T %.3f Z %.3f, largest density error %.2f%%\n", times.back(),
+                fronts.back(), 100.0 * largest);
+  }
+  EXPECT_LT(worst_density, 0.02) << "the largest density error of a frame";
+  double worst = 0.0;
+  for (const auto& [t, z] : kMartinMoyce) {
+    const auto after = std::upper_bound(times.begin(), times.end(), t);
+    ASSERT_NE(after, times.end()) << "T " << t << " is past the run";
+    const std::size_t k = static_cast<std::size_t>(after - times.begin());
+    const double u = (t - times[k - 1]) / (times[k] - times[k - 1]);
+    const double zs = fronts[k - 1] + u * (fronts[k] - fronts[k - 1]);
+    EXPECT_NEAR(zs / z, 1.0, 0.10) << "at T " << t << ": Z " << zs << " against " << z;
+    worst = std::max(worst, std::abs(zs / z - 1.0));
+  }
+  std::printf(
+      "dam break: the front within %.1f%% of Martin and Moyce's points; largest density "
+      "error %.2f%%\n",
+      100.0 * worst, 100.0 * worst_density);
 }
 
 TEST(Fluid, ASplashOnAFreeBoxKeepsMomentum) {
