@@ -200,9 +200,11 @@ double compulsory_bytes(motes::Kernel k, const Measurement& m) {
     case motes::Kernel::ImpulsesApply:  // per sweep: read first, com, quat, inertia, vel, angmom,
                                         // impulses and moments; write vel, angmom, angvel
       return (4.0 * (b + 1) + 128.0 * b + 32.0 * nr) * static_cast<double>(m.impulse_sweeps);
-    case motes::Kernel::FluidDensity:  // no benchmark workload has fluid (docs/fluids.md): per
-    case motes::Kernel::FluidUpdate:   // fluid particle and sweep, read own pos, vel, material,
-                                       // count, state; write state or shift (not counted yet)
+    case motes::Kernel::FluidDensity:    // no benchmark workload has fluid (docs/fluids.md):
+    case motes::Kernel::FluidUpdate:     // per fluid particle and sweep (density, update) or
+    case motes::Kernel::FluidVorticity:  // substep (vorticity, velocity), read own pos, vel,
+    case motes::Kernel::FluidVelocity:   // material, count, state; write state, shift, the
+                                         // vorticity's three or the velocity (not counted yet)
       return 0;
     case motes::Kernel::ParticlesCheck:  // not in a step (the run's guard): read pos, vel
       return 32 * n;
@@ -493,7 +495,8 @@ void run_bench(const BenchOptions& o) {
   // Column labels of the kernel families, in motes::Kernel order (JSON has the full names).
   constexpr std::array kLabels = {"nb_upd",   "grid",     "nb_build", "contacts", "b_reduce",
                                   "b_integr", "p_update", "p_integr", "cl_fit",   "cl_goal",
-                                  "constr",   "imp_comp", "imp_appl", "fl_dens",  "fl_upd"};
+                                  "constr",   "imp_comp", "imp_appl", "fl_dens",  "fl_upd",
+                                  "fl_vort",  "fl_vel"};
   static_assert(kLabels.size() == kStepKernels, "a label per kernel family of a step");
   std::string ks;
   for (const char* label : kLabels) ks += fmt::format(" {:>8}", label);

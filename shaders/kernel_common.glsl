@@ -72,6 +72,9 @@ layout(std430, binding = B_FLUID_STATE) buffer FluidStateBuf { vec4 fluid_state[
 layout(std430, binding = B_FLUID_MATERIALS) readonly buffer FluidMaterialsBuf {
   FluidMaterial fluid_materials[];
 };
+layout(std430, binding = B_FLUID_VEL_OLD) buffer FluidVelOldBuf { vec4 fluid_vel_old[]; };
+layout(std430, binding = B_FLUID_AUX) buffer FluidAuxBuf { vec4 fluid_aux[]; };
+layout(std430, binding = B_FLUID_NORMAL) buffer FluidNormalBuf { vec4 fluid_normal[]; };
 layout(std430, binding = B_GRID_ARRIVAL) buffer GridArrivalBuf { uint grid_arrival[]; };
 layout(std430, binding = B_GRID_UNSORTED) buffer GridUnsortedBuf { uint grid_unsorted[]; };
 layout(std430, binding = B_SCAN_SCRATCH) buffer ScanScratchBuf { uint scan_scratch[]; };

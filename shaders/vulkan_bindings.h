@@ -53,15 +53,18 @@
 #define B_BODY_POS_LOW 46
 #define B_FLUID_STATE 47
 #define B_FLUID_MATERIALS 48
+#define B_FLUID_VEL_OLD 49
+#define B_FLUID_AUX 50
+#define B_FLUID_NORMAL 51
 // Scratch buffers of the backend (not part of motes::Buffer).
-#define B_GRID_ARRIVAL 49  // uint (N): arrival rank of a particle in its bucket (atomic, any order)
-#define B_GRID_UNSORTED 50  // uint (N): particle ids grouped by bucket, in arrival order
-#define B_SCAN_SCRATCH 51   // uint: block sums of every level of the bucket-count scan
+#define B_GRID_ARRIVAL 52  // uint (N): arrival rank of a particle in its bucket (atomic, any order)
+#define B_GRID_UNSORTED 53  // uint (N): particle ids grouped by bucket, in arrival order
+#define B_SCAN_SCRATCH 54   // uint: block sums of every level of the bucket-count scan
 // uint: VkDispatchIndirectCommand (4 words each) of every pass of a conditional rebuild, then the
 // same for when it runs (written once at allocate); neighbours_update.comp copies or zeroes the
 // first.
-#define B_INDIRECT_ARGS 52
-#define B_COUNT 53
+#define B_INDIRECT_ARGS 55
+#define B_COUNT 56
 
 // Threads per workgroup of every kernel; the scan handles 4 elements per thread.
 #define WORKGROUP_SIZE 256

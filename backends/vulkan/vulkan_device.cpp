@@ -47,6 +47,9 @@ static_assert(B_BODY_ANGMOM_PUSH == static_cast<int>(Buffer::BodyAngMomPush));
 static_assert(B_ENERGY_PARTIALS == static_cast<int>(Buffer::EnergyPartials));
 static_assert(B_FLUID_STATE == static_cast<int>(Buffer::FluidState));
 static_assert(B_FLUID_MATERIALS == static_cast<int>(Buffer::FluidMaterials));
+static_assert(B_FLUID_VEL_OLD == static_cast<int>(Buffer::FluidVelOld));
+static_assert(B_FLUID_AUX == static_cast<int>(Buffer::FluidAux));
+static_assert(B_FLUID_NORMAL == static_cast<int>(Buffer::FluidNormal));
 static_assert(B_GRID_ARRIVAL == static_cast<int>(Buffer::Count));
 
 namespace {

@@ -100,6 +100,12 @@ const char* buffer_name(Buffer b) {
       return "FluidState";
     case Buffer::FluidMaterials:
       return "FluidMaterials";
+    case Buffer::FluidVelOld:
+      return "FluidVelOld";
+    case Buffer::FluidAux:
+      return "FluidAux";
+    case Buffer::FluidNormal:
+      return "FluidNormal";
     case Buffer::ImpulseStamp:
       return "ImpulseStamp";
     case Buffer::MotionCheck:
@@ -257,6 +263,9 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
     case Buffer::PartitionCheck:
       return {kUint, s.partition != 0 ? std::size_t{1} : 0};
     case Buffer::FluidState:
+    case Buffer::FluidVelOld:
+    case Buffer::FluidAux:
+    case Buffer::FluidNormal:
       return {kVec4, s.fluid_particles};
     case Buffer::FluidMaterials:
       return {sizeof(shared::FluidMaterial), s.fluid_particles > 0 ? std::size_t{s.materials} : 0};

@@ -1,5 +1,6 @@
-// What the fluid families' cases share (test_fluid_density.cpp, test_fluid_update.cpp): a world
-// of rigid bodies around a block of fluid, its oracle lists, and writing the families' inputs.
+// What the fluid families' cases share (test_fluid_density.cpp, test_fluid_update.cpp,
+// test_fluid_vorticity.cpp, test_fluid_velocity.cpp): a world of rigid bodies around a block of
+// fluid, its oracle lists, and writing the families' inputs.
 #pragma once
 
 #include <algorithm>
@@ -91,6 +92,35 @@ inline FluidWorld fluid_world(std::uint32_t seed, std::size_t n, float spacing, 
   fw.grid = motes_ref::grid_build(w.particles, p);
   fw.nb = motes_ref::neighbours_build(w.particles, fw.grid, p);
   return fw;
+}
+
+/// The velocity-level parameters of the stirred cases: XSPH c 0.1, vorticity eps 0.5 m/s,
+/// cohesion gamma 0.5, adhesion beta 2 (each term a visible part of the change of velocity).
+inline const vec4 kFluidStirParameters(0.1f, 0.5f, 0.5f, 2.0f);
+
+/// The fluid particles of fw set in motion for the velocity-level families: a rigid rotation
+/// of `spin` rad/s about the y axis through the block's mean position, plus a seeded uniform
+/// noise of up to `noise` m/s per axis; and the fluid material's velocity-level parameters
+/// `velocity` = (XSPH c, vorticity eps, cohesion gamma, adhesion beta).
+inline void fluid_stir(FluidWorld& fw, std::uint32_t seed, float spin, float noise, vec4 velocity) {
+  const StepParams& p = fw.w.params;
+  motes_ref::Particles& particles = fw.w.particles;
+  double mx = 0.0, mz = 0.0;
+  for (uint k = 0; k < p.fluid_count; ++k) {
+    mx += double(particles.pos[p.fluid_first + k].x);
+    mz += double(particles.pos[p.fluid_first + k].z);
+  }
+  const double count = std::max(1.0, double(p.fluid_count));
+  const auto cx = static_cast<float>(mx / count), cz = static_cast<float>(mz / count);
+  Rng rng(seed);
+  for (uint k = 0; k < p.fluid_count; ++k) {
+    vec4& v = particles.vel[p.fluid_first + k];
+    const vec4 x = particles.pos[p.fluid_first + k];
+    v.x = spin * (x.z - cz) + noise * rng.uniform(-1.0f, 1.0f);
+    v.y = noise * rng.uniform(-1.0f, 1.0f);
+    v.z = -spin * (x.x - cx) + noise * rng.uniform(-1.0f, 1.0f);
+  }
+  if (!fw.fluids.empty()) fw.fluids[kFluidMaterial].velocity = velocity;
 }
 
 /// Component c of every element, in x (the others 0): FluidState's rho, lambda and Lambda differ

@@ -297,4 +297,27 @@ std::vector<vec4> fluid_update(const Particles& particles, const Neighbours& nb,
                                const std::vector<motes::shared::FluidMaterial>& fluids,
                                const std::vector<vec4>& state, const StepParams& p);
 
+/// What fluid_vorticity writes, one vec4 per fluid particle each.
+struct FluidVorticity {
+  std::vector<vec4> vel_old;  ///< FluidVelOld: (v_i, 0)
+  std::vector<vec4> aux;      ///< FluidAux: (omega_i, |omega_i|)
+  std::vector<vec4> normal;   ///< FluidNormal: (n_i, 0)
+};
+/// fluid_vorticity: for every fluid particle, over the fluid particles of nb.lists[i] in order
+/// (solids skipped), omega_i = sum of shared::fluid_vorticity_term and n_i = sum of
+/// shared::fluid_normal_term (m_j its material's mass, rho_j state's x, h i's material's).
+FluidVorticity fluid_vorticity(const Particles& particles, const Neighbours& nb,
+                               const std::vector<motes::shared::FluidMaterial>& fluids,
+                               const std::vector<vec4>& state, const StepParams& p);
+/// fluid_velocity: ParticleVel of every particle: a fluid particle's (v_i + dv_i, its w), v_i
+/// and its neighbours' velocities from `vort`.vel_old, dv_i = ((c xsph + shared::
+/// fluid_confinement(eta, omega_i, eps, h_s)) + cohesion) + adhesion, the sums over nb.lists[i]
+/// in order: a fluid j with r^2 <= h^2 adds shared::fluid_xsph_term, fluid_eta_term and
+/// fluid_cohesion_term, a solid j fluid_adhesion_term (psi_j = s rho_0 (2 r_j)^3); every other
+/// particle's velocity as it was.
+std::vector<vec4> fluid_velocity(const Particles& particles, const Neighbours& nb,
+                                 const std::vector<motes::shared::FluidMaterial>& fluids,
+                                 const std::vector<vec4>& state, const FluidVorticity& vort,
+                                 const StepParams& p);
+
 }  // namespace motes_ref

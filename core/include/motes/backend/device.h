@@ -116,6 +116,14 @@ enum class Buffer : std::uint32_t {
   /// FluidMaterial (M with fluid, else 0): each material's fluid parameters (shared/fluid.h;
   /// 0 for a material no fluid uses), written once by the host (motes/fluid.h).
   FluidMaterials,
+  /// vec4 (fluid particles): fluid_vorticity's copy of each fluid particle's velocity, 0: the
+  /// velocity pass (fluid_velocity) reads its own and its neighbours' from here, never from the
+  /// ParticleVel it writes.
+  FluidVelOld,
+  /// vec4 (fluid particles): fluid_vorticity's omega_i (the SPH curl of the velocity), |omega_i|.
+  FluidAux,
+  /// vec4 (fluid particles): fluid_vorticity's n_i (Akinci et al. 2013's surface normal), 0.
+  FluidNormal,
   Count
 };
 
@@ -169,7 +177,8 @@ struct Sizes {
   std::uint32_t halo_index = 0;       ///< words of HaloIndex
   std::uint32_t halo_data = 0;        ///< vec4s of HaloData
   std::uint32_t partition = 0;        ///< 1: PartitionRefPos (N) and PartitionCheck (1) exist
-  std::uint32_t fluid_particles = 0;  ///< particles of fluids (FluidState; FluidMaterials when > 0)
+  std::uint32_t fluid_particles = 0;  ///< particles of fluids (FluidState, FluidVelOld, FluidAux,
+                                      ///< FluidNormal; FluidMaterials when > 0)
 };
 
 /// Bytes of one element and number of elements of a buffer.

@@ -85,6 +85,20 @@
 //   the same neighbours in the same order of fluid_shift_term (lambda_j from FluidState; a solid
 //   j: lambda_j 0, s_corr 0, m_j = psi_j), then each plane's slope along its normal times
 //   lambda_i w_i; every other particle's 0 (a rigid particle's reaction: not yet).
+// fluid_vorticity (once a substep, after the positions): every fluid particle gathers over its
+//   fluid neighbours (fluid_particle; solids skipped) in list order (over capacity: the 27 cells
+//   of the last build, whose particles beyond h add zeros), with m_j its material's mass, rho_j
+//   FluidState's and i's h: FluidVelOld[i - Nf] = (v_i, 0); FluidAux[i - Nf] = (omega_i,
+//   |omega_i|), omega_i = sum_j fluid_vorticity_term; FluidNormal[i - Nf] = (n_i, 0),
+//   n_i = sum_j fluid_normal_term.
+// fluid_velocity: every fluid particle, from FluidVelOld (its own and its neighbours' velocities;
+//   never ParticleVel, which it writes), FluidAux, FluidNormal and FluidState, gathers over the
+//   same neighbours in the same order, in one loop: for a fluid j within h (r^2 <= h^2), the XSPH
+//   sum of fluid_xsph_term, eta_i of fluid_eta_term and the cohesion sum of
+//   fluid_cohesion_term; for a solid j, the adhesion sum of fluid_adhesion_term (psi_j of
+//   fluid_neighbour_mass); ParticleVel[i].xyz = v_i + (((c xsph + fluid_confinement(eta_i,
+//   omega_i, eps, h_s)) + cohesion) + adhesion) with i's material's (c, eps, gamma, beta) and
+//   h_s = p.gravity_dt.w, w kept; every other particle untouched.
 // particles_check (not part of a step: the motion guard): MotionCheck gets the largest
 //   (|v| / d)^2 of a finite particle of [0, particle_count), the first particle with it and its
 //   |v|^2, and the first particle whose position or velocity is not finite
@@ -168,6 +182,16 @@
      SortedBody, NeighbourList, NeighbourCount, NeighbourRefPos, Planes, LinkExclusions,         \
      FluidMaterials, FluidState),                                                                \
     (ParticleForce))                                                                             \
+  X(FluidVorticity, fluid_vorticity,                                                             \
+    (ParticlePos, ParticleVel, ParticleBody, ParticleMaterial, GridOrder, GridCellStart,         \
+     SortedBody, NeighbourList, NeighbourCount, NeighbourRefPos, LinkExclusions, FluidMaterials, \
+     FluidState),                                                                                \
+    (FluidVelOld, FluidAux, FluidNormal))                                                        \
+  X(FluidVelocity, fluid_velocity,                                                               \
+    (ParticlePos, ParticleVel, ParticleBody, ParticleMaterial, GridOrder, GridCellStart,         \
+     SortedBody, NeighbourList, NeighbourCount, NeighbourRefPos, LinkExclusions, FluidMaterials, \
+     FluidState, FluidVelOld, FluidAux, FluidNormal),                                            \
+    (ParticleVel))                                                                               \
   X(ParticlesCheck, particles_check, (ParticlePos, ParticleVel), (MotionCheck))                  \
   X(EnergyReduce, energy_reduce,                                                                 \
     (ParticlePos, ParticleVel, BodyPos, BodyVel, BodyAngMom, BodyAngVel, EnergyPartials),        \
