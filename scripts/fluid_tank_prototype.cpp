@@ -257,7 +257,7 @@ int main(int argc, char** argv) {
         vec3 dv(0.0f);
         for (std::size_t j : near[i]) {
           const vec3 rij = x[i] - x[j];
-          dv += sh::fluid_xsph_term(old_v[i], old_v[j], m, rho[j], sh::dot(rij, rij), h);
+          dv += sh::fluid_xsph_term(old_v[i], old_v[j], m, rho[i], rho[j], sh::dot(rij, rij), h);
         }
         v[i] += dv * xsph;
       }

@@ -37,7 +37,7 @@ void add_neighbour(uint j, vec3 xi, vec3 vi, float wi, vec3 ni, float rhoi, Flui
   uint jk = j - p.fluid_first;
   float mj = fluid_materials[particle_material[j]].density_h.z;
   float rhoj = fluid_state[jk].x;
-  g.xsph += fluid_xsph_term(vi, xyz(fluid_vel_old[jk]), mj, rhoj, r2, h);
+  g.xsph += fluid_xsph_term(vi, xyz(fluid_vel_old[jk]), mj, rhoi, rhoj, r2, h);
   g.eta += fluid_eta_term(wi, fluid_aux[jk].w, mj, rhoj, fluid_spiky_gradient(rij, h));
   g.cohesion += fluid_cohesion_term(rij, mj, rhoi, rhoj, ni, xyz(fluid_normal[jk]), f.density_h.x,
                                     f.velocity.z, h, hs);

@@ -65,7 +65,7 @@ __global__ void fluid_velocity_kernel(shared::StepParams p, FluidVelocityInputs 
     const uint jk = j - p.fluid_first;
     const float mj = in.fluids[in.material[j]].density_h.z;
     const float rhoj = in.state[jk].x;
-    xsph += shared::fluid_xsph_term(vi, shared::xyz(in.vel_old[jk]), mj, rhoj, r2, h);
+    xsph += shared::fluid_xsph_term(vi, shared::xyz(in.vel_old[jk]), mj, rhoi, rhoj, r2, h);
     eta += shared::fluid_eta_term(omega_i.w, in.aux[jk].w, mj, rhoj,
                                   shared::fluid_spiky_gradient(rij, h));
     cohesion += shared::fluid_cohesion_term(rij, mj, rhoi, rhoj, ni, shared::xyz(in.normal[jk]),

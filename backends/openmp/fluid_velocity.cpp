@@ -66,7 +66,7 @@ void OpenMPDevice::fluid_velocity(const shared::StepParams& p) {
       const std::size_t jk = j - p.fluid_first;
       const float mj = fluids[material[j]].density_h.z;
       const float rhoj = state[jk].x;
-      xsph += shared::fluid_xsph_term(vi, shared::xyz(vel_old[jk]), mj, rhoj, r2, h);
+      xsph += shared::fluid_xsph_term(vi, shared::xyz(vel_old[jk]), mj, rhoi, rhoj, r2, h);
       eta += shared::fluid_eta_term(omega_i.w, aux[jk].w, mj, rhoj,
                                     shared::fluid_spiky_gradient(rij, h));
       cohesion += shared::fluid_cohesion_term(rij, mj, rhoi, rhoj, ni, shared::xyz(normal[jk]),

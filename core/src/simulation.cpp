@@ -439,6 +439,13 @@ void Simulation::step_positions(const shared::StepParams& lists) {
         d.enqueue(Kernel::ParticlesUpdate, params_);
       }
     }
+    if (sizes_.fluid_particles != 0) {
+      // The fluids' velocity pass (docs/fluids.md, "The substep", 7): the vorticity and normals
+      // of the substep's velocities, then XSPH viscosity, vorticity confinement, cohesion and
+      // adhesion from them.
+      d.enqueue(Kernel::FluidVorticity, params_);
+      d.enqueue(Kernel::FluidVelocity, params_);
+    }
   }
   if (bodies) d.enqueue(Kernel::ParticlesUpdate, params_);
 }

@@ -55,7 +55,7 @@ void main() {
   vec3 fl = fluid_shift_term(lambda, lambda, fm.density_h.z, fm.density_h.z,
                              fluid_s_corr(dot(rij, rij), fm.density_h.z, fm), g, fm.density_h.x) +
             fluid_rigid_reaction(g, fm.density_h.z, p.gravity_dt.w) +
-            fluid_xsph_term(xyz(v), xyz(vel[i]), 1.0f, 1.0f, 0.0f, fm.density_h.y) +
+            fluid_xsph_term(xyz(v), xyz(vel[i]), 1.0f, 1.0f, 1.0f, 0.0f, fm.density_h.y) +
             fluid_confinement(fluid_eta_term(1.0f, 2.0f, 1.0f, 1.0f, g),
                               fluid_vorticity_term(xyz(v), xyz(vel[i]), 1.0f, 1.0f, g), 1.0f,
                               p.gravity_dt.w) +

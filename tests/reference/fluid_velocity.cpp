@@ -49,7 +49,7 @@ std::vector<vec4> fluid_velocity(const Particles& particles, const Neighbours& n
       const std::size_t jk = j - p.fluid_first;
       const float mj = fluids[particles.material[j]].density_h.z;
       const float rhoj = state[jk].x;
-      xsph += sh::fluid_xsph_term(vi, sh::xyz(vort.vel_old[jk]), mj, rhoj, r2, h);
+      xsph += sh::fluid_xsph_term(vi, sh::xyz(vort.vel_old[jk]), mj, rhoi, rhoj, r2, h);
       eta += sh::fluid_eta_term(omega_len_i, vort.aux[jk].w, mj, rhoj,
                                 sh::fluid_spiky_gradient(rij, h));
       cohesion += sh::fluid_cohesion_term(rij, mj, rhoi, rhoj, ni, sh::xyz(vort.normal[jk]), rho0,
