@@ -47,6 +47,8 @@ struct BenchOptions {
   std::uint64_t cloth_steps = 1000;
   std::vector<int> soft_counts = {1000};
   std::uint64_t soft_steps = 200;
+  std::vector<std::uint64_t> fluid_sizes = {100000};
+  std::uint64_t fluid_steps = 60;  // frames of 1/60 s: one simulated second
   std::string cache = "bench-cache";
   std::string dense_from;  // LAMMPS data file: the dense phase starts from LAMMPS's settled state
   std::string json_path;
@@ -200,7 +202,7 @@ double compulsory_bytes(motes::Kernel k, const Measurement& m) {
     case motes::Kernel::ImpulsesApply:  // per sweep: read first, com, quat, inertia, vel, angmom,
                                         // impulses and moments; write vel, angmom, angvel
       return (4.0 * (b + 1) + 128.0 * b + 32.0 * nr) * static_cast<double>(m.impulse_sweeps);
-    case motes::Kernel::FluidDensity:    // no benchmark workload has fluid (docs/fluids.md):
+    case motes::Kernel::FluidDensity:    // W5 (docs/fluids.md), not counted yet:
     case motes::Kernel::FluidUpdate:     // per fluid particle and sweep (density, update) or
     case motes::Kernel::FluidVorticity:  // substep (vorticity, velocity), read own pos, vel,
     case motes::Kernel::FluidVelocity:   // material, count, state; write state, shift, the
@@ -456,11 +458,12 @@ void run_realtime(const BenchOptions& o) {
 void run_bench(const BenchOptions& o) {
   if (o.workload != "all" && o.workload != "settle" && o.workload != "dominoes" &&
       o.workload != "cloth" && o.workload != "soft" && o.workload != "impulse-dominoes" &&
-      o.workload != "realtime") {
-    fail(fmt::format(
-        "--workload must be settle, dominoes, cloth, soft, impulse-dominoes, realtime or all, "
-        "got '{}'",
-        o.workload));
+      o.workload != "fluid" && o.workload != "realtime") {
+    fail(
+        fmt::format("--workload must be settle, dominoes, cloth, soft, impulse-dominoes, fluid, "
+                    "realtime or all, "
+                    "got '{}'",
+                    o.workload));
   }
   if (o.workload == "realtime") {
     run_realtime(o);
@@ -588,6 +591,18 @@ void run_bench(const BenchOptions& o) {
       });
     }
   }
+  if (o.workload == "fluid") {
+    for (const std::uint64_t size : o.fluid_sizes) {
+      attempt([&] {
+        const motes::Scene scene = motes::fluid_workload(size);
+        Measurement m = measure(scene, o, o.fluid_steps, [](motes::Simulation&) {});
+        m.workload = "fluid";
+        m.phase = "dam-break";
+        print_row(m);
+        results.push_back(to_json(m));
+      });
+    }
+  }
   if (o.workload == "soft") {
     for (const int count : o.soft_counts) {
       attempt([&] {
@@ -613,7 +628,8 @@ void add_bench_command(CLI::App& app) {
       "W4 soft");
   cmd->add_option("--workload", opts->workload,
                   "settle, dominoes, all (settle and dominoes), cloth, soft, impulse-dominoes "
-                  "(W2's dominoes with impulse contacts) or realtime (scenes at frame-sized steps)")
+                  "(W2's dominoes with impulse contacts), fluid (W5: a dam break, frames of "
+                  "1/60 s) or realtime (scenes at frame-sized steps)")
       ->capture_default_str();
   cmd->add_option("--scenes", opts->scenes,
                   "realtime: scene files, or folders whose .json files are scenes")
@@ -632,6 +648,14 @@ void add_bench_command(CLI::App& app) {
       ->check(whole_number_of<int>(2, 1024))
       ->capture_default_str();
   cmd->add_option("--cloth-steps", opts->cloth_steps, "W3: steps timed")
+      ->check(whole_number(1))
+      ->capture_default_str();
+  cmd->add_option("--fluid-sizes", opts->fluid_sizes,
+                  "W5: liquid particles of each dam break (about: a column a x 2a x a)")
+      ->delimiter(',')
+      ->check(whole_number_of<std::uint64_t>(1000, 100000000))
+      ->capture_default_str();
+  cmd->add_option("--fluid-steps", opts->fluid_steps, "W5: frames timed (1/60 s each)")
       ->check(whole_number(1))
       ->capture_default_str();
   cmd->add_option("--soft-counts", opts->soft_counts, "W4: numbers of soft cubes (392 particles)")

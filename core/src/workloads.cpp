@@ -1,4 +1,4 @@
-// Benchmark workloads W1 "settle", W2 "dominoes", W3 "cloth" and W4 "soft"
+// Benchmark workloads W1 "settle", W2 "dominoes", W3 "cloth", W4 "soft" and W5 "fluid"
 // (docs/benchmarks.md).
 #include "motes/workloads.h"
 
@@ -13,6 +13,8 @@
 #include <fmt/format.h>
 
 #include "motes/cloth.h"
+#include "motes/fluid.h"
+#include "motes/shapes.h"
 
 namespace motes {
 
@@ -297,6 +299,63 @@ Scene soft_workload(int count) {
     scene.bodies.push_back(std::move(b));
   }
   scene.planes.push_back(plane("floor", {0, 1, 0}, {0, 0, 0}));
+  return scene;
+}
+
+Scene fluid_workload(std::uint64_t particles) {
+  constexpr double d = 0.01;
+  const int a = std::max(2, static_cast<int>(std::cbrt(static_cast<double>(particles) / 2.0)));
+  Scene scene;
+  scene.source = fmt::format("<fluid workload {} x {} x {}>", a, 2 * a, a);
+  scene.settings.dt = 1.0 / 60.0;
+  scene.settings.substeps = kFluidSubsteps;
+  scene.settings.fluid_iterations = kFluidIterations;
+  scene.settings.neighbour_capacity = kFluidNeighbourCapacity;
+  scene.settings.contact_model = ContactModel::Positions;
+  scene.settings.gravity = {0.0, -9.81, 0.0};
+  scene.settings.particle_diameter = d;
+  scene.settings.duration = 1.0;
+  Material water;
+  water.name = "water";
+  water.density = 1000.0;
+  water.friction = 0.1;
+  scene.materials.push_back(water);
+  scene.settings.contact = water;
+  Material wood;
+  wood.name = "wood";
+  wood.density = 700.0;
+  wood.friction = 0.4;
+  scene.materials.push_back(wood);
+  const double width = a * d;
+  FluidSpec f;
+  f.name = "water";
+  f.material = 0;
+  f.diameter = d;
+  f.points.reserve(static_cast<std::size_t>(2) * a * a * a);
+  for (int z = 0; z < a; ++z) {
+    for (int y = 0; y < 2 * a; ++y) {
+      for (int x = 0; x < a; ++x)
+        f.points.emplace_back((x + 0.5) * d, (y + 0.5) * d, (z + 0.5) * d);
+    }
+  }
+  scene.fluids.push_back(std::move(f));
+  Result<ParticleSet> box = box_lattice(Eigen::Vector3i(4, 4, 4), d);
+  if (box) {
+    const auto shape = std::make_shared<const ParticleSet>(std::move(box).value());
+    for (int k = 0; k < 4; ++k) {
+      BodySpec b;
+      b.name = fmt::format("block{}", k);
+      b.shape = shape;
+      b.material = 1;
+      b.position = {width * (1.5 + 0.5 * k), 0.02, width * (0.2 + 0.2 * k)};
+      scene.bodies.push_back(std::move(b));
+    }
+  }
+  scene.planes.push_back(plane("floor", {0, 1, 0}, {0, 0, 0}));
+  scene.planes.push_back(plane("x0", {1, 0, 0}, {0, 0, 0}));
+  scene.planes.push_back(plane("x1", {-1, 0, 0}, {4.0 * width, 0, 0}));
+  scene.planes.push_back(plane("z0", {0, 0, 1}, {0, 0, 0}));
+  scene.planes.push_back(plane("z1", {0, 0, -1}, {0, 0, width}));
   return scene;
 }
 

@@ -46,6 +46,12 @@ Scene cloth_workload(int side);
 /// floor so that they land within the first 0.1 s; k = 2000 N/m, gamma_n = 500/s, dt = 1e-4 s.
 /// count: 1 to 100,000.
 Scene soft_workload(int count);
+/// W5 "fluid": a dam break of about `particles` liquid particles (d = 0.01 m, water, position-based
+/// fluids at the settled defaults: 16 substeps of 1/60 s, 2 sweeps; docs/fluids.md): a column
+/// a x 2 a x a (n^2 = 2, a = cbrt(particles / 2) particles) at one end of a tank 4 a long and a
+/// wide, with four rigid 4 cm cubes of 700 kg/m^3 on the floor 1.5 a to 3 a along it.
+/// particles: 16 to 100,000,000.
+Scene fluid_workload(std::uint64_t particles);
 
 }  // namespace motes
 MOTES_API_END
