@@ -94,7 +94,8 @@ void ParticleColors::observe(const Snapshot& frame) {
 void ParticleColors::observe_fluids(const Snapshot& frame) {
   fluid_state_.clear();
   if (color_by_ != ColorBy::Body && color_by_ != ColorBy::Kind) return;
-  if (std::find(look_.body_fluid.begin(), look_.body_fluid.end(), 1) == look_.body_fluid.end()) {
+  if (std::none_of(look_.body_fluid.begin(), look_.body_fluid.end(),
+                   [](std::uint8_t fluid) { return fluid != 0; })) {
     return;
   }
   // The fluid particles by column (2 d x 2 d across up), each column from the top down.
