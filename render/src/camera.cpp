@@ -142,18 +142,29 @@ SceneLook look_from_scene(const Scene& scene) {
       look.ground_height = look.ground_height ? std::max(*look.ground_height, height) : height;
     }
   }
-  // Body indices as in a Snapshot: the scene's bodies, then its cloths and ropes.
-  look.body_static.reserve(scene.bodies.size() + scene.linked.size());
-  look.body_colors.reserve(scene.bodies.size() + scene.linked.size());
+  look.gravity = static_cast<float>(g.norm());
+  // Body indices as in a Snapshot: the scene's bodies, then its cloths and ropes, then its fluids.
+  const std::size_t count = scene.bodies.size() + scene.linked.size() + scene.fluids.size();
+  look.body_static.reserve(count);
+  look.body_colors.reserve(count);
+  look.body_fluid.reserve(count);
+  const auto own = [](const std::optional<Eigen::Vector3d>& color) {
+    return color ? std::optional<Eigen::Vector3f>(color->cast<float>()) : std::nullopt;
+  };
   for (const BodySpec& body : scene.bodies) {
     look.body_static.push_back(body.kind == BodyKind::Static ? 1 : 0);
-    look.body_colors.push_back(
-        body.color ? std::optional<Eigen::Vector3f>(body.color->cast<float>()) : std::nullopt);
+    look.body_colors.push_back(own(body.color));
+    look.body_fluid.push_back(0);
   }
   for (const LinkedSpec& linked : scene.linked) {
     look.body_static.push_back(0);
-    look.body_colors.push_back(
-        linked.color ? std::optional<Eigen::Vector3f>(linked.color->cast<float>()) : std::nullopt);
+    look.body_colors.push_back(own(linked.color));
+    look.body_fluid.push_back(0);
+  }
+  for (const FluidSpec& fluid : scene.fluids) {
+    look.body_static.push_back(0);
+    look.body_colors.push_back(own(fluid.color));
+    look.body_fluid.push_back(1);
   }
   return look;
 }

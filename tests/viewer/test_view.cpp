@@ -884,6 +884,101 @@ TEST(ViewCudaCopy, ManyFramesWithAGrabAndAReset) {
   expect_many_frames_with_a_grab_and_a_reset("cuda", "CUDA copy");
 }
 
+// A small tank of water (docs/rendering.md, "Colours of liquids").
+constexpr const char* kWaterScene = R"({
+  "settings": { "dt": 0.016666666666666666, "gravity": [0, -9.81, 0],
+                "contact_model": "position", "particle_diameter": 0.01 },
+  "materials": { "water": { "density": 1000, "friction": 0.0 },
+                 "glass": { "density": 2500, "friction": 0.0 } },
+  "bodies": [ { "name": "water", "kind": "fluid", "material": "water",
+                "fluid": { "type": "box", "min": [0, 0, 0], "max": [0.12, 0.08, 0.06] } } ],
+  "planes": [ { "type": "box", "name": "tank", "min": [0, 0, 0], "max": [0.12, 0.2, 0.06],
+                "material": "glass" } ]
+})";
+
+/// The headless renderer's pictures of kWaterScene after `frames` frames on openmp: the fluid
+/// shaded as water, in its flat base colour, and the background alone.
+struct WaterPictures {
+  Image shaded, flat, background;
+};
+
+WaterPictures water_pictures(const motes::Scene& scene, int frames) {
+  auto sim = motes::Simulation::create(scene, motes::open_device("openmp").value()).value();
+  const motes::Snapshot first = sim->snapshot().value();
+  EXPECT_TRUE(sim->step(static_cast<std::uint64_t>(frames)));  // dt is a 60th of a second
+  const motes::Snapshot last = sim->snapshot().value();
+  motes::render::RenderSettings s;
+  s.size = {kWidth, kHeight};
+  s.look = motes::render::look_from_scene(scene);
+  s.shadows = false;
+  s.camera =
+      motes::render::fit_camera(first.particle_pos, s.look.up, s.size, 35.0f, s.look.ground_height);
+  auto draw = [&](const motes::render::RenderSettings& settings, const motes::Snapshot& frame) {
+    motes::render::FrameRenderer r(settings);
+    r.render(first);  // the ground's extent from the first frame, as the viewer takes it
+    return r.render(frame);
+  };
+  WaterPictures p;
+  p.shaded = draw(s, last);
+  p.background = draw(s, motes::Snapshot{});
+  s.look.body_fluid.clear();
+  s.look.body_colors = {motes::render::water_color()};
+  p.flat = draw(s, last);
+  return p;
+}
+
+/// The mean colour of the pixels where `picture` differs from `background` by more than 30.
+Eigen::Vector3d mean_where_different(const Image& picture, const Image& background) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (int y = 0; y < picture.height; ++y) {
+    for (int x = 0; x < picture.width; ++x) {
+      const std::uint8_t *a = picture.pixel(x, y), *b = background.pixel(x, y);
+      if (std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]) <= 30) continue;
+      sum += Eigen::Vector3d(a[0], a[1], a[2]);
+      ++count;
+    }
+  }
+  EXPECT_GT(count, 2000);
+  return sum / std::max(count, 1);
+}
+
+// Liquids: drawn staged, shaded as water by the headless renderer's rule (lighter at the surface,
+// darker deep down); drawn zero copy, in the water's flat base colour (docs/viewer.md, "Not done
+// yet"); blue either way. The measure tells the two looks apart.
+TEST(ViewFluid, StagedShadesWaterAsTheHeadlessRendererZeroCopyDrawsItFlat) {
+  constexpr int kWaterFrames = 4;
+  const fs::path scene_path = write_file("water.json", kWaterScene);
+  const motes::Scene scene = motes::load_scene_file(scene_path.string()).value();
+  const WaterPictures ref = water_pictures(scene, kWaterFrames);
+  const double apart = difference(ref.shaded, ref.flat);
+  std::printf("water shaded against flat %.2f\n", apart);
+  EXPECT_GT(apart, kSameBelow);
+  std::vector<std::string> backends = {"openmp"};
+  if (has_backend("vulkan")) backends.emplace_back("vulkan");
+  for (const std::string& backend : backends) {
+    const fs::path png = scratch("water-" + backend + ".png");
+    ASSERT_EQ(shell(std::string(MOTES_CLI_PATH) + " view " + scene_path.string() + " --backend " +
+                    backend + " --offscreen --no-shadows --size 320x240 --frames " +
+                    std::to_string(kWaterFrames) + " --screenshot " + png.string() + " > " +
+                    scratch("water-" + backend + ".txt").string()),
+              0);
+    const Image picture = load_png(png);
+    const Image& expected = backend == "openmp" ? ref.shaded : ref.flat;
+    const Image& other = backend == "openmp" ? ref.flat : ref.shaded;
+    const double same = difference(picture, expected), wrong = difference(picture, other);
+    const Eigen::Vector3d mean = mean_where_different(picture, ref.background);
+    std::printf(
+        "water on %s: %.2f from the headless picture, %.2f from the other look; mean "
+        "colour %.0f %.0f %.0f\n",
+        backend.c_str(), same, wrong, mean.x(), mean.y(), mean.z());
+    EXPECT_LT(same, kSameBelow) << backend;
+    EXPECT_GT(wrong, kSameBelow) << backend;
+    EXPECT_GT(mean.z(), mean.x() + 40.0) << backend;
+    EXPECT_GT(mean.z(), mean.y() + 20.0) << backend;
+  }
+}
+
 }  // namespace
 
 namespace {

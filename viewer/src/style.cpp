@@ -101,7 +101,8 @@ std::vector<Vec4> Styler::device_colors(const Snapshot& first_frame,
                                         const std::vector<std::uint32_t>& order) const {
   std::vector<Vec4> out(order.size());
   for (std::size_t i = 0; i < order.size(); ++i) {
-    out[i] = linear_color(colors_(first_frame, order[i]));
+    // Fixed for the scene: fluids in their base colour, without the per-frame water shading.
+    out[i] = linear_color(colors_.unshaded(first_frame, order[i]));
   }
   return out;
 }

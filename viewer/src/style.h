@@ -44,7 +44,8 @@ class Styler {
   void instances(const Snapshot& frame, Instances& out);
   /// The zero-copy path's colours: by speed and height the rule's data for the shaders (the
   /// speed so far); by body and kind per device particle, in `order` (scene particle of each
-  /// device particle, Simulation::scene_particle_order), from `first_frame`.
+  /// device particle, Simulation::scene_particle_order), from `first_frame`, fluids without the
+  /// per-frame water shading (ParticleColors::unshaded).
   [[nodiscard]] ColorState color_state() const;
   [[nodiscard]] std::vector<Vec4> device_colors(const Snapshot& first_frame,
                                                 const std::vector<std::uint32_t>& order) const;

@@ -43,9 +43,9 @@ Result<Size> parse_size(const std::string& text);
 
 /// What decides a particle's colour.
 enum class ColorBy {
-  Body,    ///< one colour per body: its "color" in the scene, else from a palette
+  Body,    ///< one colour per body: its "color" in the scene, else from a palette (fluids: water)
   Speed,   ///< particle speed through a colour map, 0 to the fastest speed seen so far
-  Kind,    ///< dynamic bodies warm, static bodies grey
+  Kind,    ///< dynamic bodies warm, static bodies grey, fluids water blue
   Height,  ///< height along "up" through the colour map, over the first frame's range
 };
 
@@ -87,10 +87,13 @@ struct SceneLook {
   std::vector<std::uint8_t> body_static;  ///< 1 for a static body, by body index (may be short)
   /// A body's own colour (the scene's "color", sRGB 0..1), by body index (may be short).
   std::vector<std::optional<Eigen::Vector3f>> body_colors;
+  std::vector<std::uint8_t> body_fluid;  ///< 1 for a fluid, by body index (may be short)
+  float gravity = 9.81f;  ///< |g| (m/s^2; 0: none): the speed scale of a fluid's spray colour
 };
 
 /// The look of a loaded scene: up = -gravity (y when there is none), the ground = the plane whose
-/// normal is up, if any, which bodies are static, and the bodies' own colours.
+/// normal is up, if any, which bodies are static or fluid, and the bodies' own colours (bodies,
+/// then cloths and ropes, then fluids: a Snapshot's body indices).
 SceneLook look_from_scene(const Scene& scene);
 
 /// Everything that stays the same from frame to frame.
@@ -105,17 +108,31 @@ struct RenderSettings {
 /// The palette colour of body `index` (sRGB, 0..1).
 Eigen::Vector3f body_color(std::uint32_t index);
 
+/// The colour of a fluid without its own "color" (sRGB, 0..1): water blue.
+Eigen::Vector3f water_color();
+
 /// A particle's colour in pictures (sRGB, 0..1) by `color_by`: the rule the headless renderer and
 /// `motes view` share. Speed colours scale by the fastest speed observed so far, height colours
 /// by the first observed frame's range along the look's up.
+///
+/// Fluid particles (SceneLook::body_fluid) by body and by kind take their base colour (by body
+/// the fluid's own colour, else water_color(); by kind water_color()) shaded per frame like water
+/// (docs/rendering.md, "Colours of liquids"): darker with depth below the liquid's local surface
+/// (the top of its run of particles in a column of 2 d x 2 d across up, d the diameter), lighter
+/// in the top layer, and whiter where it moves fast (spray: from 2 to 6 sqrt(g d)).
 class ParticleColors {
  public:
   ParticleColors(ColorBy color_by, SceneLook look);
-  /// Takes `frame`'s fastest speed (when colouring by speed) and, the first time a frame has
-  /// particles, its height range.
+  /// Takes `frame`'s fastest speed (when colouring by speed), the first time a frame has
+  /// particles its height range, and (colouring by body or kind) its fluid particles' shading.
   void observe(const Snapshot& frame);
-  /// The colour of particle `index` of `frame`.
+  /// The colour of particle `index` of `frame`, the frame last observed.
   [[nodiscard]] Eigen::Vector3f operator()(const Snapshot& frame, std::size_t index) const;
+  /// The same without the per-frame shading of fluids (a fluid's base colour): for colours fixed
+  /// once per scene (`motes view`'s zero-copy path).
+  [[nodiscard]] Eigen::Vector3f unshaded(const Snapshot& frame, std::size_t index) const;
+  /// Whether particle `index` of `frame` belongs to a fluid.
+  [[nodiscard]] bool is_fluid(const Snapshot& frame, std::size_t index) const;
   [[nodiscard]] ColorBy color_by() const { return color_by_; }
 
   // The rule's data, for a GPU that applies it itself (motes view's zero-copy path): the colour
@@ -129,10 +146,16 @@ class ParticleColors {
   [[nodiscard]] const Eigen::Vector3f& up() const { return look_.up; }
 
  private:
+  /// The shading of `frame`'s fluid particles (fluid_state_), colouring by body or kind.
+  void observe_fluids(const Snapshot& frame);
+
   ColorBy color_by_;
   SceneLook look_;
   float speed_max_ = 0.0f;
   std::optional<Eigen::Vector2f> height_range_;
+  /// Per particle of the last observed frame (fluid particles only, else unused): the depth
+  /// below the local surface in diameters, and the speed in units of sqrt(g d).
+  std::vector<Eigen::Vector2f> fluid_state_;
 };
 
 /// Renders frames with fixed settings; buffers are kept between frames.
