@@ -1,11 +1,12 @@
 // Fluids in a scene file: an entry of "bodies" with "kind": "fluid" (issue 29; docs/fluids.md,
-// docs/scene-format.md "Fluids"): a box or a sphere filled with particles on a cubic lattice at the
-// rest spacing.
+// docs/scene-format.md "Fluids"): a box, a sphere or a mesh's volume filled with particles on a
+// cubic lattice at the rest spacing.
 #include <fmt/format.h>
 
 #include <cmath>
 #include <limits>
 
+#include "motes/shapes.h"
 #include "scene_parts.h"
 
 namespace motes::scene_detail {
@@ -90,6 +91,42 @@ std::vector<Eigen::Vector3d> fill_sphere(const Node& fluid, double d, const Shap
   return points;
 }
 
+/// A mesh's volume: the voxelizer's lattice of spacing d inside the mesh (scaled by "scale", a
+/// number or one per axis), in the mesh's own coordinates moved by "position" (no rotation:
+/// rotate the mesh file). A closed mesh is filled by its crossings, an open one by its winding
+/// number, as a body's mesh shape is (docs/scene-format.md, "Open and non-manifold meshes").
+std::vector<Eigen::Vector3d> fill_mesh(const Node& fluid, double d, ShapeCache& cache) {
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+  if (auto s = fluid.find("scale")) {
+    scale = s->json().is_array() ? s->vec3(Sign::Positive)
+                                 : Eigen::Vector3d::Constant(s->number(Sign::Positive));
+  }
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  if (auto p = fluid.find("position")) position = p->vec3();
+  TriangleMesh mesh = *load_mesh_once(fluid.at("file"), cache);
+  for (Eigen::Vector3d& v : mesh.vertices) v = v.cwiseProduct(scale);
+  // The box around the mesh bounds the count before anything is filled.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+  Eigen::Vector3d hi = -lo;
+  for (const Eigen::Vector3d& v : mesh.vertices) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  if (!mesh.vertices.empty()) {
+    const Eigen::Vector3d cells = ((hi - lo) / d).array() + 1.0;
+    check_count(fluid, cells.x() * cells.y() * cells.z(), cache);
+  }
+  VoxelizeOptions options;
+  options.diameter = d;
+  Result<ParticleSet> filled = voxelize(mesh, options);
+  if (!filled) fluid.at("file").fail(filled.message());
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(filled.value().points.size());
+  for (const Eigen::Vector3f& p : filled.value().points)
+    points.push_back(p.cast<double>() + position);
+  return points;
+}
+
 }  // namespace
 
 bool is_fluid(const Node& entry) {
@@ -99,8 +136,7 @@ bool is_fluid(const Node& entry) {
   return kind != json.end() && kind->is_string() && *kind == "fluid";
 }
 
-FluidSpec read_fluid(const Node& entry, std::size_t index, const ShapeCache& cache,
-                     const Scene& scene) {
+FluidSpec read_fluid(const Node& entry, std::size_t index, ShapeCache& cache, const Scene& scene) {
   entry.expect_object({"name", "kind", "material", "fluid", "velocity", "color"});
   if (scene.settings.contact_model != ContactModel::Positions) {
     entry.at("kind").fail(
@@ -119,19 +155,25 @@ FluidSpec read_fluid(const Node& entry, std::size_t index, const ShapeCache& cac
     fluid.expect_object({"type", "min", "max", "diameter"});
   } else if (type == "sphere") {
     fluid.expect_object({"type", "center", "radius", "diameter"});
+  } else if (type == "mesh") {
+    fluid.expect_object({"type", "file", "scale", "position", "diameter"});
   } else if (fluid.has("type")) {
     fluid.at("type").fail(
-        fmt::format("unknown fluid volume \"{}\" (allowed: box, sphere; a mesh volume and "
-                    "emitters are not built yet)",
+        fmt::format("unknown fluid volume \"{}\" (allowed: box, sphere, mesh; emitters are not "
+                    "built yet)",
                     type));
   } else {
-    fluid.expect_object({"type", "min", "max", "center", "radius", "diameter"});
-    fluid.fail("missing required key \"type\" (the volume the fluid fills: \"box\" or \"sphere\")");
+    fluid.expect_object(
+        {"type", "min", "max", "center", "radius", "file", "scale", "position", "diameter"});
+    fluid.fail(
+        "missing required key \"type\" (the volume the fluid fills: \"box\", \"sphere\" or "
+        "\"mesh\")");
   }
   spec.diameter = cache.default_diameter;
   if (auto d = fluid.find("diameter")) spec.diameter = d->number(Sign::Positive);
-  spec.points = type == "box" ? fill_box(fluid, spec.diameter, cache)
-                              : fill_sphere(fluid, spec.diameter, cache);
+  spec.points = type == "box"      ? fill_box(fluid, spec.diameter, cache)
+                : type == "sphere" ? fill_sphere(fluid, spec.diameter, cache)
+                                   : fill_mesh(fluid, spec.diameter, cache);
   if (spec.points.empty()) fluid.fail("the volume holds no particle");
   for (const Eigen::Vector3d& p : spec.points) {
     if (!(p.cwiseAbs().maxCoeff() <= static_cast<double>(std::numeric_limits<float>::max()))) {

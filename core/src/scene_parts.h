@@ -66,11 +66,11 @@ LinkedSpec read_linked(const Node& entry, std::size_t index, ShapeCache& cache, 
 
 /// Whether an entry of the "bodies" array is a fluid ("kind": "fluid").
 bool is_fluid(const Node& entry);
-/// Reads such an entry, the index-th of "bodies", into a FluidSpec: its volume filled with
-/// particles at the rest spacing (scene_fluid.cpp; docs/scene-format.md, "Fluids"). A fluid
-/// needs "contact_model": "position"; errors carry the JSON path.
-FluidSpec read_fluid(const Node& entry, std::size_t index, const ShapeCache& cache,
-                     const Scene& scene);
+/// Reads such an entry, the index-th of "bodies", into a FluidSpec: its volume (a box, a sphere or
+/// a closed mesh, loaded through `cache`) filled with particles at the rest spacing
+/// (scene_fluid.cpp; docs/scene-format.md, "Fluids"). A fluid needs "contact_model": "position";
+/// errors carry the JSON path.
+FluidSpec read_fluid(const Node& entry, std::size_t index, ShapeCache& cache, const Scene& scene);
 
 /// Largest distance a particle may travel in one substep at the start, as a fraction of its radius
 /// (docs/reliability.md, "Initial speeds").

@@ -2,7 +2,10 @@
 // rest spacing, the material's fluid fields and their defaults, the located errors, and the
 // fluid's place among a Simulation's bodies.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -98,6 +101,43 @@ TEST(SceneFluid, SphereIsFilledOnALatticeAboutItsCentre) {
   EXPECT_TRUE((mean / 33.0).isApprox(Eigen::Vector3d(1, 2, 3)));
 }
 
+TEST(SceneFluid, MeshIsFilledOnTheVoxelizersLattice) {
+  // A closed cube of 0.5 scaled by 0.1 (5 cm): 5 x 5 x 5 particles of 1 cm inside it, moved by
+  // "position"; a missing file and an unknown key are located errors.
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("motes_fluid_mesh_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream obj(dir / "cube.obj");
+    obj << "v 0 0 0\nv 0.5 0 0\nv 0.5 0.5 0\nv 0 0.5 0\nv 0 0 0.5\nv 0.5 0 0.5\nv 0.5 0.5 0.5\n"
+           "v 0 0.5 0.5\nf 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\n"
+           "f 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
+  }
+  const auto load = [&](const std::string& fluid) {
+    return load_scene_text(fluid_scene(R"({"kind": "fluid", "fluid": )" + fluid + "}"), "s.json",
+                           dir.string());
+  };
+  Result<Scene> r =
+      load(R"({"type": "mesh", "file": "cube.obj", "scale": 0.1, "position": [1, 2, 3]})");
+  ASSERT_TRUE(r) << r.message();
+  const FluidSpec& f = r->fluids[0];
+  EXPECT_EQ(f.points.size(), 125u);
+  for (const Eigen::Vector3d& p : f.points) {
+    EXPECT_TRUE((p - Eigen::Vector3d(1, 2, 3)).minCoeff() > 0.0 &&
+                (p - Eigen::Vector3d(1.05, 2.05, 3.05)).maxCoeff() < 0.0)
+        << p.transpose();
+  }
+  Result<Scene> missing = load(R"({"type": "mesh", "file": "nope.obj"})");
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.message().find("s.json: /bodies/0/fluid/file: cannot open mesh"),
+            std::string::npos)
+      << missing.message();
+  Result<Scene> extra = load(R"({"type": "mesh", "file": "cube.obj", "radius": 1})");
+  ASSERT_FALSE(extra);
+  EXPECT_NE(extra.message().find("s.json: /bodies/0/fluid"), std::string::npos) << extra.message();
+  std::filesystem::remove_all(dir);
+}
+
 TEST(SceneFluid, MaterialFieldsAndTheirDefaults) {
   const std::string box =
       R"({"kind": "fluid", "material": "MAT", "fluid": {"type": "box", "min": [0, 0, 0],
@@ -138,8 +178,8 @@ TEST(SceneFluid, ErrorsNameTheFileThePlaceAndTheReason) {
       {fluid_scene(R"({"kind": "fluid"})"), "s.json: /bodies/0: missing required key \"fluid\""},
       {fluid_scene(R"({"kind": "fluid", "fluid": {"min": [0, 0, 0]}})"),
        "s.json: /bodies/0/fluid: missing required key \"type\""},
-      {fluid_scene(R"({"kind": "fluid", "fluid": {"type": "mesh"}})"),
-       "s.json: /bodies/0/fluid/type: unknown fluid volume \"mesh\" (allowed: box, sphere"},
+      {fluid_scene(R"({"kind": "fluid", "fluid": {"type": "cone"}})"),
+       "s.json: /bodies/0/fluid/type: unknown fluid volume \"cone\" (allowed: box, sphere, mesh"},
       {fluid_scene(R"({"kind": "fluid", "fluid": {"type": "box", "min": [0, 0, 0],
                      "max": [0.02, 0, 0.02]}})"),
        "s.json: /bodies/0/fluid/max/1: must be greater than min[1]"},
