@@ -2,8 +2,9 @@
 // fluid_update: one thread per particle; a fluid particle's correction dx_i of the density
 // constraint, a gather over its neighbour list in list order (over capacity: the 27 cells of the
 // last build, whose extra particles beyond h add zeros), then the planes' slope terms, as a shift
-// in ParticleForce (w = 1); a dynamic rigid particle's reaction to its fluid neighbours
-// (fluid_solid_reaction, the same walk), every other particle's ParticleForce 0 (shared/fluid.h).
+// in ParticleForce (w = 1); every solid particle that can move its reaction to its fluid
+// neighbours (fluid_solid_reaction over the same walk, fluid_solid_force), a static particle's
+// ParticleForce 0 (shared/fluid.h).
 // As backends/openmp/fluid_update.cpp.
 #extension GL_GOOGLE_include_directive : require
 #include "kernel_common.glsl"
@@ -31,7 +32,7 @@ vec3 reaction_term(uint j, vec3 xb, float rb) {
                               fluid_materials[particle_material[j]], p.gravity_dt.w);
 }
 
-// A dynamic rigid particle's reaction, over the same walk as a fluid particle's correction.
+// A solid particle's reaction (a momentum), over the same walk as a fluid particle's correction.
 vec3 rigid_reaction(uint b) {
   vec3 xb = xyz(particle_pos[b]);
   float rb = particle_pos[b].w;
@@ -58,8 +59,10 @@ void main() {
   uint i = thread_index();
   if (i >= p.particle_count) return;
   if (!fluid_particle(i, p.fluid_first, p.fluid_count)) {
-    bool reacts = i < p.rigid_particle_count && particle_vel[i].w != 0.0f;
-    particle_force[i] = vec4(reacts ? rigid_reaction(i) : vec3(0.0f), 0.0f);
+    float wi = particle_vel[i].w;
+    particle_force[i] = wi != 0.0f ? fluid_solid_force(rigid_reaction(i), i < p.rigid_particle_count,
+                                                       wi, p.gravity_dt.w)
+                                   : vec4(0.0f);
     return;
   }
   vec3 xi = xyz(particle_pos[i]);

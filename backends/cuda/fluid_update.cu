@@ -1,8 +1,9 @@
 // fluid_update: one thread per particle; a fluid particle's correction dx_i of the density
 // constraint, a gather over its neighbour list in list order (over capacity: the 27 cells of the
 // last build, whose extra particles beyond h add zeros), then the planes' slope terms, as a shift
-// in ParticleForce (w = 1); a dynamic rigid particle's reaction to its fluid neighbours
-// (fluid_solid_reaction, the same walk), every other particle's ParticleForce 0 (shared/fluid.h).
+// in ParticleForce (w = 1); every solid particle that can move its reaction to its fluid
+// neighbours (fluid_solid_reaction over the same walk, fluid_solid_force), a static particle's
+// ParticleForce 0 (shared/fluid.h).
 // As backends/openmp/fluid_update.cpp.
 #include "cuda_device.h"
 #include "shared/fluid.h"
@@ -62,7 +63,7 @@ __global__ void fluid_update_kernel(shared::StepParams p, FluidUpdateInputs in,
   const vec3 xi = shared::xyz(pi);
   if (!shared::fluid_particle(i, p.fluid_first, p.fluid_count)) {
     vec3 reaction(0.0f);
-    if (i < p.rigid_particle_count && in.vel[i].w != 0.0f) {
+    if (in.vel[i].w != 0.0f) {
       each_neighbour([&](uint j) {
         if (!shared::fluid_particle(j, p.fluid_first, p.fluid_count)) return;
         reaction +=
@@ -70,7 +71,8 @@ __global__ void fluid_update_kernel(shared::StepParams p, FluidUpdateInputs in,
                                          pi.w, in.fluids[in.material[j]], p.gravity_dt.w);
       });
     }
-    force[i] = vec4(reaction, 0.0f);
+    force[i] = shared::fluid_solid_force(reaction, i < p.rigid_particle_count, in.vel[i].w,
+                                         p.gravity_dt.w);
     return;
   }
   const shared::FluidMaterial f = in.fluids[in.material[i]];

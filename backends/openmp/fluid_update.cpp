@@ -1,8 +1,10 @@
 // fluid_update: every fluid particle's correction dx_i of the density constraint, a gather over
 // its neighbour list in list order (over capacity: the 27 cells of the last build, whose extra
 // particles beyond h add zeros), then the planes' slope terms, as a shift in ParticleForce
-// (w = 1); a dynamic rigid particle's reaction to its fluid neighbours (fluid_solid_reaction, the
-// same walk), every other particle's ParticleForce 0 (shared/fluid.h).
+// (w = 1); every solid particle that can move its reaction to its fluid neighbours
+// (fluid_solid_reaction over the same walk, written by fluid_solid_force: a rigid particle's for
+// its body, a free particle's as its own shift), a static particle's ParticleForce 0
+// (shared/fluid.h).
 #include <chrono>
 #include <cstdint>
 
@@ -62,14 +64,14 @@ void OpenMPDevice::fluid_update(const shared::StepParams& p) {
     const vec3 xi = shared::xyz(pi);
     if (!shared::fluid_particle(uint(i), p.fluid_first, p.fluid_count)) {
       vec3 reaction(0.0f);
-      if (i < p.rigid_particle_count && vel[i].w != 0.0f) {
+      if (vel[i].w != 0.0f) {
         each_neighbour(i, [&](uint j) {
           if (!shared::fluid_particle(j, p.fluid_first, p.fluid_count)) return;
           reaction += shared::fluid_solid_reaction(shared::xyz(pos[j]), state[j - p.fluid_first].y,
                                                    xi, pi.w, fluids[material[j]], hs);
         });
       }
-      force[i] = vec4(reaction, 0.0f);
+      force[i] = shared::fluid_solid_force(reaction, i < p.rigid_particle_count, vel[i].w, hs);
       return;
     }
     const shared::FluidMaterial f = fluids[material[i]];

@@ -453,9 +453,9 @@ void Simulation::step_positions(const shared::StepParams& lists) {
 void Simulation::relax_fluids(bool bodies) {
   // Each sweep (docs/fluids.md, "The substep"): every fluid particle's density and lambda
   // (fluid_density; the substep's first sweep restarts the summed Lambda), its correction and the
-  // rigid particles' reactions (fluid_update), the fluid moved by its corrections
-  // (particles_integrate's shift: every other particle's is 0), and the rigid bodies take their
-  // reactions as the contact shifts' do.
+  // solid particles' reactions (fluid_update), the fluid and the free solid particles moved by
+  // them (particles_integrate's shift), and the rigid bodies take their particles' reactions as
+  // the contact shifts' do.
   Device& d = *device_;
   shared::StepParams sweep = params_;
   sweep.flags |= MOTES_FLAG_POSITION;

@@ -277,12 +277,25 @@ MOTES_FN vec4 fluid_plane_density(vec4 normal_offset, vec3 xi, MOTES_IN(FluidMat
               fi.density_h.x * fluid_plane_share(z, h));
 }
 
-/// A dynamic rigid particle b's reaction to its pair with fluid particle i (fluid_update): minus
+/// What fluid_update writes to a solid particle b's ParticleForce from its reaction R (a momentum:
+/// the sum of fluid_solid_reaction over its fluid neighbours): a rigid body's particle R itself
+/// (w 0: its body takes it, particles_update with MOTES_FLAG_ABSORB | MOTES_FLAG_PARTICLE_SHIFT);
+/// a free particle (a free sphere, a soft body's, a cloth's or a rope's, inverse mass w_b) the
+/// shift R w_b h_s with w 1, which particles_integrate's shift turns into the velocity change
+/// R w_b: either way the pair keeps its momentum.
+MOTES_FN vec4 fluid_solid_force(vec3 reaction, bool rigid, float wb, float hs) {
+  if (rigid) {
+    return vec4(reaction, 0.0f);
+  }
+  return vec4(reaction * (wb * hs), 1.0f);
+}
+
+/// A solid particle b's reaction to its pair with fluid particle i (fluid_update): minus
 /// the momentum i gains from the pair's term of its correction dx_i, computed as i computes it
 /// (fluid_shift_term with b's lambda 0, no s_corr and b's mass psi_b of i's material,
-/// fluid_neighbour_mass), over the substep h_s; summed over b's fluid neighbours, its body takes
-/// it (particles_update with MOTES_FLAG_ABSORB | MOTES_FLAG_PARTICLE_SHIFT), so the pair keeps its
-/// momentum.
+/// fluid_neighbour_mass), over the substep h_s; summed over b's fluid neighbours, b takes it
+/// (fluid_solid_force), so the pair keeps its momentum. Any solid particle that can move reacts:
+/// a rigid body's, a free sphere, a soft body's, a cloth's or a rope's.
 MOTES_FN vec3 fluid_solid_reaction(vec3 xi, float lambda_i, vec3 xb, float rb,
                                    MOTES_IN(FluidMaterial) fi, float hs) {
   float mi = fi.density_h.z;

@@ -94,6 +94,26 @@ inline FluidWorld fluid_world(std::uint32_t seed, std::size_t n, float spacing, 
   return fw;
 }
 
+/// fw with its first `solids` fluid particles made free solid particles (as a free sphere's, a
+/// soft body's, a cloth's or a rope's: they react to the liquid with their own shift): the fluid
+/// range starts after them, each keeps its place, its inverse mass is halved and its material is
+/// 0; the oracle's grid and lists are built again for the new range.
+inline void fluid_free_solids(FluidWorld& fw, uint solids) {
+  StepParams& p = fw.w.params;
+  solids = std::min(solids, p.fluid_count);
+  for (uint k = 0; k < solids; ++k) {
+    const uint i = p.fluid_first + k;
+    fw.w.particles.vel[i].w *= 0.5f;
+    fw.w.particles.material[i] = 0;
+  }
+  p.fluid_first += solids;
+  p.fluid_count -= solids;
+  fw.w.sizes.fluid_particles = p.fluid_count;
+  fw.state.erase(fw.state.begin(), fw.state.begin() + solids);
+  fw.grid = motes_ref::grid_build(fw.w.particles, p);
+  fw.nb = motes_ref::neighbours_build(fw.w.particles, fw.grid, p);
+}
+
 /// The velocity-level parameters of the stirred cases: XSPH c 0.1, vorticity eps 0.5 m/s,
 /// cohesion gamma 0.5, adhesion beta 2 (each term a visible part of the change of velocity).
 inline const vec4 kFluidStirParameters(0.1f, 0.5f, 0.5f, 2.0f);

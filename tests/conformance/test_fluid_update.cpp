@@ -1,9 +1,11 @@
 // fluid_update against the oracle (docs/fluids.md): ParticleForce of every particle (a fluid
-// particle's correction dx_i with w = 1, every other particle's 0).
+// particle's correction dx_i with w = 1; a solid particle's reaction to the liquid: a rigid
+// particle's momentum with w = 0, a free solid particle's shift with w = 1; a static one's 0).
 //
 // The worlds of test_fluid_density.cpp (fluid_support.h), with FluidState the oracle's
 // fluid_density of them (the lambdas a sweep gives); every other buffer poisoned. Cases: sizes 0,
-// 1, 31 and 1,234, the lattice at rest, a compressed block, lists of capacity 4 against 64.
+// 1, 31 and 1,234, the lattice at rest, a compressed block, free solid particles inside the block
+// (fluid_free_solids), lists of capacity 4 against 64.
 //
 // Tolerance: NMSE 1e-7 against the oracle on xyz (the shifts, about 1e-6 m: compared with w in
 // the norm they would hide), w identical (1 for a fluid particle, 0 for the others).
@@ -45,6 +47,11 @@ TEST_P(FluidUpdate, Random31) { run_case("block", fluid_world(313, 104, 1.0f, 0.
 TEST_P(FluidUpdate, Block1234) { run_case("block", fluid_world(314, 4114, 1.0f, 0.05f), 64); }
 TEST_P(FluidUpdate, LatticeAtRest) { run_case("lattice", fluid_world(315, 4114, 1.0f, 0.0f), 64); }
 TEST_P(FluidUpdate, Compressed) { run_case("compressed", fluid_world(316, 4114, 0.9f, 0.05f), 64); }
+TEST_P(FluidUpdate, FreeSolidsReact) {
+  FluidWorld fw = fluid_world(319, 4114, 0.95f, 0.05f);
+  fluid_free_solids(fw, 300);
+  run_case("free_solids", fw, 64);
+}
 TEST_P(FluidUpdate, OverCapacity) {
   run_case("capacity_4", fluid_world(318, 4114, 0.95f, 0.05f), 4);
 }

@@ -15,13 +15,15 @@
 //   db_exp_data.py); the largest density error of any particle at the end of a frame below 2%;
 // - momentum: a ball of liquid thrown without gravity at a free rigid box: the linear momentum of
 //   the liquid and the box kept to 1e-6 relative (the box takes the reaction of each fluid
-//   particle's shift, fluid_solid_reaction, and of the contacts).
+//   particle's shift, fluid_solid_reaction, and of the contacts); the same at a soft cube and a
+//   free cloth, whose particles take the reaction as their own shifts.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
+#include "motes/cloth.h"
 #include "motes/fluid.h"
 #include "physics/physics_scenes.h"
 #include "shared/fluid.h"
@@ -296,6 +298,65 @@ TEST(Fluid, ASplashOnAFreeBoxKeepsMomentum) {
   const Eigen::Vector3d p1 = momentum(end.value());
   const double box_speed = to_vec3(end.value().body_vel[0]).x();
   EXPECT_GT(box_speed, 0.05) << "the liquid pushed the box";
+  EXPECT_LT((p1 - p0).norm(), 1e-6 * p0.norm())
+      << "momentum before " << p0.transpose() << ", after " << p1.transpose();
+}
+
+TEST(Fluid, ASplashOnASoftCubeAndAClothKeepsMomentum) {
+  motes::Scene scene = fluid_scene(Eigen::Vector3d::Zero());
+  scene.settings.constraint_iterations = 2;
+  motes::BodySpec cube =
+      motes_test::body(motes_test::lattice(4, 4, 4, kFluidD), Eigen::Vector3d(0.1, 0.0, 0.0));
+  cube.name = "jelly";
+  motes::SoftSpec soft;
+  soft.frequency = 15.0;
+  soft.damping = 10.0;
+  soft.mode = motes::SoftMode::Linear;
+  cube.soft = soft;
+  scene.bodies.push_back(cube);
+  motes::ClothOptions o;
+  o.corner = Eigen::Vector3d(0.06, 0.025, -0.05);  // a sheet across the ball's upper half
+  o.edge_u = Eigen::Vector3d(0.0, 0.0, 0.1);
+  o.edge_v = Eigen::Vector3d(0.0, 0.05, 0.0);
+  o.nu = 11;
+  o.nv = 6;
+  o.diameter = kFluidD;
+  motes::LinkedSpec cloth = motes::make_cloth(o).value();
+  cloth.name = "sheet";
+  scene.linked.push_back(cloth);
+  motes::FluidSpec ball = fluid_block(6, 8, 6, Eigen::Vector3d(-0.025, -0.02, -0.03));
+  ball.velocity = Eigen::Vector3d(1.0, 0.2, 0.0);
+  scene.fluids.push_back(ball);
+  auto sim_r = motes_test::simulate(scene, 2);
+  ASSERT_TRUE(sim_r) << sim_r.status().message();
+  motes::Simulation& sim = *sim_r.value();
+  // Every particle is free here (no rigid body): the momentum is the particles' sum.
+  const auto momentum = [](const motes::Snapshot& s) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (const motes::shared::vec4& v : s.particle_vel) p += to_vec3(v) / static_cast<double>(v.w);
+    return p;
+  };
+  const auto body_momentum = [&](const motes::Snapshot& s, const motes::BodyInfo& b) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (std::uint32_t k = 0; k < b.particle_count; ++k) {
+      const motes::shared::vec4 v = s.particle_vel[b.first_particle + k];
+      p += to_vec3(v) / static_cast<double>(v.w);
+    }
+    return p;
+  };
+  auto start = sim.snapshot();
+  ASSERT_TRUE(start);
+  const Eigen::Vector3d p0 = momentum(start.value());
+  ASSERT_TRUE(sim.step(15));  // 0.25 s: the liquid reaches both and splashes on them
+  auto end = sim.snapshot();
+  ASSERT_TRUE(end);
+  const Eigen::Vector3d p1 = momentum(end.value());
+  const std::vector<motes::BodyInfo>& bodies = sim.bodies();
+  ASSERT_EQ(bodies.size(), 3u);
+  EXPECT_GT(body_momentum(end.value(), bodies[0]).x(), 0.05 * p0.x())
+      << "the liquid pushed the cube";
+  EXPECT_GT(body_momentum(end.value(), bodies[1]).x(), 0.02 * p0.x())
+      << "the liquid pushed the cloth";
   EXPECT_LT((p1 - p0).norm(), 1e-6 * p0.norm())
       << "momentum before " << p0.transpose() << ", after " << p1.transpose();
 }

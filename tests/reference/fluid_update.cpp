@@ -1,7 +1,7 @@
 // The oracle of fluid_update (docs/fluids.md): each fluid particle's correction summed over the
 // oracle's own full lists (motes_ref::neighbours_build), in list order, then the planes in order,
-// with shared/fluid.h's terms; a dynamic rigid particle's reaction to its fluid neighbours over its
-// list (fluid_solid_reaction); every other particle's 0.
+// with shared/fluid.h's terms; every solid particle that can move its reaction to its fluid
+// neighbours over its list (fluid_solid_reaction, fluid_solid_force); a static particle's 0.
 #include "reference.h"
 #include "shared/fluid.h"
 
@@ -64,8 +64,8 @@ std::vector<vec4> fluid_update(const Particles& particles, const Neighbours& nb,
     }
     out[i] = vec4(dx, 1.0f);
   }
-  for (std::size_t b = 0; b < p.rigid_particle_count; ++b) {
-    if (particles.vel[b].w == 0.0f) continue;
+  for (std::size_t b = 0; b < particles.size(); ++b) {
+    if (is_fluid(b, p) || particles.vel[b].w == 0.0f) continue;
     const vec3 xb = sh::xyz(particles.pos[b]);
     vec3 reaction(0.0f);
     for (const uint j : nb.lists[b]) {
@@ -74,7 +74,8 @@ std::vector<vec4> fluid_update(const Particles& particles, const Neighbours& nb,
                                            xb, particles.pos[b].w, fluids[particles.material[j]],
                                            p.gravity_dt.w);
     }
-    out[b] = vec4(reaction, 0.0f);
+    out[b] = sh::fluid_solid_force(reaction, b < p.rigid_particle_count, particles.vel[b].w,
+                                   p.gravity_dt.w);
   }
   return out;
 }

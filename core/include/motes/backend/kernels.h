@@ -84,7 +84,9 @@
 // fluid_update: ParticleForce of every particle: a fluid particle's (dx_i, 1), dx_i the sum over
 //   the same neighbours in the same order of fluid_shift_term (lambda_j from FluidState; a solid
 //   j: lambda_j 0, s_corr 0, m_j = psi_j), then each plane's slope along its normal times
-//   lambda_i w_i; every other particle's 0 (a rigid particle's reaction: not yet).
+//   lambda_i w_i; a solid particle that can move (w != 0), the sum over its fluid neighbours in
+//   the same walk of fluid_solid_reaction, written by fluid_solid_force (a rigid particle's
+//   momentum, w 0, for its body; a free particle's shift, w 1); a static particle's 0.
 // fluid_vorticity (once a substep, after the positions): every fluid particle gathers over its
 //   fluid neighbours (fluid_particle; solids skipped) in list order (over capacity: the 27 cells
 //   of the last build, whose particles beyond h add zeros), with m_j its material's mass, rho_j
