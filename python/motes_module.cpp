@@ -197,6 +197,24 @@ PYBIND11_MODULE(motes, m) {
                                  names.push_back(b.name);
                                return names;
                              })
+      .def_property_readonly(
+          "body_kinds",
+          [](PySimulation& s) {
+            // What each body is, in body_names' order: "rigid", "static", "free sphere", "soft",
+            // "cloth or rope" or "fluid".
+            std::vector<std::string> kinds;
+            for (const motes::BodyInfo& b : s.sim().bodies()) {
+              kinds.emplace_back(b.fluid                             ? "fluid"
+                                 : b.linked                          ? "cloth or rope"
+                                 : b.soft                            ? "soft"
+                                 : b.free_sphere                     ? "free sphere"
+                                 : b.kind == motes::BodyKind::Static ? "static"
+                                                                     : "rigid");
+            }
+            return kinds;
+          },
+          "What each body is, in body_names' order: rigid, static, free sphere, soft, cloth or "
+          "rope, fluid.")
       .def(
           "positions", [](PySimulation& s) { return columns_of(s.state().particle_pos, 3); },
           "Particle centres, (N, 3) float32 (a copy).")

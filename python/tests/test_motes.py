@@ -65,6 +65,21 @@ def test_state_arrays_have_the_documented_shapes():
     assert len(sim.body_names) == b and sim.body_names[0] == "first"
 
 
+def test_a_fluid_scene_runs_and_names_its_kinds():
+    # examples/scenes/fluid_floating.json: three cubes and the water after them; the water's
+    # particles follow the cubes' and keep their mass (rest density x d^3 = 1 g).
+    sim = motes.Simulation(motes.load_scene(os.path.join(SOURCE, "examples", "scenes",
+                                                         "fluid_floating.json")),
+                           backend="openmp")
+    assert sim.body_names == ["cork", "pine", "oak", "water"]
+    assert sim.body_kinds == ["rigid", "rigid", "rigid", "fluid"]
+    sim.step(2)
+    water = sim.particle_bodies() == 3
+    assert water.sum() == 3000
+    assert np.all(np.isfinite(sim.positions()[water]))
+    assert sim.positions()[water][:, 1].min() > 0.0
+
+
 def test_set_body_velocities_moves_the_particles_with_their_body():
     sim = motes.Simulation(motes.default_scene(), backend="openmp")
     v = np.zeros((sim.body_count, 3))
