@@ -35,6 +35,25 @@ inline std::uint32_t seeds_to_run(std::uint32_t all, std::uint32_t sanitized = 1
 #endif
 }
 
+/// How many frames a long unseeded test steps: all of them, or in the sanitizer build its first
+/// `sanitized`, where it checks nothing but the paths (the physics is checked in the first stage,
+/// as seeds_to_run's); `physics_checked()` says which.
+inline int frames_to_run(int all, int sanitized) {
+#ifdef MOTES_PHYSICS_SANITIZED
+  return sanitized < all ? sanitized : all;
+#else
+  (void)sanitized;
+  return all;
+#endif
+}
+inline bool physics_checked() {
+#ifdef MOTES_PHYSICS_SANITIZED
+  return false;
+#else
+  return true;
+#endif
+}
+
 /// xyz of a device vec4, widened to double.
 inline Eigen::Vector3d to_vec3(const motes::shared::vec4& v) {
   return {static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z)};
