@@ -45,6 +45,17 @@ done
 # contacts, meshes): frames byte-identical to one process's.
 for scene in "$src"/examples/scenes/*.json; do
   name=$(basename "$scene" .json)
+  # Liquids run in one process only (docs/fluids.md): over two ranks the run is refused, naming
+  # the fluid and why, before anything runs.
+  if grep -qE '"kind": "fluid"' "$scene"; then
+    status=0
+    shift_np 2 run "$scene" --backend openmp --steps 1 --format none --out "$work/$name-two" \
+      > "$work/$name-two.log" 2> "$work/$name-two.err" || status=$?
+    [ "$status" -ne 0 ] && grep -q "fluids do not run over MPI ranks yet" "$work/$name-two.err" ||
+      { echo "$name over 2 ranks: exit $status, not the fluids' refusal"; cat "$work/$name-two.err"; exit 1; }
+    echo "$name over 2 ranks refused: $(grep -m1 "fluids do not run" "$work/$name-two.err")"
+    continue
+  fi
   # A step of position contacts is a frame of 10 to 16 substeps: 60 of them (1 s) for those.
   steps=$scene_steps
   every=$scene_every
