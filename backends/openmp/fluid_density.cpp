@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdint>
 
+#include "fluid_walk.h"
 #include "openmp_device.h"
 #include "shared/fluid.h"
 #include "shared/grid_walk.h"
@@ -18,7 +19,6 @@ using shared::vec4;
 void OpenMPDevice::fluid_density(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
   const auto n = static_cast<std::int64_t>(p.fluid_count);
-  const std::size_t stride = p.particle_count;
   const vec4* pos = buf<vec4>(Buffer::ParticlePos);
   const vec4* vel = buf<vec4>(Buffer::ParticleVel);
   const uint* body = buf<uint>(Buffer::ParticleBody);
@@ -35,6 +35,7 @@ void OpenMPDevice::fluid_density(const shared::StepParams& p) {
   vec4* state = buf<vec4>(Buffer::FluidState);
   const bool first = (p.flags & MOTES_FLAG_POSITION_FIRST) != 0u;
 
+  const NeighbourWalk walk{list, count, ref, order, cell_start, sbody, body, exclusions};
   for_items(n, parallel_heavy(n), [&](std::int64_t k) {
     const auto i = static_cast<std::size_t>(p.fluid_first + static_cast<uint>(k));
     const vec4 pi = pos[i];
@@ -52,20 +53,7 @@ void OpenMPDevice::fluid_density(const shared::StepParams& p) {
       rho += mj * shared::fluid_poly6(shared::dot(rij, rij), h);
       gathered += shared::fluid_gradient_term(rij, mj, fluid_j ? vel[j].w : 0.0f, rho0, h);
     };
-    const uint c = count[i];
-    if (c <= p.neighbour_capacity) {
-      for (uint s = 0; s < c; ++s) add(list[std::size_t{s} * stride + i]);
-    } else {
-      const shared::GridRanges ranges = shared::grid_ranges(p, ref[i], cell_start);
-      for (int r = 0; r < ranges.count; ++r) {
-        for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
-          if (!shared::contact_skipped(body[i], sbody[t], uint(i), order[t], exclusions,
-                                       p.particle_count, p.linked_first)) {
-            add(order[t]);
-          }
-        }
-      }
-    }
+    for_each_neighbour(p, walk, i, add);
     for (uint s = 0; s < p.plane_count; ++s) {
       const vec4 wall = shared::fluid_plane_density(planes[s].normal_offset, xi, f);
       rho += wall.w;

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdint>
 
+#include "fluid_walk.h"
 #include "openmp_device.h"
 #include "shared/fluid.h"
 #include "shared/grid_walk.h"
@@ -22,7 +23,6 @@ using shared::vec4;
 void OpenMPDevice::fluid_update(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
   const auto n = static_cast<std::int64_t>(p.particle_count);
-  const std::size_t stride = p.particle_count;
   const vec4* pos = buf<vec4>(Buffer::ParticlePos);
   const vec4* vel = buf<vec4>(Buffer::ParticleVel);
   const uint* body = buf<uint>(Buffer::ParticleBody);
@@ -39,22 +39,9 @@ void OpenMPDevice::fluid_update(const shared::StepParams& p) {
   const vec4* state = buf<vec4>(Buffer::FluidState);
   vec4* force = buf<vec4>(Buffer::ParticleForce);
 
-  // Particle i's neighbours, in list order (over capacity: the 27 cells of the last build).
+  const NeighbourWalk walk{list, count, ref, order, cell_start, sbody, body, exclusions};
   const auto each_neighbour = [&](std::size_t i, auto&& add) {
-    const uint c = count[i];
-    if (c <= p.neighbour_capacity) {
-      for (uint s = 0; s < c; ++s) add(list[std::size_t{s} * stride + i]);
-      return;
-    }
-    const shared::GridRanges ranges = shared::grid_ranges(p, ref[i], cell_start);
-    for (int r = 0; r < ranges.count; ++r) {
-      for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
-        if (!shared::contact_skipped(body[i], sbody[t], uint(i), order[t], exclusions,
-                                     p.particle_count, p.linked_first)) {
-          add(order[t]);
-        }
-      }
-    }
+    for_each_neighbour(p, walk, i, add);
   };
   const float hs = p.gravity_dt.w;
 

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdint>
 
+#include "fluid_walk.h"
 #include "openmp_device.h"
 #include "shared/fluid.h"
 #include "shared/grid_walk.h"
@@ -20,7 +21,6 @@ using shared::vec4;
 void OpenMPDevice::fluid_velocity(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
   const auto n = static_cast<std::int64_t>(p.fluid_count);
-  const std::size_t stride = p.particle_count;
   const vec4* pos = buf<vec4>(Buffer::ParticlePos);
   const uint* body = buf<uint>(Buffer::ParticleBody);
   const uint* material = buf<uint>(Buffer::ParticleMaterial);
@@ -39,6 +39,7 @@ void OpenMPDevice::fluid_velocity(const shared::StepParams& p) {
   vec4* vel = buf<vec4>(Buffer::ParticleVel);
   const float hs = p.gravity_dt.w;
 
+  const NeighbourWalk walk{list, count, ref, order, cell_start, sbody, body, exclusions};
   for_items(n, parallel_heavy(n), [&](std::int64_t k) {
     const auto i = static_cast<std::size_t>(p.fluid_first + static_cast<uint>(k));
     const std::size_t at = static_cast<std::size_t>(k);
@@ -72,20 +73,7 @@ void OpenMPDevice::fluid_velocity(const shared::StepParams& p) {
       cohesion += shared::fluid_cohesion_term(rij, mj, rhoi, rhoj, ni, shared::xyz(normal[jk]),
                                               rho0, f.velocity.z, h, hs);
     };
-    const uint c = count[i];
-    if (c <= p.neighbour_capacity) {
-      for (uint s = 0; s < c; ++s) add(list[std::size_t{s} * stride + i]);
-    } else {
-      const shared::GridRanges ranges = shared::grid_ranges(p, ref[i], cell_start);
-      for (int r = 0; r < ranges.count; ++r) {
-        for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
-          if (!shared::contact_skipped(body[i], sbody[t], uint(i), order[t], exclusions,
-                                       p.particle_count, p.linked_first)) {
-            add(order[t]);
-          }
-        }
-      }
-    }
+    for_each_neighbour(p, walk, i, add);
     vec3 dv = xsph * f.velocity.x +
               shared::fluid_confinement(eta, shared::xyz(omega_i), f.velocity.y, hs);
     dv += cohesion;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdint>
 
+#include "fluid_walk.h"
 #include "openmp_device.h"
 #include "shared/fluid.h"
 #include "shared/grid_walk.h"
@@ -19,7 +20,6 @@ using shared::vec4;
 void OpenMPDevice::fluid_vorticity(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
   const auto n = static_cast<std::int64_t>(p.fluid_count);
-  const std::size_t stride = p.particle_count;
   const vec4* pos = buf<vec4>(Buffer::ParticlePos);
   const vec4* vel = buf<vec4>(Buffer::ParticleVel);
   const uint* body = buf<uint>(Buffer::ParticleBody);
@@ -37,6 +37,7 @@ void OpenMPDevice::fluid_vorticity(const shared::StepParams& p) {
   vec4* aux = buf<vec4>(Buffer::FluidAux);
   vec4* normal = buf<vec4>(Buffer::FluidNormal);
 
+  const NeighbourWalk walk{list, count, ref, order, cell_start, sbody, body, exclusions};
   for_items(n, parallel_heavy(n), [&](std::int64_t k) {
     const auto i = static_cast<std::size_t>(p.fluid_first + static_cast<uint>(k));
     const vec3 xi = shared::xyz(pos[i]);
@@ -52,20 +53,7 @@ void OpenMPDevice::fluid_vorticity(const shared::StepParams& p) {
       omega += shared::fluid_vorticity_term(vi, shared::xyz(vel[j]), mj, rhoj, grad);
       ni += shared::fluid_normal_term(mj, rhoj, grad, h);
     };
-    const uint c = count[i];
-    if (c <= p.neighbour_capacity) {
-      for (uint s = 0; s < c; ++s) add(list[std::size_t{s} * stride + i]);
-    } else {
-      const shared::GridRanges ranges = shared::grid_ranges(p, ref[i], cell_start);
-      for (int r = 0; r < ranges.count; ++r) {
-        for (uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
-          if (!shared::contact_skipped(body[i], sbody[t], uint(i), order[t], exclusions,
-                                       p.particle_count, p.linked_first)) {
-            add(order[t]);
-          }
-        }
-      }
-    }
+    for_each_neighbour(p, walk, i, add);
     const std::size_t at = static_cast<std::size_t>(k);
     vel_old[at] = vec4(vi, 0.0f);
     aux[at] = vec4(omega, shared::sqrt(shared::dot(omega, omega)));
