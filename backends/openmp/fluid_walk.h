@@ -35,8 +35,8 @@ void for_each_neighbour(const shared::StepParams& p, const NeighbourWalk& w, std
   const shared::GridRanges ranges = shared::grid_ranges(p, w.ref[i], w.cell_start);
   for (int r = 0; r < ranges.count; ++r) {
     for (shared::uint t = ranges.lo[r]; t < ranges.hi[r]; ++t) {
-      if (!shared::contact_skipped(w.body[i], w.sbody[t], shared::uint(i), w.order[t],
-                                   w.exclusions, p.particle_count, p.linked_first)) {
+      if (!shared::contact_skipped(w.body[i], w.sbody[t], shared::uint(i), w.order[t], w.exclusions,
+                                   p.particle_count, p.linked_first)) {
         add(w.order[t]);
       }
     }
