@@ -174,6 +174,14 @@ void run(const RunArgs& args) {
     // Pictures of every frame: the scene's camera or one fitted to the initial particles.
     Result<Snapshot> first = plan.sim->snapshot();
     if (!first) fail(first.message());
+    // An emitter's particles wait out of sight: the camera frames its nozzle instead.
+    plan.sim->hide_parked(first.value());
+    for (const FluidSpec& f : scene->fluids) {
+      if (f.emitter) {
+        const Eigen::Vector3f p = f.emitter->position.cast<float>();
+        first->particle_pos.emplace_back(p.x(), p.y(), p.z(), static_cast<float>(0.5 * f.diameter));
+      }
+    }
     render::RenderSettings settings = render_settings(
         args.render, render::look_from_scene(scene.value()), scene->camera, first->particle_pos);
     const double interval = static_cast<double>(plan.every) * s.dt;

@@ -146,6 +146,7 @@ class Session final : public SessionLoop {
     if (p_.writer || p_.render) {
       Result<Snapshot> snapshot = sim.snapshot();
       if (!snapshot) fail(snapshot.message());
+      sim.hide_parked(snapshot.value());  // an emitter's waiting particles are not drawn
       if (p_.writer) {
         if (Status s = p_.writer->write_frame(snapshot.value()); !s) fail(s.message());
       }

@@ -632,11 +632,9 @@ Status Simulation::load_state(const std::string& path) {
   {
     const std::vector<shared::vec4> pos = vec4s(kPosSection);
     const std::vector<shared::vec4> vel = vec4s(kVelSection);
-    std::uint64_t w = fnv1a64(nullptr, 0);
-    for (std::size_t i = 0; i < n; ++i) {
-      const float pair[2] = {pos[i].w, vel[i].w};
-      w = fnv1a64(pair, sizeof pair, w);
-    }
+    if (pos.size() < n || vel.size() < n) return corrupt("the particles' sections");
+    const std::uint64_t w =
+        particle_w_hash(std::span(pos).first(n), std::span(vel).first(n), emitters_);
     if (w != particle_w_hash_) {
       return Status::error(fmt::format(
           "{}: checkpoint of another scene: its particles' radii or masses are not this "
@@ -679,7 +677,7 @@ Status Simulation::load_state(const std::string& path) {
   steps_ = h.step;
   time_ = h.time;
   rebase_energy();  // the energy guard measures from the checkpoint's state
-  return Status::ok();
+  return count_emitted();
 }
 
 Status Simulation::load_state_v1(const std::string& path, const std::vector<unsigned char>& bytes) {
@@ -708,7 +706,7 @@ Status Simulation::load_state_v1(const std::string& path, const std::vector<unsi
   rebase_energy();
   steps_ = h.step;
   time_ = h.time;
-  return Status::ok();
+  return count_emitted();
 }
 
 }  // namespace motes

@@ -26,6 +26,14 @@ namespace motes {
 
 namespace {
 
+/// An emitter's particle that has not left yet (a fluid's particle of inverse mass 0): it sits
+/// far below its nozzle and counts for nothing (docs/fluids.md, "Emitters").
+bool parked(const Snapshot& state, std::span<const BodyInfo> bodies, std::size_t i) {
+  if (i >= state.particle_body.size() || i >= state.particle_vel.size()) return false;
+  const std::uint32_t b = state.particle_body[i];
+  return b < bodies.size() && bodies[b].fluid && !(state.particle_vel[i].w > 0.0f);
+}
+
 using shared::vec4;
 
 Eigen::Vector3d to_eigen(const vec4& v) {
@@ -365,8 +373,9 @@ EnergyReference energy_reference(const Snapshot& state, std::span<const BodyInfo
     const Eigen::Vector3d down = gravity / g;
     Eigen::Vector3d lowest = Eigen::Vector3d::Zero();
     double lowest_height = std::numeric_limits<double>::infinity();
-    for (const vec4& x : state.particle_pos) {
-      if (!finite3(x)) continue;
+    for (std::size_t i = 0; i < state.particle_pos.size(); ++i) {
+      const vec4& x = state.particle_pos[i];
+      if (!finite3(x) || parked(state, bodies, i)) continue;
       const double h = height(to_eigen(x), down);
       if (h < lowest_height) {
         lowest_height = h;
@@ -380,8 +389,9 @@ EnergyReference energy_reference(const Snapshot& state, std::span<const BodyInfo
   // The largest coordinate: the rounding of positions there, over a substep, is the velocity
   // noise of particles whose velocities come from position corrections.
   float coordinate = static_cast<float>(model.largest_diameter);
-  for (const vec4& x : state.particle_pos) {
-    if (!finite3(x)) continue;
+  for (std::size_t i = 0; i < state.particle_pos.size(); ++i) {
+    const vec4& x = state.particle_pos[i];
+    if (!finite3(x) || parked(state, bodies, i)) continue;
     coordinate = std::max({coordinate, std::abs(x.x), std::abs(x.y), std::abs(x.z)});
   }
   const double ulp = static_cast<double>(std::nextafter(coordinate, HUGE_VALF) - coordinate);

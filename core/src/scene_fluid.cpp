@@ -1,11 +1,13 @@
 // Fluids in a scene file: an entry of "bodies" with "kind": "fluid" (issue 29; docs/fluids.md,
 // docs/scene-format.md "Fluids"): a box, a sphere or a mesh's volume filled with particles on a
-// cubic lattice at the rest spacing.
+// cubic lattice at the rest spacing (fluid_rest_spacing: the spacing at which the kernel's sum is
+// the rest density, so a fill starts at rest).
 #include <fmt/format.h>
 
 #include <cmath>
 #include <limits>
 
+#include "motes/fluid.h"
 #include "motes/shapes.h"
 #include "scene_parts.h"
 
@@ -27,9 +29,10 @@ void check_count(const Node& where, double count, const ShapeCache& cache) {
   }
 }
 
-/// A box [min, max]: the lattice's first particle touches min on every axis, and every particle
-/// lies inside the box.
+/// A box [min, max]: the lattice of spacing s (fluid_rest_spacing) whose first particle touches
+/// min on every axis, every particle lying inside the box.
 std::vector<Eigen::Vector3d> fill_box(const Node& fluid, double d, const ShapeCache& cache) {
+  const double s = fluid_rest_spacing(d);
   const Eigen::Vector3d lo = fluid.at("min").vec3();
   const Node max_node = fluid.at("max");
   const Eigen::Vector3d hi = max_node.vec3();
@@ -39,13 +42,13 @@ std::vector<Eigen::Vector3d> fill_box(const Node& fluid, double d, const ShapeCa
     if (!(hi[i] > lo[i])) {
       axis.fail(fmt::format("must be greater than min[{}] ({} <= {})", i, hi[i], lo[i]));
     }
-    n[i] = steps_within(hi[i] - lo[i], d);
-    if (n[i] < 1) {
+    if (hi[i] - lo[i] < d * (1.0 - 1e-9)) {
       axis.fail(
           fmt::format("the box is {} m wide on this axis, less than one particle diameter "
                       "({} m)",
                       hi[i] - lo[i], d));
     }
+    n[i] = 1 + steps_within(std::max(0.0, hi[i] - lo[i] - d), s);
   }
   check_count(fluid,
               static_cast<double>(n[0]) * static_cast<double>(n[1]) * static_cast<double>(n[2]),
@@ -55,17 +58,18 @@ std::vector<Eigen::Vector3d> fill_box(const Node& fluid, double d, const ShapeCa
   for (std::int64_t z = 0; z < n[2]; ++z) {
     for (std::int64_t y = 0; y < n[1]; ++y) {
       for (std::int64_t x = 0; x < n[0]; ++x) {
-        points.push_back(lo + d * (Eigen::Vector3d(static_cast<double>(x), static_cast<double>(y),
-                                                   static_cast<double>(z)) +
-                                   Eigen::Vector3d::Constant(0.5)));
+        points.push_back(lo + Eigen::Vector3d::Constant(0.5 * d) +
+                         s * Eigen::Vector3d(static_cast<double>(x), static_cast<double>(y),
+                                             static_cast<double>(z)));
       }
     }
   }
   return points;
 }
 
-/// A sphere: the lattice centred on its centre, every particle lying inside it.
+/// A sphere: the lattice of spacing s centred on its centre, every particle lying inside it.
 std::vector<Eigen::Vector3d> fill_sphere(const Node& fluid, double d, const ShapeCache& cache) {
+  const double s = fluid_rest_spacing(d);
   const Eigen::Vector3d centre = fluid.at("center").vec3();
   const Node radius_node = fluid.at("radius");
   const double radius = radius_node.number(Sign::Positive);
@@ -74,7 +78,7 @@ std::vector<Eigen::Vector3d> fill_sphere(const Node& fluid, double d, const Shap
     radius_node.fail(
         fmt::format("a sphere of radius {} m holds no particle of diameter {} m", radius, d));
   }
-  const std::int64_t k = steps_within(reach, d);
+  const std::int64_t k = steps_within(reach, s);
   const double side = static_cast<double>(2 * k + 1);
   check_count(fluid, side * side * side * std::acos(-1.0) / 6.0, cache);
   std::vector<Eigen::Vector3d> points;
@@ -82,7 +86,7 @@ std::vector<Eigen::Vector3d> fill_sphere(const Node& fluid, double d, const Shap
     for (std::int64_t y = -k; y <= k; ++y) {
       for (std::int64_t x = -k; x <= k; ++x) {
         const Eigen::Vector3d offset =
-            d *
+            s *
             Eigen::Vector3d(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
         if (offset.norm() <= reach * (1.0 + 1e-12)) points.push_back(centre + offset);
       }
@@ -91,10 +95,11 @@ std::vector<Eigen::Vector3d> fill_sphere(const Node& fluid, double d, const Shap
   return points;
 }
 
-/// A mesh's volume: the voxelizer's lattice of spacing d inside the mesh (scaled by "scale", a
-/// number or one per axis), in the mesh's own coordinates moved by "position" (no rotation:
-/// rotate the mesh file). A closed mesh is filled by its crossings, an open one by its winding
-/// number, as a body's mesh shape is (docs/scene-format.md, "Open and non-manifold meshes").
+/// A mesh's volume: the voxelizer's lattice of spacing s (fluid_rest_spacing) inside the mesh
+/// (scaled by "scale", a number or one per axis), in the mesh's own coordinates moved by "position"
+/// (no rotation: rotate the mesh file). A closed mesh is filled by its crossings, an open one by
+/// its winding number, as a body's mesh shape is (docs/scene-format.md, "Open and non-manifold
+/// meshes").
 std::vector<Eigen::Vector3d> fill_mesh(const Node& fluid, double d, ShapeCache& cache) {
   Eigen::Vector3d scale = Eigen::Vector3d::Ones();
   if (auto s = fluid.find("scale")) {
@@ -117,7 +122,7 @@ std::vector<Eigen::Vector3d> fill_mesh(const Node& fluid, double d, ShapeCache& 
     check_count(fluid, cells.x() * cells.y() * cells.z(), cache);
   }
   VoxelizeOptions options;
-  options.diameter = d;
+  options.diameter = fluid_rest_spacing(d);
   Result<ParticleSet> filled = voxelize(mesh, options);
   if (!filled) fluid.at("file").fail(filled.message());
   std::vector<Eigen::Vector3d> points;
@@ -125,6 +130,35 @@ std::vector<Eigen::Vector3d> fill_mesh(const Node& fluid, double d, ShapeCache& 
   for (const Eigen::Vector3f& p : filled.value().points)
     points.push_back(p.cast<double>() + position);
   return points;
+}
+
+/// An emitter (docs/scene-format.md, "Emitters"): its nozzle, its schedule and its parked
+/// particles.
+FluidEmitter read_emitter(const Node& fluid, double d, const ShapeCache& cache) {
+  FluidEmitter e;
+  e.position = fluid.at("position").vec3();
+  const Node direction = fluid.at("direction");
+  const Eigen::Vector3d n = direction.vec3();
+  if (!(n.norm() > 0.0)) direction.fail("must not be zero (the way the stream leaves the nozzle)");
+  e.direction = n.normalized();
+  e.speed = fluid.at("speed").number(Sign::Positive);
+  e.rate = fluid.at("rate").number(Sign::Positive);
+  const Node limit = fluid.at("max_particles");
+  e.max_particles = static_cast<std::uint64_t>(limit.integer(1, std::int64_t{1} << 40));
+  if (static_cast<std::int64_t>(e.max_particles) > cache.max_particles) {
+    limit.fail(fmt::format("{} particles, more than settings.max_particles ({})", e.max_particles,
+                           cache.max_particles));
+  }
+  if (auto t = fluid.find("start")) e.start = t->number(Sign::NonNegative);
+  if (auto t = fluid.find("stop")) {
+    e.stop = t->number(Sign::Positive);
+    if (!(e.stop > e.start)) {
+      t->fail(fmt::format("must be later than start ({} s <= {} s)", e.stop, e.start));
+    }
+  }
+  e.nozzle = emitter_nozzle(e.direction, e.rate, e.speed, d);
+  e.layer_period = static_cast<double>(e.nozzle.size()) / e.rate;
+  return e;
 }
 
 }  // namespace
@@ -138,6 +172,7 @@ bool is_fluid(const Node& entry) {
 
 FluidSpec read_fluid(const Node& entry, std::size_t index, ShapeCache& cache, const Scene& scene) {
   entry.expect_object({"name", "kind", "material", "fluid", "velocity", "color"});
+  const Node fluid = entry.at("fluid");
   if (scene.settings.contact_model != ContactModel::Positions) {
     entry.at("kind").fail(
         "a fluid needs \"contact_model\": \"position\" in /settings (its density constraint is "
@@ -149,7 +184,6 @@ FluidSpec read_fluid(const Node& entry, std::size_t index, ShapeCache& cache, co
   if (auto v = entry.find("velocity")) spec.velocity = v->vec3();
   if (auto c = entry.find("color")) spec.color = read_color(*c);
 
-  const Node fluid = entry.at("fluid");
   const std::string type = fluid.has("type") ? fluid.at("type").string() : "";
   if (type == "box") {
     fluid.expect_object({"type", "min", "max", "diameter"});
@@ -157,23 +191,35 @@ FluidSpec read_fluid(const Node& entry, std::size_t index, ShapeCache& cache, co
     fluid.expect_object({"type", "center", "radius", "diameter"});
   } else if (type == "mesh") {
     fluid.expect_object({"type", "file", "scale", "position", "diameter"});
+  } else if (type == "emitter") {
+    fluid.expect_object({"type", "position", "direction", "speed", "rate", "max_particles", "start",
+                         "stop", "diameter"});
+    if (auto v = entry.find("velocity")) {
+      v->fail(
+          "an emitter's particles leave at its \"speed\" along its \"direction\" (drop "
+          "\"velocity\")");
+    }
   } else if (fluid.has("type")) {
     fluid.at("type").fail(
-        fmt::format("unknown fluid volume \"{}\" (allowed: box, sphere, mesh; emitters are not "
-                    "built yet)",
-                    type));
+        fmt::format("unknown fluid volume \"{}\" (allowed: box, sphere, mesh, emitter)", type));
   } else {
-    fluid.expect_object(
-        {"type", "min", "max", "center", "radius", "file", "scale", "position", "diameter"});
+    fluid.expect_object({"type", "min", "max", "center", "radius", "file", "scale", "position",
+                         "direction", "speed", "rate", "max_particles", "start", "stop",
+                         "diameter"});
     fluid.fail(
         "missing required key \"type\" (the volume the fluid fills: \"box\", \"sphere\" or "
-        "\"mesh\")");
+        "\"mesh\"; or \"emitter\")");
   }
   spec.diameter = cache.default_diameter;
   if (auto d = fluid.find("diameter")) spec.diameter = d->number(Sign::Positive);
-  spec.points = type == "box"      ? fill_box(fluid, spec.diameter, cache)
-                : type == "sphere" ? fill_sphere(fluid, spec.diameter, cache)
-                                   : fill_mesh(fluid, spec.diameter, cache);
+  if (type == "emitter") {
+    spec.emitter = read_emitter(fluid, spec.diameter, cache);
+    spec.points = emitter_parking(*spec.emitter, spec.diameter);
+  } else {
+    spec.points = type == "box"      ? fill_box(fluid, spec.diameter, cache)
+                  : type == "sphere" ? fill_sphere(fluid, spec.diameter, cache)
+                                     : fill_mesh(fluid, spec.diameter, cache);
+  }
   if (spec.points.empty()) fluid.fail("the volume holds no particle");
   for (const Eigen::Vector3d& p : spec.points) {
     if (!(p.cwiseAbs().maxCoeff() <= static_cast<double>(std::numeric_limits<float>::max()))) {
@@ -184,3 +230,59 @@ FluidSpec read_fluid(const Node& entry, std::size_t index, ShapeCache& cache, co
 }
 
 }  // namespace motes::scene_detail
+
+namespace motes {
+
+std::vector<Eigen::Vector3d> emitter_nozzle(const Eigen::Vector3d& direction, double rate,
+                                            double speed, double d) {
+  const Eigen::Vector3d n = direction.normalized();
+  const Eigen::Vector3d a =
+      std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d u = (a - a.dot(n) * n).normalized();
+  const Eigen::Vector3d w = n.cross(u);
+  const double want = rate * d / speed;  // particles a layer for a layer per d of travel
+  // Discs of squared radius q (in spacings): grow q while the count gets closer to `want`.
+  const auto count = [](std::int64_t q) {
+    std::int64_t c = 0;
+    const auto r = static_cast<std::int64_t>(std::sqrt(static_cast<double>(q)));
+    for (std::int64_t j = -r - 1; j <= r + 1; ++j) {
+      for (std::int64_t i = -r - 1; i <= r + 1; ++i) c += i * i + j * j <= q ? 1 : 0;
+    }
+    return c;
+  };
+  std::int64_t best = 0;
+  for (std::int64_t q = 1; q < (1 << 20) && static_cast<double>(count(q - 1)) < want; ++q) {
+    if (std::abs(static_cast<double>(count(q)) - want) <
+        std::abs(static_cast<double>(count(best)) - want)) {
+      best = q;
+    }
+  }
+  std::vector<Eigen::Vector3d> points;
+  const auto r = static_cast<std::int64_t>(std::sqrt(static_cast<double>(best)));
+  for (std::int64_t j = -r - 1; j <= r + 1; ++j) {
+    for (std::int64_t i = -r - 1; i <= r + 1; ++i) {
+      if (i * i + j * j <= best) {
+        points.push_back(d * (static_cast<double>(i) * u + static_cast<double>(j) * w));
+      }
+    }
+  }
+  return points;
+}
+
+std::vector<Eigen::Vector3d> emitter_parking(const FluidEmitter& e, double d) {
+  const auto side =
+      static_cast<std::uint64_t>(std::ceil(std::cbrt(static_cast<double>(e.max_particles))));
+  const double step = kEmitterParkSpacing * d;
+  const Eigen::Vector3d origin = e.position - Eigen::Vector3d(0.0, kEmitterParkDepth, 0.0);
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(e.max_particles);
+  for (std::uint64_t k = 0; k < e.max_particles; ++k) {
+    const std::uint64_t x = k % side, y = (k / side) % side, z = k / (side * side);
+    points.push_back(origin + step * Eigen::Vector3d(static_cast<double>(x),
+                                                     -static_cast<double>(y),
+                                                     static_cast<double>(z)));
+  }
+  return points;
+}
+
+}  // namespace motes

@@ -333,12 +333,17 @@ Fingerprint fingerprint(const Settings& settings, const HostLayout& layout) {
     h = fnv1a64(&body, sizeof body, h);
     h = fnv1a64(&q, sizeof q, h);
   }
-  std::uint64_t w = fnv1a64(nullptr, 0);
-  const ParticleLayout& p = layout.particles;
-  for (std::size_t i = 0; i < p.pos.size(); ++i) {
-    const float pair[2] = {p.pos[i].w, p.vel[i].w};
-    w = fnv1a64(pair, sizeof pair, w);
+  for (const EmitterRange& e : layout.emitters) {  // their schedules (only in a scene with one)
+    const FluidEmitter& f = e.emitter;
+    const double words[11] = {f.position.x(),  f.position.y(),  f.position.z(), f.direction.x(),
+                              f.direction.y(), f.direction.z(), f.speed,        f.rate,
+                              f.start,         f.stop,          f.layer_period};
+    h = fnv1a64(words, sizeof words, h);
+    const std::uint64_t range[3] = {e.first, e.count, f.nozzle.size()};
+    h = fnv1a64(range, sizeof range, h);
   }
+  const ParticleLayout& p = layout.particles;
+  const std::uint64_t w = particle_w_hash(p.pos, p.vel, layout.emitters);
   return {fnv1a64(&w, sizeof w, h), w};
 }
 

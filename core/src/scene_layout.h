@@ -12,6 +12,7 @@
 
 #include "motes/backend/device.h"
 #include "motes/cloth.h"
+#include "motes/fluid.h"
 #include "motes/scene.h"
 #include "motes/simulation.h"
 #include "motes/soft.h"
@@ -121,6 +122,8 @@ struct HostLayout {
   TableLayout tables;
   /// FluidMaterials: one entry per material with fluid, none without (motes/fluid.h).
   std::vector<shared::FluidMaterial> fluid_materials;
+  /// The emitters' particles (parked: inverse mass 0 in ParticleVel until they leave).
+  std::vector<EmitterRange> emitters;
   HaloLayout halo;
 };
 

@@ -1,6 +1,6 @@
 // The scene's fluids laid out for the device (scene_layout.h; docs/fluids.md, "Particles and
 // buffers"): free particles [Nf, Ns), between the free spheres and the soft bodies, each its own
-// body for the lists, and the FluidMaterials table.
+// body for the lists, and the FluidMaterials table; an emitter's particles parked (inverse mass 0).
 #include <fmt/format.h>
 
 #include <cmath>
@@ -30,10 +30,19 @@ Status build_fluids(const Scene& scene, const SceneCounts& counts, HostLayout& o
     }
     out.device_index.push_back(at);
     out.bodies[first_entry + fi].mass = mass * static_cast<double>(f.points.size());
+    if (f.emitter) {  // parked until they leave: inverse mass 0 (docs/fluids.md, "Emitters")
+      EmitterRange e;
+      e.entry = first_entry + fi;
+      e.first = at;
+      e.count = static_cast<std::uint32_t>(f.points.size());
+      e.inverse_mass = static_cast<float>(1.0 / mass);
+      e.emitter = *f.emitter;
+      out.emitters.push_back(std::move(e));
+    }
     for (const Eigen::Vector3d& x : f.points) {
       const std::uint32_t i = at++;
       p.pos[i] = to_vec4(x, 0.5 * f.diameter);
-      p.vel[i] = to_vec4(f.velocity, 1.0 / mass);
+      p.vel[i] = to_vec4(f.velocity, f.emitter ? 0.0 : 1.0 / mass);
       // Its own body, as a free sphere's (body words past the rigid bodies, one per particle of
       // [Nr, Ns)).
       p.body[i] = out.sizes.bodies + (i - out.sizes.rigid_particles);

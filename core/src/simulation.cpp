@@ -100,16 +100,28 @@ Status allocate_halo(Device& d, std::size_t count, HostMemory<vec4>& memory) {
   return Status::ok();
 }
 
-/// The particle lowest along gravity (the first of equals; the first without gravity).
-std::size_t lowest_particle(const Eigen::Vector3d& gravity, const std::vector<vec4>& pos) {
+/// The point lowest along gravity (the first of equals; the first without gravity) of the
+/// particles and the emitters' nozzles, leaving out the emitters' parked particles.
+vec4 lowest_point(const Eigen::Vector3d& gravity, const std::vector<vec4>& pos,
+                  const std::vector<EmitterRange>& emitters) {
+  std::vector<bool> parked(pos.size(), false);
+  std::vector<vec4> candidates;
+  for (const EmitterRange& e : emitters) {
+    for (std::uint32_t k = 0; k < e.count; ++k) parked[e.first + k] = true;
+    candidates.push_back(to_vec4(e.emitter.position, 0.0));
+  }
+  for (std::size_t i = 0; i < pos.size(); ++i) {
+    if (!parked[i]) candidates.push_back(pos[i]);
+  }
   const auto g_dot = [&](const vec4& x) {
     return gravity.dot(Eigen::Vector3f(x.x, x.y, x.z).cast<double>());
   };
+  if (candidates.empty()) return vec4(0.0f);
   std::size_t lowest = 0;
-  for (std::size_t i = 1; i < pos.size(); ++i) {
-    if (g_dot(pos[i]) > g_dot(pos[lowest])) lowest = i;
+  for (std::size_t i = 1; i < candidates.size(); ++i) {
+    if (g_dot(candidates[i]) > g_dot(candidates[lowest])) lowest = i;
   }
-  return lowest;
+  return candidates[lowest];
 }
 
 }  // namespace
@@ -206,6 +218,7 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
   rigid_inv_inertia_ = host.rigid.inv_inertia;
   colour_first_ = host.linked.colouring.first;
   sphere_turns_ = std::move(host.sphere_turns);
+  emitters_ = host.emitters;
 
   Status s = write_layout(d, host);
   if (s) s = clear_contact_history();
@@ -223,7 +236,7 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
       rigid_scene_body_[device_index_[b]] = static_cast<std::uint32_t>(b);
   }
   const std::vector<vec4>& ppos = host.particles.pos;
-  const vec4 origin = ppos.empty() ? vec4(0.0f) : ppos[lowest_particle(settings_.gravity, ppos)];
+  const vec4 origin = lowest_point(settings_.gravity, ppos, emitters_);
   energy_origin_ = Eigen::Vector3f(origin.x, origin.y, origin.z).cast<double>();
   const std::uint32_t header[MOTES_ENERGY_HEADER] = {
       shared::float_bits(origin.x), shared::float_bits(origin.y), shared::float_bits(origin.z), 0u};
@@ -243,6 +256,9 @@ Status Simulation::step(std::uint64_t count) {
   if (!settings_.impulse_memory_across_builds) lists.flags &= ~MOTES_FLAG_IMPULSE;
   const bool positions = settings_.contact_model == ContactModel::Positions;
   for (std::uint64_t k = 0; k < count; ++k) {
+    if (!emitters_.empty()) {
+      if (Status s = emit(); !s) return s;
+    }
     if (positions) step_positions(lists);
     for (int sub = 0; sub < settings_.substeps && !positions; ++sub) {
       d.enqueue(Kernel::NeighboursUpdate, lists);
@@ -595,7 +611,7 @@ Status Simulation::write_state(const Snapshot& state) {
   steps_ = state.step;
   time_ = static_cast<double>(steps_) * settings_.dt;
   rebase_energy();  // a state from outside: the energy guard measures from it
-  return Status::ok();
+  return count_emitted();
 }
 
 namespace {

@@ -23,42 +23,6 @@ constexpr double kD = kDiameter;
 constexpr double kGap = 1.0e-5;     // between bodies laid on each other or on the floor (m)
 constexpr double kSlotPitch = 2.5;  // m between cases' places on the floor
 
-/// splitmix64: a small generator with the same output everywhere.
-class Rng {
- public:
-  explicit Rng(std::uint64_t seed) : s_(seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull) {}
-  std::uint64_t next() {
-    std::uint64_t z = (s_ += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  /// In [0, 1).
-  double unit() { return static_cast<double>(next() >> 11) * (1.0 / 9007199254740992.0); }
-  double uniform(double lo, double hi) { return lo + (hi - lo) * unit(); }
-  /// In [lo, hi].
-  int integer(int lo, int hi) {
-    return lo + static_cast<int>(next() % static_cast<std::uint64_t>(hi - lo + 1));
-  }
-  bool chance(double p) { return unit() < p; }
-  Eigen::Vector3d vec(double scale) {
-    const double x = uniform(-scale, scale);
-    const double y = uniform(-scale, scale);
-    return {x, y, uniform(-scale, scale)};
-  }
-  /// A uniformly random rotation (Shoemake).
-  Eigen::Quaterniond rotation() {
-    const double u1 = unit(), u2 = unit(), u3 = unit();
-    const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
-    const double t2 = 2.0 * std::numbers::pi * u2, t3 = 2.0 * std::numbers::pi * u3;
-    return Eigen::Quaterniond(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2),
-                              b * std::sin(t3));
-  }
-
- private:
-  std::uint64_t s_;
-};
-
 using Dims = Eigen::Vector3i;
 
 std::shared_ptr<const motes::ParticleSet> box(const Dims& n) {

@@ -47,6 +47,48 @@ TEST(FluidMaterial, DefaultsAreTheSettledSet) {
   EXPECT_EQ(f.density_h.y, 4.0f * static_cast<float>(d / 2.0));
 }
 
+// The fill's spacing: the poly6 sum of its lattice is rho_0 (1.0098 rho_0 at spacing d).
+TEST(FluidMaterial, RestSpacingHoldsTheRestDensity) {
+  const double d = 0.01;
+  const double s = motes::fluid_rest_spacing(d);
+  EXPECT_NEAR(s / d, 1.003075, 1e-6);
+  const motes::shared::FluidMaterial f = motes::fluid_material(water(), d, 1.0 / 960.0);
+  double rho = 0.0;
+  for (int x = -2; x <= 2; ++x) {
+    for (int y = -2; y <= 2; ++y) {
+      for (int z = -2; z <= 2; ++z) {
+        const double r2 = s * s * (x * x + y * y + z * z);
+        rho += static_cast<double>(f.density_h.z) * static_cast<double>(motes::shared::fluid_poly6(
+                                                        static_cast<float>(r2), f.density_h.y));
+      }
+    }
+  }
+  EXPECT_NEAR(rho / 1000.0, 1.0, 2e-6);
+}
+
+// s_corr is the force of a pair potential: -du/dr of fluid_s_corr_energy is m dx / h_s^2 times
+// the sweeps, dx the shift term s_corr gives i (fluid_shift_term), at several distances; 0 from h.
+TEST(FluidMaterial, ArtificialPressureIsThePairPotentialsForce) {
+  const double d = 0.01, hs = 1.0 / 960.0;
+  const int sweeps = 2;
+  const motes::shared::FluidMaterial f = motes::fluid_material(water(), d, hs);
+  const float h = f.density_h.y, m = f.density_h.z;
+  for (const double q : {0.25, 0.45, 0.6, 0.8}) {
+    const double r = q * static_cast<double>(h), e = 1e-5 * static_cast<double>(h);
+    const double force = -(motes::fluid_s_corr_energy(r + e, f, hs, sweeps) -
+                           motes::fluid_s_corr_energy(r - e, f, hs, sweeps)) /
+                         (2.0 * e);
+    const motes::shared::vec3 rij(static_cast<float>(r), 0.0f, 0.0f);
+    const float s_corr = motes::shared::fluid_s_corr(static_cast<float>(r * r), m, f);
+    const motes::shared::vec3 dx = motes::shared::fluid_shift_term(
+        0.0f, 0.0f, m, m, s_corr, motes::shared::fluid_spiky_gradient(rij, h), f.density_h.x);
+    const double moved = static_cast<double>(dx.x) * sweeps * static_cast<double>(m) / (hs * hs);
+    EXPECT_GT(force, 0.0) << "a repulsion, q " << q;
+    EXPECT_NEAR(moved / force, 1.0, 1e-4) << "q " << q;
+  }
+  EXPECT_EQ(motes::fluid_s_corr_energy(static_cast<double>(h), f, hs, sweeps), 0.0);
+}
+
 TEST(FluidMaterial, RestDensityOverridesDensityAndKFollowsTheSubstep) {
   motes::Material m = water();
   m.rest_density = 998.0;

@@ -32,16 +32,24 @@ Result<Scene> load_fluid_text(const std::string& text) {
 TEST(SceneFluid, BoxIsFilledAtTheRestSpacingInsideTheBox) {
   Result<Scene> r = load_fluid_text(fluid_scene(
       R"({"name": "water", "kind": "fluid", "velocity": [0.1, 0, 0], "color": "#3060ff",
-          "fluid": {"type": "box", "min": [0, 0, 0], "max": [0.05, 0.03, 0.0405]}})"));
+          "fluid": {"type": "box", "min": [0, 0, 0], "max": [0.0505, 0.031, 0.0405]}})"));
   ASSERT_TRUE(r) << r.message();
   ASSERT_EQ(r->fluids.size(), 1u);
   const FluidSpec& f = r->fluids[0];
   EXPECT_EQ(f.name, "water");
   EXPECT_EQ(f.diameter, 0.01);  // settings.particle_diameter's default
+  // The rest spacing s = 1.003075 d (fluid_rest_spacing): 1 + floor((L - d) / s) per axis, so a
+  // box of exactly n diameters would hold n - 1 (its particles n s wide).
+  const double s = fluid_rest_spacing(0.01);
   ASSERT_EQ(f.points.size(), 5u * 3u * 4u);
   EXPECT_TRUE(f.points.front().isApprox(Eigen::Vector3d(0.005, 0.005, 0.005)));
-  EXPECT_TRUE(f.points[1].isApprox(Eigen::Vector3d(0.015, 0.005, 0.005)));  // x fastest
-  EXPECT_TRUE(f.points.back().isApprox(Eigen::Vector3d(0.045, 0.025, 0.035)));
+  EXPECT_TRUE(f.points[1].isApprox(Eigen::Vector3d(0.005 + s, 0.005, 0.005)));  // x fastest
+  EXPECT_TRUE(
+      f.points.back().isApprox(Eigen::Vector3d(0.005 + 4 * s, 0.005 + 2 * s, 0.005 + 3 * s)));
+  Result<Scene> exact = load_fluid_text(fluid_scene(
+      R"({"kind": "fluid", "fluid": {"type": "box", "min": [0, 0, 0], "max": [0.05, 0.05, 0.05]}})"));
+  ASSERT_TRUE(exact) << exact.message();
+  EXPECT_EQ(exact->fluids[0].points.size(), 4u * 4u * 4u);
   EXPECT_TRUE(f.velocity.isApprox(Eigen::Vector3d(0.1, 0.0, 0.0)));
   ASSERT_TRUE(f.color.has_value());
   EXPECT_EQ(r->particle_count(), 60u);
@@ -87,15 +95,16 @@ TEST(SceneFluid, SettingsDefaultToTheSettledSetWithFluid) {
 }
 
 TEST(SceneFluid, SphereIsFilledOnALatticeAboutItsCentre) {
-  // Reach 0.025 - 0.005 = 2 spacings: the lattice points with |n|^2 <= 4, 1 + 6 + 12 + 8 + 6.
+  // Reach 0.0251 - 0.005 = 2 rest spacings (2 s = 0.02006): the lattice points with |n|^2 <= 4,
+  // 1 + 6 + 12 + 8 + 6.
   Result<Scene> r = load_fluid_text(fluid_scene(
-      R"({"kind": "fluid", "fluid": {"type": "sphere", "center": [1, 2, 3], "radius": 0.025}})"));
+      R"({"kind": "fluid", "fluid": {"type": "sphere", "center": [1, 2, 3], "radius": 0.0251}})"));
   ASSERT_TRUE(r) << r.message();
   const FluidSpec& f = r->fluids[0];
   ASSERT_EQ(f.points.size(), 33u);
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& p : f.points) {
-    EXPECT_LE((p - Eigen::Vector3d(1, 2, 3)).norm(), 0.02 + 1e-12);
+    EXPECT_LE((p - Eigen::Vector3d(1, 2, 3)).norm(), 0.0201 + 1e-12);
     mean += p;
   }
   EXPECT_TRUE((mean / 33.0).isApprox(Eigen::Vector3d(1, 2, 3)));
@@ -169,7 +178,7 @@ TEST(SceneFluid, MaterialFieldsAndTheirDefaults) {
 
 TEST(SceneFluid, ErrorsNameTheFileThePlaceAndTheReason) {
   const std::string box =
-      R"("fluid": {"type": "box", "min": [0, 0, 0], "max": [0.02, 0.02, 0.02]})";
+      R"("fluid": {"type": "box", "min": [0, 0, 0], "max": [0.0201, 0.0201, 0.0201]})";
   const std::vector<std::pair<std::string, std::string>> bad = {
       {fluid_scene(R"({"kind": "fluid", )" + box + "}", "{}", R"("contact_model": "impulse")"),
        "s.json: /bodies/0/kind: a fluid needs \"contact_model\": \"position\""},
@@ -232,7 +241,7 @@ TEST(SceneFluid, SimulationLaysTheFluidOutAfterTheBodiesInTheSceneOrder) {
           "position": [0.5, 0.5, 0.5]},
          {"name": "ball", "shape": {"type": "sphere", "radius": 0.005}, "position": [-0.5, 0, 0]},
          {"name": "water", "kind": "fluid", "velocity": [0.25, 0, 0], "material": "water",
-          "fluid": {"type": "box", "min": [0, 0, 0], "max": [0.02, 0.02, 0.03]}})",
+          "fluid": {"type": "box", "min": [0, 0, 0], "max": [0.0201, 0.0201, 0.0301]}})",
       R"({"water": {"density": 1000, "rest_density": 998}})"));
   ASSERT_TRUE(r) << r.message();
   auto device = open_device("openmp");

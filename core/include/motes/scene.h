@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -174,9 +175,33 @@ struct LinkedSpec {
   std::optional<Eigen::Vector3d> color;  ///< sRGB, each 0..1, for pictures
 };
 
-/// A volume of liquid (issue 29, docs/fluids.md): equal particles on a cubic lattice of spacing
-/// `diameter` (the rest spacing), each of mass rest_density x diameter^3, filling a box or a
-/// sphere. Loaded and checked; Simulation::create does not run fluids yet (it says so).
+/// A stream of liquid from a nozzle (docs/fluids.md, "Emitters"): layers of particles leave a
+/// disc across `direction` at `speed`, `rate` particles a second, from `start` until `stop` or
+/// until `max_particles` have left. The disc holds the lattice points (spacing d) of the nozzle
+/// (emitter_nozzle); a layer leaves every `layer_period` s.
+struct FluidEmitter {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();     ///< the nozzle's centre (m)
+  Eigen::Vector3d direction{0.0, -1.0, 0.0};              ///< unit vector the stream leaves along
+  double speed = 1.0;                                     ///< m/s
+  double rate = 1000.0;                                   ///< particles per second
+  std::uint64_t max_particles = 0;                        ///< the most it ever emits (> 0)
+  double start = 0.0;                                     ///< s
+  double stop = std::numeric_limits<double>::infinity();  ///< s
+  std::vector<Eigen::Vector3d> nozzle;                    ///< one layer's offsets from position (m)
+  double layer_period = 0.0;  ///< s between layers: nozzle.size() / rate
+};
+
+/// The nozzle of an emitter of particles of diameter d (spacing d), `rate` particles a second at
+/// `speed` along unit `direction`: the points i u + j w (u, w across the direction) of the square
+/// lattice within the disc whose count is closest to rate d / speed (a layer per d of travel, so
+/// that the stream is spaced d along it), at least one.
+std::vector<Eigen::Vector3d> emitter_nozzle(const Eigen::Vector3d& direction, double rate,
+                                            double speed, double d);
+
+/// A volume of liquid (issue 29, docs/fluids.md): equal particles on a cubic lattice of the rest
+/// spacing (fluid_rest_spacing: 1.003 x `diameter`), each of mass rest_density x diameter^3,
+/// filling a box, a sphere or a mesh's volume; or an emitter's particles, parked (inverse mass 0,
+/// far below its nozzle: `points` are their places) until they leave it.
 struct FluidSpec {
   std::string name;
   int material = 0;                     ///< index into Scene::materials (its fluid fields)
@@ -184,7 +209,14 @@ struct FluidSpec {
   std::vector<Eigen::Vector3d> points;  ///< world positions of the particles
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   std::optional<Eigen::Vector3d> color;  ///< sRGB, each 0..1, for pictures
+  std::optional<FluidEmitter> emitter;   ///< set: the particles leave this emitter
 };
+
+/// Where an emitter's particles wait (m): far enough below its nozzle (kEmitterParkDepth) that
+/// nothing reaches them, kEmitterParkSpacing diameters apart so that no two are neighbours.
+constexpr double kEmitterParkDepth = 1000.0;
+constexpr double kEmitterParkSpacing = 4.0;
+std::vector<Eigen::Vector3d> emitter_parking(const FluidEmitter& e, double d);
 
 /// A static analytic half-space: solid below the plane (opposite to the normal).
 struct PlaneSpec {

@@ -12,6 +12,7 @@
 #include "motes/api.h"
 #include "motes/backend/device.h"
 #include "motes/energy.h"
+#include "motes/fluid.h"
 #include "motes/scene.h"
 #include "motes/status.h"
 #include "shared/common.h"
@@ -314,6 +315,13 @@ class Simulation {
   /// Device memory this simulation holds (Device::required_bytes).
   [[nodiscard]] std::uint64_t device_bytes() const { return device_->required_bytes(sizes_); }
   [[nodiscard]] Device& device() { return *device_; }
+  /// The fluids' emitters: their particles on the device and how many have left
+  /// (docs/fluids.md, "Emitters").
+  [[nodiscard]] const std::vector<EmitterRange>& emitters() const { return emitters_; }
+  /// For pictures and output files: the emitters' particles that have not left yet get NaN
+  /// centres (they wait far below their nozzles; renderers and readers skip non-finite
+  /// particles). Never write such a state back (write_state).
+  void hide_parked(Snapshot& state) const;
 
  private:
   Simulation() = default;
@@ -337,6 +345,13 @@ class Simulation {
   /// Writes a scene-ordered state (a snapshot or a checkpoint's) to the device and, with
   /// `rebuild`, asks for a neighbour-list rebuild and clears the impulse contacts' history.
   Status restore(const Snapshot& state, bool rebuild = true);
+  /// The emitters' particles due by the start of the step at time_ leave their nozzles: their
+  /// places and velocities written on the device (one read and one write of ParticlePos and
+  /// ParticleVel), a list rebuild asked for, their energy added to the energy guard's reference.
+  Status emit();
+  /// Each emitter's particles that have left (inverse mass > 0 on the device), after a state
+  /// was written from outside.
+  Status count_emitted();
   /// The scene body and scene particle index of device particle i.
   [[nodiscard]] std::pair<std::uint32_t, std::uint32_t> locate_particle(std::uint32_t i) const;
   /// load_state for a version 1 file (bytes: the whole file).
@@ -357,6 +372,7 @@ class Simulation {
   std::vector<shared::vec4> rigid_inv_inertia_;
   /// Constraints of colour c are Constraints [colour_first_[c], colour_first_[c + 1]).
   std::vector<std::uint32_t> colour_first_;
+  std::vector<EmitterRange> emitters_;
   /// Position contacts: the scene has dynamic rigid bodies (their passes run).
   bool position_bodies_ = false;
   /// (scene body, orientation) of the free spheres that are not at the identity orientation; a
