@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "motes/shapes.h"
+#include "unit/cli_support.h"
 #include "unit/test_support.h"
 
 namespace motes {
@@ -27,9 +28,7 @@ using motes_test::bunny_path;
 using motes_test::mesh_path;
 using motes_test::sorted_points;
 
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
+using motes_test::contains;
 
 using motes_test::box_mesh;
 
