@@ -34,16 +34,16 @@ Status Simulation::emit() {
     const double mass = 1.0 / static_cast<double>(e.inverse_mass);
     for (std::uint64_t k = e.emitted; k < by; ++k) {
       // Layer k / per_layer left at start + layer T: where it is now, as a projectile.
-      const double tau = std::max(
-          0.0, time_ - (f.start + static_cast<double>(k / per_layer) * f.layer_period));
-      const Eigen::Vector3d x =
-          f.position + f.nozzle[k % per_layer] + f.direction * (f.speed * tau) + 0.5 * g * tau * tau;
+      const double tau =
+          std::max(0.0, time_ - (f.start + static_cast<double>(k / per_layer) * f.layer_period));
+      const Eigen::Vector3d x = f.position + f.nozzle[k % per_layer] +
+                                f.direction * (f.speed * tau) + 0.5 * g * tau * tau;
       const Eigen::Vector3d v = f.direction * f.speed + g * tau;
       const std::size_t i = e.first + k;
-      pos[i] = vec4(static_cast<float>(x.x()), static_cast<float>(x.y()),
-                    static_cast<float>(x.z()), pos[i].w);
-      vel[i] = vec4(static_cast<float>(v.x()), static_cast<float>(v.y()),
-                    static_cast<float>(v.z()), e.inverse_mass);
+      pos[i] = vec4(static_cast<float>(x.x()), static_cast<float>(x.y()), static_cast<float>(x.z()),
+                    pos[i].w);
+      vel[i] = vec4(static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z()),
+                    e.inverse_mass);
       const Eigen::Vector3d xf(pos[i].x, pos[i].y, pos[i].z);
       const Eigen::Vector3d vf(vel[i].x, vel[i].y, vel[i].z);
       kinetic += 0.5 * mass * vf.squaredNorm();
