@@ -133,7 +133,8 @@ TEST(RenderFluid, SpeedAndHeightColoursTreatFluidAsEverythingElse) {
   EXPECT_NE(height(frame, 16), height(frame, 1));  // the map along up, not water
 }
 
-// A tank of water, simulated for a moment, drawn with the fitted camera.
+// A tank of water (12 x 8 x 6 particles at the rest spacing), simulated for a moment, drawn with
+// the fitted camera.
 constexpr const char* kTank = R"({
   "settings": { "dt": 0.016666666666666666, "gravity": [0, -9.81, 0],
                 "contact_model": "position", "particle_diameter": 0.01 },
@@ -141,10 +142,10 @@ constexpr const char* kTank = R"({
                  "glass": { "density": 2500, "friction": 0.0 } },
   "bodies": [
     { "name": "water", "kind": "fluid", "material": "water",
-      "fluid": { "type": "box", "min": [0, 0, 0], "max": [0.12, 0.08, 0.06] } }
+      "fluid": { "type": "box", "min": [0, 0, 0], "max": [0.1204, 0.0803, 0.0602] } }
   ],
   "planes": [
-    { "type": "box", "name": "tank", "min": [0, 0, 0], "max": [0.12, 0.2, 0.06],
+    { "type": "box", "name": "tank", "min": [0, 0, 0], "max": [0.1204, 0.2, 0.0602],
       "material": "glass" }
   ]
 })";

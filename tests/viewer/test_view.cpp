@@ -891,8 +891,8 @@ constexpr const char* kWaterScene = R"({
   "materials": { "water": { "density": 1000, "friction": 0.0 },
                  "glass": { "density": 2500, "friction": 0.0 } },
   "bodies": [ { "name": "water", "kind": "fluid", "material": "water",
-                "fluid": { "type": "box", "min": [0, 0, 0], "max": [0.12, 0.08, 0.06] } } ],
-  "planes": [ { "type": "box", "name": "tank", "min": [0, 0, 0], "max": [0.12, 0.2, 0.06],
+                "fluid": { "type": "box", "min": [0, 0, 0], "max": [0.1204, 0.0803, 0.0602] } } ],
+  "planes": [ { "type": "box", "name": "tank", "min": [0, 0, 0], "max": [0.1204, 0.2, 0.0602],
                 "material": "glass" } ]
 })";
 
