@@ -175,15 +175,9 @@ void run(const RunArgs& args) {
     Result<Snapshot> first = plan.sim->snapshot();
     if (!first) fail(first.message());
     // An emitter's particles wait out of sight: the camera frames its nozzle instead.
-    plan.sim->hide_parked(first.value());
-    for (const FluidSpec& f : scene->fluids) {
-      if (f.emitter) {
-        const Eigen::Vector3f p = f.emitter->position.cast<float>();
-        first->particle_pos.emplace_back(p.x(), p.y(), p.z(), static_cast<float>(0.5 * f.diameter));
-      }
-    }
-    render::RenderSettings settings = render_settings(
-        args.render, render::look_from_scene(scene.value()), scene->camera, first->particle_pos);
+    render::RenderSettings settings =
+        render_settings(args.render, render::look_from_scene(scene.value()), scene->camera,
+                        camera_points(*plan.sim, scene.value(), std::move(first.value())));
     const double interval = static_cast<double>(plan.every) * s.dt;
     plan.render = open_render_output(args.render, std::move(settings), args.render_dir, interval,
                                      scene->camera.has_value());

@@ -25,6 +25,7 @@
 #ifdef MOTES_HAVE_VIEWER
 #include "motes/view_pick.h"
 #include "motes/viewer.h"
+#include "render_args.h"
 #endif
 
 namespace motes::cli {
@@ -669,8 +670,8 @@ void view(const ViewArgs& args) {
   std::fflush(stdout);
   const render::Camera camera =
       scene->camera ? render::camera_from_spec(*scene->camera)
-                    : render::fit_camera(first.particle_pos, style.look.up, size.value(), 35.0f,
-                                         style.look.ground_height);
+                    : render::fit_camera(camera_points(*sim, scene.value(), first), style.look.up,
+                                         size.value(), 35.0f, style.look.ground_height);
   run_view(args, *surface, style, camera, sim, std::move(first), script);
   sim.reset();  // zero copy: motes' device is on the viewer's, which goes next
   surface.reset();

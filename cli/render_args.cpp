@@ -48,6 +48,16 @@ void add_render_options(CLI::App* sub, RenderArgs& args) {
   sub->add_flag("--no-shadows", args.no_shadows, "no shadows (a little faster)");
 }
 
+std::vector<shared::vec4> camera_points(const Simulation& sim, const Scene& scene, Snapshot first) {
+  sim.hide_parked(first);
+  for (const FluidSpec& f : scene.fluids) {
+    if (!f.emitter) continue;
+    const Eigen::Vector3f p = f.emitter->position.cast<float>();
+    first.particle_pos.emplace_back(p.x(), p.y(), p.z(), static_cast<float>(0.5 * f.diameter));
+  }
+  return std::move(first.particle_pos);
+}
+
 render::RenderSettings render_settings(const RenderArgs& args, const render::SceneLook& look,
                                        const std::optional<CameraSpec>& camera,
                                        const std::vector<shared::vec4>& first_frame) {

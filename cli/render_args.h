@@ -9,6 +9,7 @@
 #include "motes/render.h"
 #include "motes/render_output.h"
 #include "motes/scene.h"
+#include "motes/simulation.h"
 
 namespace motes::cli {
 
@@ -25,6 +26,10 @@ void add_render_options(CLI::App* sub, RenderArgs& args);
 
 /// Settings from the options, the scene's look and camera (or one fitted to `first_frame`);
 /// exits through fail() on bad values.
+/// The points a fitted camera frames at the start of a run: the particles, less an emitter's
+/// waiting ones (far below its nozzle), and each emitter's nozzle.
+std::vector<shared::vec4> camera_points(const Simulation& sim, const Scene& scene, Snapshot first);
+
 render::RenderSettings render_settings(const RenderArgs& args, const render::SceneLook& look,
                                        const std::optional<CameraSpec>& camera,
                                        const std::vector<shared::vec4>& first_frame);
