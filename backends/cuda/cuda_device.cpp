@@ -316,6 +316,29 @@ Status CudaDevice::write(Buffer b, const void* src, std::size_t bytes) {
   return check(cudaStreamSynchronize(stream_), "cudaMemcpy to the device");
 }
 
+Status CudaDevice::write_at(Buffer b, std::size_t offset, const void* src, std::size_t bytes) {
+  // The host's mirrors of BodyFirst and ParticleBody are whole-buffer copies: the patched buffer
+  // goes through write.
+  if (b == Buffer::BodyFirst || b == Buffer::ParticleBody) {
+    return Device::write_at(b, offset, src, bytes);
+  }
+  const auto i = static_cast<std::size_t>(b);
+  if (!allocated_) return Status::error("cuda: write before allocate");
+  if (offset > bytes_[i] || bytes > bytes_[i] - offset) {
+    return Status::error(fmt::format("cuda: writing {} bytes at {} into {} of {} bytes", bytes,
+                                     offset, buffer_name(b), bytes_[i]));
+  }
+  if (Status s = flush(); !s) return s;
+  if (bytes == 0) return Status::ok();
+  if (Status s = check(cudaMemcpyAsync(static_cast<unsigned char*>(buffers_[i]) + offset, src,
+                                       bytes, cudaMemcpyHostToDevice, stream_),
+                       "cudaMemcpy to the device");
+      !s) {
+    return s;
+  }
+  return check(cudaStreamSynchronize(stream_), "cudaMemcpy to the device");
+}
+
 Status CudaDevice::read(Buffer b, void* dst, std::size_t bytes) {
   const auto i = static_cast<std::size_t>(b);
   if (!allocated_) return Status::error("cuda: read before allocate");

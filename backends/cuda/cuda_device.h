@@ -38,6 +38,7 @@ class CudaDevice final : public Device {
   [[nodiscard]] std::uint64_t available_bytes() const override;
   Status allocate(const Sizes& sizes) override;
   Status write(Buffer b, const void* src, std::size_t bytes) override;
+  Status write_at(Buffer b, std::size_t offset, const void* src, std::size_t bytes) override;
   Status read(Buffer b, void* dst, std::size_t bytes) override;
 
   void enqueue(Kernel k, const shared::StepParams& p) override;

@@ -136,6 +136,24 @@ Status OpenMPDevice::write(Buffer b, const void* src, std::size_t bytes) {
   }
   impulse_acc_flush();
   if (bytes > 0) std::memcpy(buffers_[i].data(), src, bytes);
+  wrote(b);
+  return Status::ok();
+}
+
+Status OpenMPDevice::write_at(Buffer b, std::size_t offset, const void* src, std::size_t bytes) {
+  const auto i = static_cast<std::size_t>(b);
+  if (i >= buffers_.size()) return Status::error("openmp: write before allocate");
+  if (offset > buffers_[i].size() || bytes > buffers_[i].size() - offset) {
+    return Status::error(fmt::format("openmp: writing {} bytes at {} into {} of {} bytes", bytes,
+                                     offset, buffer_name(b), buffers_[i].size()));
+  }
+  impulse_acc_flush();
+  if (bytes > 0) std::memcpy(buffers_[i].data() + offset, src, bytes);
+  wrote(b);
+  return Status::ok();
+}
+
+void OpenMPDevice::wrote(Buffer b) {
   impulse_contacts_ready_ = false;  // what the kept contact frames were made from may have changed
   impulse_points_ready_ = false;    // and the particles' places (poses, offsets)
   if (b == Buffer::NeighbourList || b == Buffer::NeighbourCount) impulse_mirror_.clear();
@@ -143,7 +161,6 @@ Status OpenMPDevice::write(Buffer b, const void* src, std::size_t bytes) {
   if (b == Buffer::ParticlePos || b == Buffer::NeighbourList || b == Buffer::NeighbourCount) {
     forget_impulse_passes();
   }
-  return Status::ok();
 }
 
 Status OpenMPDevice::read(Buffer b, void* dst, std::size_t bytes) {

@@ -52,6 +52,7 @@ class OpenMPDevice final : public Device {
   [[nodiscard]] std::uint64_t available_bytes() const override;
   Status allocate(const Sizes& sizes) override;
   Status write(Buffer b, const void* src, std::size_t bytes) override;
+  Status write_at(Buffer b, std::size_t offset, const void* src, std::size_t bytes) override;
   Status read(Buffer b, void* dst, std::size_t bytes) override;
 
   void enqueue(Kernel k, const shared::StepParams& p) override;
@@ -180,6 +181,9 @@ class OpenMPDevice final : public Device {
   /// Drops what the last counting pass found (after allocate, or a write of positions or lists):
   /// the next sweep without a counting pass visits every particle.
   void forget_impulse_passes();
+  /// What a write of buffer b makes stale: the kept contact frames and points, the impulse
+  /// mirror of the lists, the last counting pass.
+  void wrote(Buffer b);
   bool timing_ = false;
   KernelTimes times_;
 };

@@ -683,6 +683,26 @@ Status VulkanDevice::write(Buffer b, const void* src, std::size_t bytes) {
   });
 }
 
+Status VulkanDevice::write_at(Buffer b, std::size_t offset, const void* src, std::size_t bytes) {
+  // BodyFirst's whole contents choose the impulses_apply shader: the patched buffer goes through
+  // write.
+  if (b == Buffer::BodyFirst) return Device::write_at(b, offset, src, bytes);
+  const auto i = static_cast<std::size_t>(b);
+  if (!allocated_) return Status::error("vulkan: write before allocate");
+  if (offset > buffers_[i].data_bytes || bytes > buffers_[i].data_bytes - offset) {
+    return Status::error(fmt::format("vulkan: writing {} bytes at {} into {} of {} bytes", bytes,
+                                     offset, buffer_name(b), buffers_[i].data_bytes));
+  }
+  if (bytes == 0) return Status::ok();
+  if (Status s = flush(); !s) return s;
+  if (Status s = ensure_staging(bytes); !s) return s;
+  std::memcpy(staging_.mapped, src, bytes);
+  return run_once([&](VkCommandBuffer cb) {
+    const VkBufferCopy region{0, offset, bytes};
+    vkCmdCopyBuffer(cb, staging_.buffer, buffers_[i].buffer, 1, &region);
+  });
+}
+
 Status VulkanDevice::read(Buffer b, void* dst, std::size_t bytes) {
   const auto i = static_cast<std::size_t>(b);
   if (!allocated_) return Status::error("vulkan: read before allocate");

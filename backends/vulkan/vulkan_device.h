@@ -89,6 +89,7 @@ class VulkanDevice final : public Device {
   [[nodiscard]] BufferLimit buffer_limit() const override;
   Status allocate(const Sizes& sizes) override;
   Status write(Buffer b, const void* src, std::size_t bytes) override;
+  Status write_at(Buffer b, std::size_t offset, const void* src, std::size_t bytes) override;
   Status read(Buffer b, void* dst, std::size_t bytes) override;
 
   void enqueue(Kernel k, const shared::StepParams& p) override;

@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <cstring>
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -470,6 +472,14 @@ Status check_device_fits(const Device& device, const Sizes& sizes) {
   return Status::error(fmt::format("{} particles do not fit on {} device {} ({}): {}; {}",
                                    sizes.particles, info.backend, info.index, info.name,
                                    fmt::join(reasons, "; and "), advice));
+}
+
+Status Device::write_at(Buffer b, std::size_t offset, const void* src, std::size_t bytes) {
+  if (bytes == 0) return Status::ok();
+  std::vector<unsigned char> head(offset + bytes);
+  if (Status s = read(b, head.data(), offset); !s) return s;
+  std::memcpy(head.data() + offset, src, bytes);
+  return write(b, head.data(), head.size());
 }
 
 }  // namespace motes

@@ -15,23 +15,17 @@ namespace motes {
 using shared::vec4;
 
 Status Simulation::emit() {
-  bool due = false;
-  for (const EmitterRange& e : emitters_) {
-    due = due || emitter_particles_by(e.emitter, time_) > e.emitted;
-  }
-  if (!due) return Status::ok();
   Device& d = *device_;
-  const std::size_t n = sizes_.particles;
-  std::vector<vec4> pos(n), vel(n);
-  if (Status s = d.read(Buffer::ParticlePos, pos.data(), n * sizeof(vec4)); !s) return s;
-  if (Status s = d.read(Buffer::ParticleVel, vel.data(), n * sizeof(vec4)); !s) return s;
   const Eigen::Vector3d& g = settings_.gravity;
   double kinetic = 0.0, potential = 0.0;
+  bool any = false;
   for (EmitterRange& e : emitters_) {
     const FluidEmitter& f = e.emitter;
     const std::uint64_t by = std::min<std::uint64_t>(emitter_particles_by(f, time_), e.count);
+    if (by <= e.emitted) continue;
     const std::size_t per_layer = f.nozzle.size();
     const double mass = 1.0 / static_cast<double>(e.inverse_mass);
+    std::vector<vec4> pos, vel;
     for (std::uint64_t k = e.emitted; k < by; ++k) {
       // Layer k / per_layer left at start + layer T: where it is now, as a projectile.
       const double tau =
@@ -39,25 +33,34 @@ Status Simulation::emit() {
       const Eigen::Vector3d x = f.position + f.nozzle[k % per_layer] +
                                 f.direction * (f.speed * tau) + 0.5 * g * tau * tau;
       const Eigen::Vector3d v = f.direction * f.speed + g * tau;
-      const std::size_t i = e.first + k;
-      pos[i] = vec4(static_cast<float>(x.x()), static_cast<float>(x.y()), static_cast<float>(x.z()),
-                    pos[i].w);
-      vel[i] = vec4(static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z()),
-                    e.inverse_mass);
-      const Eigen::Vector3d xf(pos[i].x, pos[i].y, pos[i].z);
-      const Eigen::Vector3d vf(vel[i].x, vel[i].y, vel[i].z);
+      pos.emplace_back(static_cast<float>(x.x()), static_cast<float>(x.y()),
+                       static_cast<float>(x.z()), e.radius);
+      vel.emplace_back(static_cast<float>(v.x()), static_cast<float>(v.y()),
+                       static_cast<float>(v.z()), e.inverse_mass);
+      const Eigen::Vector3d xf(pos.back().x, pos.back().y, pos.back().z);
+      const Eigen::Vector3d vf(vel.back().x, vel.back().y, vel.back().z);
       kinetic += 0.5 * mass * vf.squaredNorm();
       potential -= mass * g.dot(xf - energy_origin_);
     }
-    e.emitted = std::max(e.emitted, by);
+    // Only the new particles' range of the two buffers (32 bytes a particle).
+    const std::size_t at = (std::size_t{e.first} + e.emitted) * sizeof(vec4);
+    if (Status s = d.write_at(Buffer::ParticlePos, at, pos.data(), pos.size() * sizeof(vec4)); !s) {
+      return s;
+    }
+    if (Status s = d.write_at(Buffer::ParticleVel, at, vel.data(), vel.size() * sizeof(vec4)); !s) {
+      return s;
+    }
+    e.emitted = by;
+    any = true;
   }
-  if (Status s = d.write(Buffer::ParticlePos, pos.data(), n * sizeof(vec4)); !s) return s;
-  if (Status s = d.write(Buffer::ParticleVel, vel.data(), n * sizeof(vec4)); !s) return s;
+  if (!any) return Status::ok();
   // The lists know nothing of the new particles: rebuild them at the next update.
-  std::uint32_t words[4] = {};
-  if (Status s = d.read(Buffer::NeighbourState, words, sizeof words); !s) return s;
-  words[MOTES_NEIGHBOUR_REBUILD] = 1u;
-  if (Status s = d.write(Buffer::NeighbourState, words, sizeof words); !s) return s;
+  const std::uint32_t rebuild = 1u;
+  if (Status s = d.write_at(Buffer::NeighbourState, MOTES_NEIGHBOUR_REBUILD * sizeof rebuild,
+                            &rebuild, sizeof rebuild);
+      !s) {
+    return s;
+  }
   // Energy from outside the scene: the guard's reference takes it, and its margin grows as it
   // would have had the particles been there from the start.
   if (energy_started_) {

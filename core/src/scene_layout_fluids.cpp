@@ -36,6 +36,7 @@ Status build_fluids(const Scene& scene, const SceneCounts& counts, HostLayout& o
       e.first = at;
       e.count = static_cast<std::uint32_t>(f.points.size());
       e.inverse_mass = static_cast<float>(1.0 / mass);
+      e.radius = static_cast<float>(0.5 * f.diameter);
       e.emitter = *f.emitter;
       out.emitters.push_back(std::move(e));
     }

@@ -75,6 +75,7 @@ struct EmitterRange {
   std::uint32_t first = 0;
   std::uint32_t count = 0;
   float inverse_mass = 0.0f;
+  float radius = 0.0f;  ///< their radius (ParticlePos w)
   FluidEmitter emitter;
   std::uint64_t emitted = 0;  ///< particles that have left, a prefix of the range
 };

@@ -346,8 +346,9 @@ class Simulation {
   /// `rebuild`, asks for a neighbour-list rebuild and clears the impulse contacts' history.
   Status restore(const Snapshot& state, bool rebuild = true);
   /// The emitters' particles due by the start of the step at time_ leave their nozzles: their
-  /// places and velocities written on the device (one read and one write of ParticlePos and
-  /// ParticleVel), a list rebuild asked for, their energy added to the energy guard's reference.
+  /// places and velocities written on the device (Device::write_at: their range of ParticlePos
+  /// and ParticleVel), a list rebuild asked for, their energy added to the energy guard's
+  /// reference.
   Status emit();
   /// Each emitter's particles that have left (inverse mass > 0 on the device), after a state
   /// was written from outside.

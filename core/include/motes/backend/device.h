@@ -286,6 +286,10 @@ class Device {
   virtual Status allocate(const Sizes& sizes) = 0;
   /// Copies host memory into the start of a buffer; bytes <= buffer_layout(b).bytes().
   virtual Status write(Buffer b, const void* src, std::size_t bytes) = 0;
+  /// Copies host memory into bytes [offset, offset + bytes) of a buffer, leaving the rest as it
+  /// is (an emitter's new particles, docs/fluids.md "Emitters"). The default reads the buffer up to
+  /// there, patches it and writes it back; the backends copy only the range.
+  virtual Status write_at(Buffer b, std::size_t offset, const void* src, std::size_t bytes);
   /// Copies the start of a buffer to host memory (waits for queued kernels).
   virtual Status read(Buffer b, void* dst, std::size_t bytes) = 0;
 
