@@ -142,7 +142,14 @@ FluidEmitter read_emitter(const Node& fluid, double d, const ShapeCache& cache) 
   if (!(n.norm() > 0.0)) direction.fail("must not be zero (the way the stream leaves the nozzle)");
   e.direction = n.normalized();
   e.speed = fluid.at("speed").number(Sign::Positive);
-  e.rate = fluid.at("rate").number(Sign::Positive);
+  const Node rate = fluid.at("rate");
+  e.rate = rate.number(Sign::Positive);
+  if (e.rate * d / e.speed > static_cast<double>(kEmitterNozzleLimit)) {
+    rate.fail(fmt::format(
+        "{} particles a second at {} m/s is a nozzle of {:.4g} particles, more than {} (lower the "
+        "rate or raise the speed)",
+        e.rate, e.speed, e.rate * d / e.speed, kEmitterNozzleLimit));
+  }
   const Node limit = fluid.at("max_particles");
   e.max_particles = static_cast<std::uint64_t>(limit.integer(1, std::int64_t{1} << 40));
   if (static_cast<std::int64_t>(e.max_particles) > cache.max_particles) {
@@ -240,21 +247,28 @@ std::vector<Eigen::Vector3d> emitter_nozzle(const Eigen::Vector3d& direction, do
       std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
   const Eigen::Vector3d u = (a - a.dot(n) * n).normalized();
   const Eigen::Vector3d w = n.cross(u);
-  const double want = rate * d / speed;  // particles a layer for a layer per d of travel
-  // Discs of squared radius q (in spacings): grow q while the count gets closer to `want`.
-  const auto count = [](std::int64_t q) {
+  // Particles a layer for a layer per d of travel, at most kEmitterNozzleLimit (read_emitter
+  // refuses more).
+  const double want = std::min(rate * d / speed, static_cast<double>(kEmitterNozzleLimit));
+  // Discs of squared radius q (in spacings): grow q while the count gets closer to `want`; the
+  // count grows by the lattice points on each circle i^2 + j^2 = q.
+  const auto on_circle = [](std::int64_t q) {
     std::int64_t c = 0;
-    const auto r = static_cast<std::int64_t>(std::sqrt(static_cast<double>(q)));
-    for (std::int64_t j = -r - 1; j <= r + 1; ++j) {
-      for (std::int64_t i = -r - 1; i <= r + 1; ++i) c += i * i + j * j <= q ? 1 : 0;
+    for (std::int64_t i = 0; i * i <= q; ++i) {
+      const auto j =
+          static_cast<std::int64_t>(std::llround(std::sqrt(static_cast<double>(q - i * i))));
+      if (j * j != q - i * i) continue;
+      c += (i == 0 ? 1 : 2) * (j == 0 ? 1 : 2);
     }
     return c;
   };
-  std::int64_t best = 0;
-  for (std::int64_t q = 1; q < (1 << 20) && static_cast<double>(count(q - 1)) < want; ++q) {
-    if (std::abs(static_cast<double>(count(q)) - want) <
-        std::abs(static_cast<double>(count(best)) - want)) {
+  std::int64_t best = 0, count = 1, best_count = 1;
+  for (std::int64_t q = 1; static_cast<double>(count) < want; ++q) {
+    count += on_circle(q);
+    if (std::abs(static_cast<double>(count) - want) <
+        std::abs(static_cast<double>(best_count) - want)) {
       best = q;
+      best_count = count;
     }
   }
   std::vector<Eigen::Vector3d> points;

@@ -38,6 +38,9 @@ TEST(FluidEmitter, NozzleHoldsTheLayerTheRateAndSpeedAsk) {
   EXPECT_EQ(emitter_nozzle(down, 50.0, 0.5, 0.01).size(), 1u);
   EXPECT_EQ(emitter_nozzle(down, 250.0, 0.5, 0.01).size(), 5u);
   EXPECT_EQ(emitter_nozzle(down, 450.0, 0.5, 0.01).size(), 9u);
+  // The largest nozzle: about kEmitterNozzleLimit points, found quickly.
+  const std::size_t largest = emitter_nozzle(down, 5e6, 0.5, 0.01).size();
+  EXPECT_NEAR(static_cast<double>(largest), 1e5, 100.0);
   // Across the direction, d apart, centred on the nozzle.
   const Eigen::Vector3d slant = Eigen::Vector3d(1.0, -1.0, 0.5).normalized();
   const std::vector<Eigen::Vector3d> disc = emitter_nozzle(slant, 1000.0, 0.5, 0.01);
@@ -92,6 +95,9 @@ TEST(FluidEmitter, SceneFormatAndItsErrors) {
       {R"({"type": "emitter", "position": [0, 0, 0], "direction": [0, 1, 0], "speed": 1,
            "rate": 10, "max_particles": 5, "start": 2, "stop": 1})",
        "/bodies/0/fluid/stop: must be later than start"},
+      {R"({"type": "emitter", "position": [0, 0, 0], "direction": [0, 1, 0], "speed": 1e-30,
+           "rate": 1e30, "max_particles": 5})",
+       "/bodies/0/fluid/rate: 1e+30 particles a second at 1e-30 m/s is a nozzle of"},
       {R"({"type": "emitter", "position": [0, 0, 0], "direction": [0, 1, 0], "speed": 1,
            "rate": 10, "max_particles": 5, "min": [0, 0, 0]})",
        "/bodies/0/fluid/min: unknown key \"min\""},

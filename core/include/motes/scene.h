@@ -197,6 +197,8 @@ struct FluidEmitter {
 /// that the stream is spaced d along it), at least one.
 std::vector<Eigen::Vector3d> emitter_nozzle(const Eigen::Vector3d& direction, double rate,
                                             double speed, double d);
+/// The most particles a nozzle holds (a disc about 3.6 m across at 1 cm).
+constexpr std::int64_t kEmitterNozzleLimit = 100000;
 
 /// A volume of liquid (issue 29, docs/fluids.md): equal particles on a cubic lattice of the rest
 /// spacing (fluid_rest_spacing: 1.003 x `diameter`), each of mass rest_density x diameter^3,
