@@ -139,8 +139,9 @@ FluidEmitter read_emitter(const Node& fluid, double d, const ShapeCache& cache) 
   e.position = fluid.at("position").vec3();
   const Node direction = fluid.at("direction");
   const Eigen::Vector3d n = direction.vec3();
-  if (!(n.norm() > 0.0)) direction.fail("must not be zero (the way the stream leaves the nozzle)");
-  e.direction = n.normalized();
+  const double largest = n.cwiseAbs().maxCoeff();
+  if (!(largest > 0.0)) direction.fail("must not be zero (the way the stream leaves the nozzle)");
+  e.direction = (n / largest).normalized();  // scaled first: no overflow of the norm near 3e38
   e.speed = fluid.at("speed").number(Sign::Positive);
   const Node rate = fluid.at("rate");
   e.rate = rate.number(Sign::Positive);

@@ -76,6 +76,11 @@ TEST(FluidEmitter, SceneFormatAndItsErrors) {
   ASSERT_TRUE(f.emitter.has_value());
   EXPECT_EQ(f.points.size(), 250u);  // the limit's particles, parked
   EXPECT_TRUE(f.emitter->direction.isApprox(Eigen::Vector3d(0, -1, 0)));
+  std::string huge = kTap;
+  huge.replace(huge.find("[0, -2, 0]"), 10, "[3e38, -3e38, 0]");
+  Result<Scene> far = load_scene_text(emitter_scene(huge), "s.json", ".");
+  ASSERT_TRUE(far) << far.message();
+  EXPECT_TRUE(far->fluids[0].emitter->direction.isApprox(Eigen::Vector3d(1, -1, 0).normalized()));
   EXPECT_EQ(f.emitter->nozzle.size(), 21u);
   EXPECT_DOUBLE_EQ(f.emitter->layer_period, 0.021);
   for (const Eigen::Vector3d& p : f.points) EXPECT_LT(p.y(), 0.2 - kEmitterParkDepth + 1e-9);
