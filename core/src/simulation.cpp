@@ -564,13 +564,22 @@ Result<Snapshot> Simulation::snapshot() {
     if (info.linked || info.soft || info.fluid) {  // the mean of its particles, in double
       Eigen::Vector3d x = Eigen::Vector3d::Zero();
       Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      double count = 0.0;
       for (std::uint32_t k = 0; k < info.particle_count; ++k) {
         const vec4 p = ppos[first + k];
         const vec4 u = pvel[first + k];
+        // An emitter's waiting particles (inverse mass 0, 1 km below) are not in the liquid yet.
+        if (info.fluid && !(u.w > 0.0f)) continue;
         x += Eigen::Vector3f(p.x, p.y, p.z).cast<double>();
         v += Eigen::Vector3f(u.x, u.y, u.z).cast<double>();
+        count += 1.0;
       }
-      const double count = static_cast<double>(info.particle_count);
+      if (count == 0.0) {  // an emitter before its first layer: at its nozzle, at rest
+        for (const EmitterRange& e : emitters_) {
+          if (e.entry == b) x = e.emitter.position;
+        }
+        count = 1.0;
+      }
       s.body_pos[b] = to_vec4(x / count, 1.0 / info.mass);
       s.body_vel[b] = to_vec4(v / count, 0.0);
       s.body_angmom[b] = vec4(0.0f);

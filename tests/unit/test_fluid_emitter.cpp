@@ -166,6 +166,10 @@ TEST(FluidEmitter, PoursAtItsRateFromItsNozzleUntilItsLimit) {
       }
     }
     EXPECT_EQ(moving, want);
+    // The liquid's body state is the mean of the particles that have left (at the nozzle before).
+    const double mean_y = static_cast<double>(s->body_pos[0].y);
+    EXPECT_GT(mean_y, 0.0);
+    EXPECT_LE(mean_y, 0.2 + 1e-6);
     // The ones still parked are hidden from pictures.
     Snapshot shown = s.value();
     sim->hide_parked(shown);
