@@ -17,6 +17,7 @@ install(TARGETS motes_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(FILES
         core/include/motes/api.h core/include/motes/checkpoint.h core/include/motes/cloth.h
         core/include/motes/decomposition.h core/include/motes/devices.h core/include/motes/energy.h
+        core/include/motes/fluid.h
         core/include/motes/output.h
         core/include/motes/scene.h core/include/motes/shapes.h core/include/motes/simulation.h
         core/include/motes/status.h core/include/motes/workloads.h
