@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstring>
 #include <limits>
+#include <optional>
 
 #include "motes/checkpoint.h"
 #include "scene_layout.h"
@@ -104,24 +105,25 @@ Status allocate_halo(Device& d, std::size_t count, HostMemory<vec4>& memory) {
 /// particles and the emitters' nozzles, leaving out the emitters' parked particles.
 vec4 lowest_point(const Eigen::Vector3d& gravity, const std::vector<vec4>& pos,
                   const std::vector<EmitterRange>& emitters) {
-  std::vector<bool> parked(pos.size(), false);
-  std::vector<vec4> candidates;
-  for (const EmitterRange& e : emitters) {
-    for (std::uint32_t k = 0; k < e.count; ++k) parked[e.first + k] = true;
-    candidates.push_back(to_vec4(e.emitter.position, 0.0));
-  }
-  for (std::size_t i = 0; i < pos.size(); ++i) {
-    if (!parked[i]) candidates.push_back(pos[i]);
-  }
   const auto g_dot = [&](const vec4& x) {
     return gravity.dot(Eigen::Vector3f(x.x, x.y, x.z).cast<double>());
   };
-  if (candidates.empty()) return vec4(0.0f);
-  std::size_t lowest = 0;
-  for (std::size_t i = 1; i < candidates.size(); ++i) {
-    if (g_dot(candidates[i]) > g_dot(candidates[lowest])) lowest = i;
+  // The candidates in order, without a copy: the nozzles, then the particles not parked (the
+  // emitters' ranges are disjoint, so a particle is parked when it lies in one of them).
+  const auto parked = [&](std::size_t i) {
+    return std::any_of(emitters.begin(), emitters.end(), [i](const EmitterRange& e) {
+      return i >= e.first && i - e.first < e.count;
+    });
+  };
+  std::optional<vec4> lowest;
+  const auto consider = [&](const vec4& x) {
+    if (!lowest || g_dot(x) > g_dot(*lowest)) lowest = x;
+  };
+  for (const EmitterRange& e : emitters) consider(to_vec4(e.emitter.position, 0.0));
+  for (std::size_t i = 0; i < pos.size(); ++i) {
+    if (emitters.empty() || !parked(i)) consider(pos[i]);
   }
-  return candidates[lowest];
+  return lowest.value_or(vec4(0.0f));
 }
 
 }  // namespace

@@ -39,12 +39,8 @@ inline std::uint32_t seeds_to_run(std::uint32_t all, std::uint32_t sanitized = 1
 /// `sanitized`, where it checks nothing but the paths (the physics is checked in the first stage,
 /// as seeds_to_run's); `physics_checked()` says which.
 inline int frames_to_run(int all, int sanitized) {
-#ifdef MOTES_PHYSICS_SANITIZED
-  return sanitized < all ? sanitized : all;
-#else
-  (void)sanitized;
-  return all;
-#endif
+  return static_cast<int>(
+      seeds_to_run(static_cast<std::uint32_t>(all), static_cast<std::uint32_t>(sanitized)));
 }
 inline bool physics_checked() {
 #ifdef MOTES_PHYSICS_SANITIZED

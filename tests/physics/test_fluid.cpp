@@ -75,6 +75,15 @@ motes::FluidSpec fluid_block(int nx, int ny, int nz, const Eigen::Vector3d& corn
   return f;
 }
 
+/// A tank of planes: the floor y = 0 and walls at x = 0, x = length, z = 0 and z = depth.
+void add_tank(motes::Scene& scene, double length, double depth) {
+  scene.planes.push_back(motes_test::plane({0, 1, 0}, {0, 0, 0}));
+  scene.planes.push_back(motes_test::plane({1, 0, 0}, {0, 0, 0}));
+  scene.planes.push_back(motes_test::plane({-1, 0, 0}, {length, 0, 0}));
+  scene.planes.push_back(motes_test::plane({0, 0, 1}, {0, 0, 0}));
+  scene.planes.push_back(motes_test::plane({0, 0, -1}, {0, 0, depth}));
+}
+
 TEST(Fluid, TankAtRestHoldsItsDensityAndItsPressureGrowsWithDepth) {
   constexpr int kSide = 12;
   constexpr int kLayers = 14;
@@ -82,11 +91,7 @@ TEST(Fluid, TankAtRestHoldsItsDensityAndItsPressureGrowsWithDepth) {
   motes::Scene scene = fluid_scene(Eigen::Vector3d(0.0, -9.81, 0.0));
   scene.fluids.push_back(
       fluid_block(kSide, kLayers, kSide, Eigen::Vector3d::Constant(0.5 * kFluidD)));
-  scene.planes.push_back(motes_test::plane({0, 1, 0}, {0, 0, 0}));
-  scene.planes.push_back(motes_test::plane({1, 0, 0}, {0, 0, 0}));
-  scene.planes.push_back(motes_test::plane({-1, 0, 0}, {width, 0, 0}));
-  scene.planes.push_back(motes_test::plane({0, 0, 1}, {0, 0, 0}));
-  scene.planes.push_back(motes_test::plane({0, 0, -1}, {0, 0, width}));
+  add_tank(scene, width, width);
   auto sim_r = motes_test::simulate(scene, 2);
   ASSERT_TRUE(sim_r) << sim_r.status().message();
   motes::Simulation& sim = *sim_r.value();
@@ -208,11 +213,7 @@ TEST(Fluid, DamBreakFrontFollowsMartinAndMoyce) {
   motes::Scene scene = fluid_scene(Eigen::Vector3d(0.0, -9.81, 0.0));
   scene.fluids.push_back(
       fluid_block(kWide, 2 * kWide, 8, Eigen::Vector3d::Constant(0.5 * kFluidD)));
-  scene.planes.push_back(motes_test::plane({0, 1, 0}, {0, 0, 0}));
-  scene.planes.push_back(motes_test::plane({1, 0, 0}, {0, 0, 0}));
-  scene.planes.push_back(motes_test::plane({-1, 0, 0}, {length, 0, 0}));
-  scene.planes.push_back(motes_test::plane({0, 0, 1}, {0, 0, 0}));
-  scene.planes.push_back(motes_test::plane({0, 0, -1}, {0, 0, depth}));
+  add_tank(scene, length, depth);
   motes::Scene held = scene;
   held.planes.push_back(motes_test::plane({-1, 0, 0}, {a, 0, 0}));  // the dam
   auto rest_r = motes_test::simulate(held, 2);
@@ -301,11 +302,7 @@ TEST(Fluid, CubesFloatWithTheirDensityRatioUnderWater) {
     }
   }
   scene.fluids.push_back(water);
-  scene.planes.push_back(motes_test::plane({0, 1, 0}, {0, 0, 0}));
-  scene.planes.push_back(motes_test::plane({1, 0, 0}, {0, 0, 0}));
-  scene.planes.push_back(motes_test::plane({-1, 0, 0}, {kLength, 0, 0}));
-  scene.planes.push_back(motes_test::plane({0, 0, 1}, {0, 0, 0}));
-  scene.planes.push_back(motes_test::plane({0, 0, -1}, {0, 0, kDepth}));
+  add_tank(scene, kLength, kDepth);
   auto sim_r = motes_test::simulate(scene, 2);
   ASSERT_TRUE(sim_r) << sim_r.status().message();
   motes::Simulation& sim = *sim_r.value();
