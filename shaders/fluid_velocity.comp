@@ -1,10 +1,12 @@
 #version 450
-// fluid_velocity: one thread per fluid particle; its change of velocity at the velocity level, a
-// gather over its neighbours in list order (over capacity: the 27 cells of the last build, whose
-// extra particles add zeros): XSPH viscosity, vorticity confinement and cohesion over its fluid
-// neighbours within h, adhesion over its solid ones; from the velocities fluid_vorticity copied
-// to FluidVelOld, into ParticleVel (w kept; shared/fluid.h). Each thread reads and writes only its
-// own ParticleVel entry. As backends/openmp/fluid_velocity.cpp.
+// fluid_velocity: one thread per fluid particle (with MOTES_FLAG_FLUID_ADHESION per particle); a
+// fluid particle's change of velocity at the velocity level, a gather over its neighbours in list
+// order (over capacity: the 27 cells of the last build, whose extra particles add zeros): XSPH
+// viscosity, vorticity confinement and cohesion over its fluid neighbours within h, adhesion over
+// its solid ones; from the velocities fluid_vorticity copied to FluidVelOld, into ParticleVel (w
+// kept; shared/fluid.h). With the flag a solid particle that can move takes the reaction to its
+// fluid neighbours' adhesion (a rigid one's in ParticleForce, a free one's into its ParticleVel).
+// Each thread writes only its own entries. As backends/openmp/fluid_velocity.cpp.
 #extension GL_GOOGLE_include_directive : require
 #include "kernel_common.glsl"
 #include "shared/fluid.h"
@@ -43,10 +45,50 @@ void add_neighbour(uint j, vec3 xi, vec3 vi, float wi, vec3 ni, float rhoi, Flui
                                     f.velocity.z, h, hs);
 }
 
+// Fluid particle j's part of solid particle b's adhesion reaction (0 for any other j).
+vec3 reaction_term(uint j, vec3 xb, float rb) {
+  if (!fluid_particle(j, p.fluid_first, p.fluid_count)) return vec3(0.0f);
+  return fluid_adhesion_reaction(xyz(particle_pos[j]), xb, rb,
+                                 fluid_materials[particle_material[j]], p.gravity_dt.w);
+}
+
+// A solid particle's adhesion reaction (a momentum), over the same walk as a fluid particle's.
+vec3 adhesion_reaction(uint b) {
+  vec3 xb = xyz(particle_pos[b]);
+  float rb = particle_pos[b].w;
+  vec3 sum = vec3(0.0f);
+  uint c = neighbour_count[b];
+  if (c <= p.neighbour_capacity) {
+    for (uint s = 0u; s < c; ++s) sum += reaction_term(neighbour_list[s * p.particle_count + b], xb, rb);
+    return sum;
+  }
+  uint body_b = particle_body[b];
+  uint lo[27];
+  uint hi[27];
+  int ranges = grid_walk(neighbour_ref_pos[b], lo, hi);
+  for (int r = 0; r < ranges; ++r) {
+    for (uint t = lo[r]; t < hi[r]; ++t) {
+      uint j = grid_order[t];
+      if (!contact_skipped(body_b, sorted_body[t], b, j)) sum += reaction_term(j, xb, rb);
+    }
+  }
+  return sum;
+}
+
 void main() {
+  bool solids = (p.flags & MOTES_FLAG_FLUID_ADHESION) != 0u;
   uint k = thread_index();
-  if (k >= p.fluid_count) return;
-  uint i = p.fluid_first + k;
+  if (k >= (solids ? p.particle_count : p.fluid_count)) return;
+  uint i = (solids ? 0u : p.fluid_first) + k;
+  if (!fluid_particle(i, p.fluid_first, p.fluid_count)) {
+    vec4 vb = particle_vel[i];
+    vec3 reaction = vb.w != 0.0f ? adhesion_reaction(i) : vec3(0.0f);
+    bool rigid = i < p.rigid_particle_count;
+    if (rigid) particle_force[i] = vec4(reaction, 0.0f);
+    particle_vel[i] = fluid_adhesion_taken(vb, reaction, rigid);
+    return;
+  }
+  k = i - p.fluid_first;
   vec3 xi = xyz(particle_pos[i]);
   FluidMaterial f = fluid_materials[particle_material[i]];
   vec3 vi = xyz(fluid_vel_old[k]);

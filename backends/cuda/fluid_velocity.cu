@@ -1,9 +1,11 @@
-// fluid_velocity: one thread per fluid particle; its change of velocity at the velocity level, a
-// gather over its neighbours in list order (over capacity: the 27 cells of the last build, whose
-// extra particles add zeros): XSPH viscosity, vorticity confinement and cohesion over its fluid
-// neighbours within h, adhesion over its solid ones; from the velocities fluid_vorticity copied
-// to FluidVelOld, into ParticleVel (w kept; shared/fluid.h). Each thread reads and writes only its
-// own ParticleVel entry. As backends/openmp/fluid_velocity.cpp.
+// fluid_velocity: one thread per fluid particle (with MOTES_FLAG_FLUID_ADHESION per particle); a
+// fluid particle's change of velocity at the velocity level, a gather over its neighbours in list
+// order (over capacity: the 27 cells of the last build, whose extra particles add zeros): XSPH
+// viscosity, vorticity confinement and cohesion over its fluid neighbours within h, adhesion over
+// its solid ones; from the velocities fluid_vorticity copied to FluidVelOld, into ParticleVel (w
+// kept; shared/fluid.h). With the flag a solid particle that can move takes the reaction to its
+// fluid neighbours' adhesion (a rigid one's in ParticleForce, a free one's into its ParticleVel).
+// Each thread writes only its own entries. As backends/openmp/fluid_velocity.cpp.
 #include "cuda_device.h"
 #include "shared/fluid.h"
 #include "shared/grid_walk.h"
@@ -35,20 +37,60 @@ struct FluidVelocityInputs {
   const vec4* __restrict__ normal;
 };
 
+// Calls add(j) for every neighbour j of particle i, in list order (over capacity: the 27 cells).
+template <typename F>
+__device__ void each_neighbour(const shared::StepParams& p, const FluidVelocityInputs& in, uint i,
+                               const F& add) {
+  const uint c = in.count[i];
+  if (c <= p.neighbour_capacity) {
+    const std::size_t stride = p.particle_count;
+    for (uint s = 0; s < c; ++s) add(in.list[std::size_t{s} * stride + i]);
+    return;
+  }
+  const uint body_i = in.body[i];
+  shared::grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
+    for (uint t = lo; t < hi; ++t) {
+      const uint j = in.order[t];
+      if (!shared::contact_skipped(body_i, in.sbody[t], i, j, in.exclusions, p.particle_count,
+                                   p.linked_first)) {
+        add(j);
+      }
+    }
+  });
+}
+
 __global__ void fluid_velocity_kernel(shared::StepParams p, FluidVelocityInputs in,
-                                      vec4* __restrict__ vel) {
+                                      vec4* __restrict__ vel, vec4* __restrict__ force) {
+  const bool solids = (p.flags & MOTES_FLAG_FLUID_ADHESION) != 0u;
   const std::uint64_t k = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
-  if (k >= p.fluid_count) return;
-  const uint i = p.fluid_first + uint(k);
+  if (k >= (solids ? p.particle_count : p.fluid_count)) return;
+  const uint i = (solids ? 0u : p.fluid_first) + uint(k);
+  if (!shared::fluid_particle(i, p.fluid_first, p.fluid_count)) {
+    const vec4 pb = in.pos[i];
+    const vec4 vb = vel[i];
+    vec3 reaction(0.0f);
+    if (vb.w != 0.0f) {
+      each_neighbour(p, in, i, [&](uint j) {
+        if (!shared::fluid_particle(j, p.fluid_first, p.fluid_count)) return;
+        reaction += shared::fluid_adhesion_reaction(shared::xyz(in.pos[j]), shared::xyz(pb), pb.w,
+                                                    in.fluids[in.material[j]], p.gravity_dt.w);
+      });
+    }
+    const bool rigid = i < p.rigid_particle_count;
+    if (rigid) force[i] = vec4(reaction, 0.0f);
+    vel[i] = shared::fluid_adhesion_taken(vb, reaction, rigid);
+    return;
+  }
+  const uint at = i - p.fluid_first;
   const vec3 xi = shared::xyz(in.pos[i]);
   const shared::FluidMaterial f = in.fluids[in.material[i]];
   const float rho0 = f.density_h.x;
   const float h = f.density_h.y;
   const float hs = p.gravity_dt.w;
-  const vec3 vi = shared::xyz(in.vel_old[k]);
-  const vec4 omega_i = in.aux[k];
-  const vec3 ni = shared::xyz(in.normal[k]);
-  const float rhoi = in.state[k].x;
+  const vec3 vi = shared::xyz(in.vel_old[at]);
+  const vec4 omega_i = in.aux[at];
+  const vec3 ni = shared::xyz(in.normal[at]);
+  const float rhoi = in.state[at].x;
   vec3 xsph(0.0f);
   vec3 eta(0.0f);
   vec3 cohesion(0.0f);
@@ -71,22 +113,7 @@ __global__ void fluid_velocity_kernel(shared::StepParams p, FluidVelocityInputs 
     cohesion += shared::fluid_cohesion_term(rij, mj, rhoi, rhoj, ni, shared::xyz(in.normal[jk]),
                                             rho0, f.velocity.z, h, hs);
   };
-  const uint c = in.count[i];
-  if (c <= p.neighbour_capacity) {
-    const std::size_t stride = p.particle_count;
-    for (uint s = 0; s < c; ++s) add(in.list[std::size_t{s} * stride + i]);
-  } else {
-    const uint body_i = in.body[i];
-    shared::grid_walk(p, in.ref[i], in.cell_start, [&](uint lo, uint hi) {
-      for (uint t = lo; t < hi; ++t) {
-        const uint j = in.order[t];
-        if (!shared::contact_skipped(body_i, in.sbody[t], i, j, in.exclusions, p.particle_count,
-                                     p.linked_first)) {
-          add(j);
-        }
-      }
-    });
-  }
+  each_neighbour(p, in, i, add);
   vec3 dv =
       xsph * f.velocity.x + shared::fluid_confinement(eta, shared::xyz(omega_i), f.velocity.y, hs);
   dv += cohesion;
@@ -97,7 +124,9 @@ __global__ void fluid_velocity_kernel(shared::StepParams p, FluidVelocityInputs 
 }  // namespace
 
 void CudaDevice::launch_fluid_velocity(const shared::StepParams& p) {
-  if (p.fluid_count == 0) return;
+  const bool solids = (p.flags & MOTES_FLAG_FLUID_ADHESION) != 0u;
+  const uint n = solids ? p.particle_count : p.fluid_count;
+  if (n == 0) return;
   const FluidVelocityInputs in{buf<vec4>(Buffer::ParticlePos),
                                buf<uint>(Buffer::ParticleBody),
                                buf<uint>(Buffer::ParticleMaterial),
@@ -113,8 +142,8 @@ void CudaDevice::launch_fluid_velocity(const shared::StepParams& p) {
                                buf<vec4>(Buffer::FluidVelOld),
                                buf<vec4>(Buffer::FluidAux),
                                buf<vec4>(Buffer::FluidNormal)};
-  fluid_velocity_kernel<<<blocks_for(p.fluid_count), kBlock, 0, stream_>>>(
-      p, in, buf<vec4>(Buffer::ParticleVel));
+  fluid_velocity_kernel<<<blocks_for(n), kBlock, 0, stream_>>>(
+      p, in, buf<vec4>(Buffer::ParticleVel), buf<vec4>(Buffer::ParticleForce));
 }
 
 }  // namespace motes::cuda

@@ -2,7 +2,10 @@
 // its neighbours in list order (over capacity: the 27 cells of the last build, whose extra
 // particles add zeros): XSPH viscosity, vorticity confinement and cohesion over its fluid
 // neighbours within h, adhesion over its solid ones; from the velocities fluid_vorticity copied to
-// FluidVelOld, into ParticleVel (w kept; shared/fluid.h).
+// FluidVelOld, into ParticleVel (w kept; shared/fluid.h). With MOTES_FLAG_FLUID_ADHESION every
+// solid particle that can move takes the reaction to its fluid neighbours' adhesion over the same
+// walk (fluid_adhesion_reaction): a rigid particle's in ParticleForce for its body, a free one's
+// into its ParticleVel (fluid_adhesion_taken).
 #include <chrono>
 #include <cstdint>
 
@@ -20,7 +23,8 @@ using shared::vec4;
 
 void OpenMPDevice::fluid_velocity(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
-  const auto n = static_cast<std::int64_t>(p.fluid_count);
+  const bool solids = (p.flags & MOTES_FLAG_FLUID_ADHESION) != 0u;
+  const auto n = static_cast<std::int64_t>(solids ? p.particle_count : p.fluid_count);
   const vec4* pos = buf<vec4>(Buffer::ParticlePos);
   const uint* body = buf<uint>(Buffer::ParticleBody);
   const uint* material = buf<uint>(Buffer::ParticleMaterial);
@@ -37,12 +41,29 @@ void OpenMPDevice::fluid_velocity(const shared::StepParams& p) {
   const vec4* aux = buf<vec4>(Buffer::FluidAux);
   const vec4* normal = buf<vec4>(Buffer::FluidNormal);
   vec4* vel = buf<vec4>(Buffer::ParticleVel);
+  vec4* force = buf<vec4>(Buffer::ParticleForce);
   const float hs = p.gravity_dt.w;
 
   const NeighbourWalk walk{list, count, ref, order, cell_start, sbody, body, exclusions};
-  for_items(n, parallel_heavy(n), [&](std::int64_t k) {
-    const auto i = static_cast<std::size_t>(p.fluid_first + static_cast<uint>(k));
-    const std::size_t at = static_cast<std::size_t>(k);
+  for_items(n, parallel_heavy(n), [&](std::int64_t item) {
+    const auto i =
+        static_cast<std::size_t>(solids ? 0u : p.fluid_first) + static_cast<std::size_t>(item);
+    if (!shared::fluid_particle(uint(i), p.fluid_first, p.fluid_count)) {
+      const vec4 pb = pos[i];
+      vec3 reaction(0.0f);
+      if (vel[i].w != 0.0f) {
+        for_each_neighbour(p, walk, i, [&](uint j) {
+          if (!shared::fluid_particle(j, p.fluid_first, p.fluid_count)) return;
+          reaction += shared::fluid_adhesion_reaction(shared::xyz(pos[j]), shared::xyz(pb), pb.w,
+                                                      fluids[material[j]], hs);
+        });
+      }
+      const bool rigid = i < p.rigid_particle_count;
+      if (rigid) force[i] = vec4(reaction, 0.0f);
+      vel[i] = shared::fluid_adhesion_taken(vel[i], reaction, rigid);
+      return;
+    }
+    const std::size_t at = i - p.fluid_first;
     const vec3 xi = shared::xyz(pos[i]);
     const shared::FluidMaterial f = fluids[material[i]];
     const float rho0 = f.density_h.x;

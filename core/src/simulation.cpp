@@ -233,6 +233,9 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
   position_bodies_ = std::any_of(bodies_.begin(), bodies_.end(), [](const BodyInfo& b) {
     return b.kind == BodyKind::Dynamic && b.has_body_state();
   });
+  fluid_adhesion_ =
+      std::any_of(host.fluid_materials.begin(), host.fluid_materials.end(),
+                  [](const shared::FluidMaterial& f) { return f.velocity.w != 0.0f; });
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     if (bodies_[b].has_body_state())
       rigid_scene_body_[device_index_[b]] = static_cast<std::uint32_t>(b);
@@ -419,6 +422,9 @@ void Simulation::step_positions(const shared::StepParams& lists) {
   react.flags |= MOTES_FLAG_ABSORB;
   shared::StepParams react_apply = project;
   react_apply.flags |= MOTES_FLAG_ABSORB;
+  // Adhesion's reactions are impulses: the bodies' velocities change, not their poses.
+  shared::StepParams adhere_apply = velocity;
+  adhere_apply.flags |= MOTES_FLAG_ABSORB;
   for (int s = 0; s < settings_.substeps; ++s) {
     if (bodies) {
       d.enqueue(Kernel::BodiesIntegrate, project);
@@ -462,7 +468,20 @@ void Simulation::step_positions(const shared::StepParams& lists) {
       // of the substep's velocities, then XSPH viscosity, vorticity confinement, cohesion and
       // adhesion from them.
       d.enqueue(Kernel::FluidVorticity, params_);
-      d.enqueue(Kernel::FluidVelocity, params_);
+      if (!fluid_adhesion_) {
+        d.enqueue(Kernel::FluidVelocity, params_);
+      } else {
+        // The solids take adhesion's reaction (docs/fluids.md, "Solids in the density, and
+        // two-way coupling"): a free particle into its velocity, a rigid body's as an impulse.
+        shared::StepParams adhere = params_;
+        adhere.flags |= MOTES_FLAG_FLUID_ADHESION;
+        d.enqueue(Kernel::FluidVelocity, adhere);
+        if (bodies) {
+          d.enqueue(Kernel::ParticlesUpdate, react);
+          d.enqueue(Kernel::ImpulsesApply, adhere_apply);
+          d.enqueue(Kernel::ParticlesUpdate, params_);
+        }
+      }
     }
   }
   if (bodies) d.enqueue(Kernel::ParticlesUpdate, params_);

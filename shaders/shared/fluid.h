@@ -305,6 +305,29 @@ MOTES_FN vec3 fluid_solid_reaction(vec3 xi, float lambda_i, vec3 xb, float rb,
   return fluid_rigid_reaction(term, mi, hs);
 }
 
+/// A solid particle b's reaction to fluid particle i's adhesion (fluid_velocity with
+/// MOTES_FLAG_FLUID_ADHESION; a momentum): minus m_i times i's term, computed as i computes it
+/// (fluid_adhesion_term with i's material, b's psi_b of it), so the pair keeps its momentum; summed
+/// over b's fluid neighbours in list order, b takes it by fluid_adhesion_taken.
+MOTES_FN vec3 fluid_adhesion_reaction(vec3 xi, vec3 xb, float rb, MOTES_IN(FluidMaterial) fi,
+                                      float hs) {
+  float psi = fluid_neighbour_mass(false, 0.0f, rb, fi);
+  vec3 term = fluid_adhesion_term(xi - xb, psi, fi.velocity.w, fi.density_h.y, hs);
+  return term * (-fi.density_h.z);
+}
+
+/// How a solid particle b that can move (inverse mass w_b != 0) takes its adhesion reaction R: a
+/// rigid body's particle hands R to its body (ParticleForce (R, 0): particles_update with
+/// MOTES_FLAG_ABSORB | MOTES_FLAG_PARTICLE_SHIFT, then impulses_apply's velocity change); a free
+/// one (a free sphere, a soft body's, a cloth's, a rope's) changes its velocity v_b by R w_b.
+/// Returns the free particle's new velocity (w kept); a rigid one's is its old.
+MOTES_FN vec4 fluid_adhesion_taken(vec4 vb, vec3 reaction, bool rigid) {
+  if (rigid) {
+    return vb;
+  }
+  return vec4(xyz(vb) + reaction * vb.w, vb.w);
+}
+
 MOTES_SHARED_END
 
 #ifdef __cplusplus

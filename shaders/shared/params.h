@@ -64,6 +64,11 @@ MOTES_SHARED_BEGIN
 /// sums them over each body into the bound of its contacts' Gram matrix that the velocity pass
 /// steps by (shared/contact_gram.h), in BodyAngVelStart.w.
 #define MOTES_FLAG_POSITION_GRAM 16384u
+/// fluid_velocity: the solid particles too (set by the core when a fluid's material has adhesion):
+/// each takes the reaction to its fluid neighbours' adhesion (shared/fluid.h:
+/// fluid_adhesion_reaction), a rigid particle's in ParticleForce (w 0) for its body, a free
+/// particle's as its change of velocity. Without it, fluid_velocity runs over the fluid only.
+#define MOTES_FLAG_FLUID_ADHESION 32768u
 
 /// Launch parameters of every kernel family; travels with the launch (push constants).
 struct StepParams {

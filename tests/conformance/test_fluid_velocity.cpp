@@ -1,21 +1,25 @@
 // fluid_velocity against the oracle (docs/fluids.md): ParticleVel of every particle (a fluid
 // particle's velocity after XSPH, vorticity confinement, cohesion and adhesion, w kept; every
-// other particle's untouched).
+// other particle's untouched) and ParticleForce (untouched); with MOTES_FLAG_FLUID_ADHESION the
+// solids' reactions to adhesion too (a rigid particle's momentum in ParticleForce with w = 0, a
+// free solid particle's change of velocity; a static one's ParticleForce 0).
 //
 // The worlds of test_fluid_density.cpp (fluid_support.h: rigid bodies, some static, around a block
 // of fluid), the fluid set in motion by fluid_stir (a rotation plus seeded noise) with every
 // velocity-level parameter nonzero; FluidState the oracle's fluid_density and FluidVelOld,
 // FluidAux, FluidNormal the oracle's fluid_vorticity of them; the fluid particles' ParticleVel xyz
-// NaN (the kernel must read velocities from FluidVelOld only; w kept); every other buffer
-// poisoned. Cases: sizes 0, 1, 31 and 1,234 (jittered lattice), the lattice at rest (cohesion and
-// adhesion only), lists of capacity 4 against 64 (the over-capacity walk of the grid: the same
-// sums); Block1234 first proves on the oracle that each of the four terms changes many particles'
-// velocities. Physics: a uniform translation stays as it is under XSPH (device: fluid_vorticity
-// then fluid_velocity).
+// NaN (the kernel must read velocities from FluidVelOld only; w kept); ParticleForce a sentinel;
+// every other buffer poisoned. Cases: sizes 0, 1, 31 and 1,234 (jittered lattice), the lattice at
+// rest (cohesion and adhesion only), lists of capacity 4 against 64 (the over-capacity walk of the
+// grid: the same sums); Block1234 first proves on the oracle that each of the four terms changes
+// many particles' velocities; the solids' reactions with free solid particles in the block
+// (fluid_free_solids), over full lists and over capacity. Physics: a uniform translation stays as
+// it is under XSPH (device: fluid_vorticity then fluid_velocity).
 //
 // Tolerance: NMSE 1e-7 against the oracle on the fluid particles' change of velocity (the velocity
-// minus FluidVelOld: about 1e-3 of it, which an NMSE of whole velocities would hide) and on their
-// velocities; w identical; every other particle's velocity identical.
+// minus FluidVelOld: about 1e-3 of it, which an NMSE of whole velocities would hide), on their
+// velocities, on the free solids' change of velocity and on the rigid particles' reactions; w
+// identical; every other particle's velocity and ParticleForce identical.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -76,29 +80,63 @@ class FluidVelocity : public FluidTest {
     return e;
   }
 
-  void run_case(const std::string& layout, FluidWorld fw, uint capacity, float spin, float noise) {
+  void run_case(const std::string& layout, FluidWorld fw, uint capacity, float spin, float noise,
+                uint flags = 0u) {
     fluid_stir(fw, 7101, spin, noise, kFluidStirParameters);
     StepParams params = fw.w.params;
     params.neighbour_capacity = capacity;
+    params.flags |= flags;
     const Expected want = expected(fw, params);
+    // ParticleForce: a sentinel everywhere; only rigid particles' entries change, with the flag.
+    const std::vector<vec4> sentinel(fw.w.particles.size(), vec4(7.0f, -7.0f, 7.0f, 7.0f));
+    std::vector<vec4> want_force = sentinel;
+    const std::vector<vec4> want_vel = motes_ref::fluid_velocity(
+        want.written, fw.nb, fw.fluids, want.state, want.vort, params, &want_force);
     ASSERT_NO_FATAL_FAILURE(write_inputs(fw, capacity, want.state));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleVel, want.written.vel));
+    ASSERT_NO_FATAL_FAILURE(write(Buffer::ParticleForce, sentinel));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::FluidVelOld, want.vort.vel_old));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::FluidAux, want.vort.aux));
     ASSERT_NO_FATAL_FAILURE(write(Buffer::FluidNormal, want.vort.normal));
     ASSERT_NO_FATAL_FAILURE(run(motes::Kernel::FluidVelocity, params));
-    std::vector<vec4> got;
+    std::vector<vec4> got, force;
     ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticleVel, got));
+    ASSERT_NO_FATAL_FAILURE(read(Buffer::ParticleForce, force));
     const std::size_t nf = params.fluid_first, count = params.fluid_count;
     begin_case("fluid_velocity/" + layout, count);
     check_close("ParticleVel change", velocity_changes(got, want.vort.vel_old, params),
-                velocity_changes(want.vel, want.vort.vel_old, params), kFluidVelocityTolerance,
+                velocity_changes(want_vel, want.vort.vel_old, params), kFluidVelocityTolerance,
                 Part::Xyz);
-    check_close("ParticleVel", fluid_slice(got, nf, count), fluid_slice(want.vel, nf, count),
+    check_close("ParticleVel", fluid_slice(got, nf, count), fluid_slice(want_vel, nf, count),
                 kFluidVelocityTolerance, Part::Xyz);
-    check_w_identical("ParticleVel", got, want.vel);
-    check_identical("ParticleVel of the other particles", outside_fluid(got, nf, count),
-                    outside_fluid(want.vel, nf, count));
+    check_w_identical("ParticleVel", got, want_vel);
+    if ((flags & MOTES_FLAG_FLUID_ADHESION) == 0u) {
+      check_identical("ParticleVel of the other particles", outside_fluid(got, nf, count),
+                      outside_fluid(want_vel, nf, count));
+      check_identical("ParticleForce", force, sentinel);
+    } else {
+      // The rigid particles' reactions; the free solids' change of velocity, each to the oracle.
+      const std::size_t nr = params.rigid_particle_count;
+      check_close("ParticleForce of the rigid particles", fluid_slice(force, 0, nr),
+                  fluid_slice(want_force, 0, nr), kFluidVelocityTolerance, Part::Xyz);
+      check_w_identical("ParticleForce", force, want_force);
+      check_identical("ParticleForce of the other particles", outside_fluid(force, 0, nr),
+                      outside_fluid(want_force, 0, nr));
+      check_identical("ParticleVel of the rigid particles", fluid_slice(got, 0, nr),
+                      fluid_slice(want_vel, 0, nr));
+      std::vector<vec4> dv_got, dv_want;
+      for (std::size_t b = nr; b < nf; ++b) {
+        const vec4 v0 = want.written.vel[b];
+        dv_got.emplace_back(got[b].x - v0.x, got[b].y - v0.y, got[b].z - v0.z, 0.0f);
+        dv_want.emplace_back(want_vel[b].x - v0.x, want_vel[b].y - v0.y, want_vel[b].z - v0.z,
+                             0.0f);
+      }
+      check_close("ParticleVel change of the free solids", dv_got, dv_want, kFluidVelocityTolerance,
+                  Part::Xyz);
+      check_identical("ParticleVel after the fluid",
+                      fluid_slice(got, nf + count, got.size() - nf - count),
+                      fluid_slice(want_vel, nf + count, want_vel.size() - nf - count));
+    }
     end_case();
   }
 };
@@ -139,6 +177,43 @@ TEST_P(FluidVelocity, LatticeAtRest) {
 }
 TEST_P(FluidVelocity, OverCapacity) {
   run_case("capacity_4", fluid_world(338, 4114, 0.95f, 0.05f), 4, 3, 0.1f);
+}
+
+// With MOTES_FLAG_FLUID_ADHESION: every solid particle's reaction to adhesion. The world's rigid
+// bodies (some static) and 300 free solid particles inside the stirred block; the oracle first
+// shows that the reactions are there (many rigid particles and free solids take one; the free
+// solids are the block's first 300 particles, whose far layers have no fluid within h).
+TEST_P(FluidVelocity, SolidsTakeAdhesionsReaction) {
+  FluidWorld fw = fluid_world(341, 4114, 1.0f, 0.05f);
+  fluid_free_solids(fw, 300);
+  {
+    FluidWorld stirred = fw;
+    fluid_stir(stirred, 7101, 3.0f, 0.1f, kFluidStirParameters);
+    StepParams params = stirred.w.params;
+    params.flags |= MOTES_FLAG_FLUID_ADHESION;
+    const Expected e = expected(stirred, params);
+    std::vector<vec4> force(stirred.w.particles.size(), vec4(0.0f));
+    const std::vector<vec4> vel = motes_ref::fluid_velocity(e.written, stirred.nb, stirred.fluids,
+                                                            e.state, e.vort, params, &force);
+    std::size_t rigid = 0, free = 0;
+    for (uint b = 0; b < params.rigid_particle_count; ++b) {
+      rigid += (force[b].x != 0.0f || force[b].y != 0.0f || force[b].z != 0.0f) ? 1u : 0u;
+    }
+    for (uint b = params.rigid_particle_count; b < params.fluid_first; ++b) {
+      const vec4 a = vel[b], o = e.written.vel[b];
+      free += (a.x != o.x || a.y != o.y || a.z != o.z) ? 1u : 0u;
+    }
+    std::printf("[fluid_velocity] adhesion's reaction on %zu rigid particles and %zu of 300 free\n",
+                rigid, free);
+    ASSERT_GE(rigid, 20u);
+    ASSERT_GE(free, 150u);  // the slab's far layers have no fluid within h
+  }
+  run_case("adhesion_reaction", fw, 64, 3, 0.1f, MOTES_FLAG_FLUID_ADHESION);
+}
+TEST_P(FluidVelocity, SolidsTakeAdhesionsReactionOverCapacity) {
+  FluidWorld fw = fluid_world(342, 4114, 0.95f, 0.05f);
+  fluid_free_solids(fw, 300);
+  run_case("adhesion_reaction_capacity_4", fw, 4, 3, 0.1f, MOTES_FLAG_FLUID_ADHESION);
 }
 
 // A uniform translation of a jittered block under XSPH (c = 0.1, the other terms 0), on the

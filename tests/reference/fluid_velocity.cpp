@@ -1,7 +1,9 @@
 // The oracle of fluid_velocity (docs/fluids.md): each fluid particle's change of velocity summed
 // over the oracle's own full lists (motes_ref::neighbours_build), in list order, with
 // shared/fluid.h's terms: XSPH, eta (for the confinement) and cohesion over the fluid neighbours
-// within h, adhesion over the solid ones; every other particle's velocity as it was.
+// within h, adhesion over the solid ones; every other particle's velocity as it was, or with
+// MOTES_FLAG_FLUID_ADHESION every solid particle that can move its reaction to its fluid
+// neighbours' adhesion (a rigid one's in `force`, a free one's into its velocity).
 #include "reference.h"
 #include "shared/fluid.h"
 
@@ -13,10 +15,30 @@ using motes::shared::vec3;
 std::vector<vec4> fluid_velocity(const Particles& particles, const Neighbours& nb,
                                  const std::vector<FluidMaterial>& fluids,
                                  const std::vector<vec4>& state, const FluidVorticity& vort,
-                                 const StepParams& p) {
+                                 const StepParams& p, std::vector<vec4>* force) {
   namespace sh = motes::shared;
   std::vector<vec4> out = particles.vel;
   const float hs = p.gravity_dt.w;
+  const auto fluid = [&](uint j) {
+    return j >= p.fluid_first && j < std::size_t{p.fluid_first} + p.fluid_count;
+  };
+  if ((p.flags & MOTES_FLAG_FLUID_ADHESION) != 0u) {
+    for (uint b = 0; b < p.particle_count; ++b) {
+      if (fluid(b)) continue;
+      const vec4 pb = particles.pos[b];
+      vec3 reaction(0.0f);
+      if (particles.vel[b].w != 0.0f) {
+        for (const uint j : nb.lists[b]) {
+          if (!fluid(j)) continue;
+          reaction += sh::fluid_adhesion_reaction(sh::xyz(particles.pos[j]), sh::xyz(pb), pb.w,
+                                                  fluids[particles.material[j]], hs);
+        }
+      }
+      const bool rigid = b < p.rigid_particle_count;
+      if (rigid && force != nullptr) (*force)[b] = vec4(reaction, 0.0f);
+      out[b] = sh::fluid_adhesion_taken(particles.vel[b], reaction, rigid);
+    }
+  }
   for (std::size_t k = 0; k < p.fluid_count; ++k) {
     const std::size_t i = p.fluid_first + k;
     const FluidMaterial f = fluids[particles.material[i]];
@@ -39,7 +61,7 @@ std::vector<vec4> fluid_velocity(const Particles& particles, const Neighbours& n
     for (const uint j : nb.lists[i]) {
       const vec3 rij = xi - sh::xyz(particles.pos[j]);
       const float r2 = sh::dot(rij, rij);
-      if (j < p.fluid_first || j >= std::size_t{p.fluid_first} + p.fluid_count) {
+      if (!fluid(j)) {
         const float d = 2.0f * particles.pos[j].w;
         const float psi = f.s_corr.w * rho0 * (d * d * d);
         adhesion += sh::fluid_adhesion_term(rij, psi, beta, h, hs);

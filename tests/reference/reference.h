@@ -314,10 +314,13 @@ FluidVorticity fluid_vorticity(const Particles& particles, const Neighbours& nb,
 /// fluid_confinement(eta, omega_i, eps, h_s)) + cohesion) + adhesion, the sums over nb.lists[i]
 /// in order: a fluid j with r^2 <= h^2 adds shared::fluid_xsph_term, fluid_eta_term and
 /// fluid_cohesion_term, a solid j fluid_adhesion_term (psi_j = s rho_0 (2 r_j)^3); every other
-/// particle's velocity as it was.
+/// particle's velocity as it was. With MOTES_FLAG_FLUID_ADHESION every solid particle b with
+/// w_b != 0 sums shared::fluid_adhesion_reaction over the fluid particles of nb.lists[b] in order:
+/// a rigid one's (b < rigid_particle_count) becomes (*force)[b] = (R, 0) (a static rigid one's
+/// (0, 0)), a free one's velocity shared::fluid_adhesion_taken; `force` may be null without it.
 std::vector<vec4> fluid_velocity(const Particles& particles, const Neighbours& nb,
                                  const std::vector<motes::shared::FluidMaterial>& fluids,
                                  const std::vector<vec4>& state, const FluidVorticity& vort,
-                                 const StepParams& p);
+                                 const StepParams& p, std::vector<vec4>* force = nullptr);
 
 }  // namespace motes_ref

@@ -350,4 +350,32 @@ TEST(FluidMath, AkinciSplines) {
   EXPECT_LT(c.x, 0.0f);
 }
 
+// The solid's side of adhesion (fluid_velocity with MOTES_FLAG_FLUID_ADHESION): the reaction is
+// minus the momentum the fluid particle gains from the pair, to the bit; a rigid particle hands
+// it to its body (its velocity kept), a free one changes its velocity by R w_b.
+TEST(FluidMath, AdhesionReactionKeepsThePairsMomentum) {
+  FluidMaterial f = material(1000.0f, 0.01f);
+  f.velocity.w = 2.0f;  // beta
+  const float h = f.density_h.y, mi = f.density_h.z, hs = 1.0f / 960.0f;
+  const vec3 xi(0.0f, 0.0f, 0.0f);
+  const vec3 xb(0.7f * h, 0.1f * h, -0.05f * h);
+  const float rb = 0.005f;
+  const vec3 term =
+      sh::fluid_adhesion_term(xi - xb, sh::fluid_neighbour_mass(false, 0.0f, rb, f), 2.0f, h, hs);
+  ASSERT_GT(sh::length(term), 0.0f);
+  const vec3 r = sh::fluid_adhesion_reaction(xi, xb, rb, f, hs);
+  EXPECT_EQ(r.x, -(term.x * mi));
+  EXPECT_EQ(r.y, -(term.y * mi));
+  EXPECT_EQ(r.z, -(term.z * mi));
+  EXPECT_GT(term.x, 0.0f) << "the fluid particle is pulled towards the solid (+x)";
+  EXPECT_LT(r.x, 0.0f) << "the solid is pulled towards the fluid particle (-x)";
+  const vec4 vb(0.1f, 0.2f, 0.3f, 4.0f);
+  const vec4 rigid = sh::fluid_adhesion_taken(vb, r, true);
+  EXPECT_EQ(rigid.x, vb.x);
+  EXPECT_EQ(rigid.w, vb.w);
+  const vec4 free = sh::fluid_adhesion_taken(vb, r, false);
+  EXPECT_EQ(free.x, vb.x + r.x * 4.0f);
+  EXPECT_EQ(free.w, 4.0f);
+}
+
 }  // namespace

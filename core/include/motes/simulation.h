@@ -376,6 +376,8 @@ class Simulation {
   std::vector<EmitterRange> emitters_;
   /// Position contacts: the scene has dynamic rigid bodies (their passes run).
   bool position_bodies_ = false;
+  /// A fluid's material has adhesion: fluid_velocity gives the solids its reaction.
+  bool fluid_adhesion_ = false;
   /// (scene body, orientation) of the free spheres that are not at the identity orientation; a
   /// free sphere never turns.
   std::vector<std::pair<std::uint32_t, shared::vec4>> sphere_turns_;

@@ -100,7 +100,11 @@
 //   fluid_cohesion_term; for a solid j, the adhesion sum of fluid_adhesion_term (psi_j of
 //   fluid_neighbour_mass); ParticleVel[i].xyz = v_i + (((c xsph + fluid_confinement(eta_i,
 //   omega_i, eps, h_s)) + cohesion) + adhesion) with i's material's (c, eps, gamma, beta) and
-//   h_s = p.gravity_dt.w, w kept; every other particle untouched.
+//   h_s = p.gravity_dt.w, w kept; every other particle untouched. With MOTES_FLAG_FLUID_ADHESION
+//   every solid particle b too (items [0, particle_count)): with w_b != 0 it sums
+//   fluid_adhesion_reaction over its fluid neighbours in the same order (else 0); a rigid one
+//   (b < rigid_particle_count) writes ParticleForce[b] = (R, 0), a free one ParticleVel[b] =
+//   fluid_adhesion_taken(v_b, R); every other ParticleForce untouched.
 // particles_check (not part of a step: the motion guard): MotionCheck gets the largest
 //   (|v| / d)^2 of a finite particle of [0, particle_count), the first particle with it and its
 //   |v|^2, and the first particle whose position or velocity is not finite
@@ -193,7 +197,7 @@
     (ParticlePos, ParticleVel, ParticleBody, ParticleMaterial, GridOrder, GridCellStart,         \
      SortedBody, NeighbourList, NeighbourCount, NeighbourRefPos, LinkExclusions, FluidMaterials, \
      FluidState, FluidVelOld, FluidAux, FluidNormal),                                            \
-    (ParticleVel))                                                                               \
+    (ParticleVel, ParticleForce))                                                                \
   X(ParticlesCheck, particles_check, (ParticlePos, ParticleVel), (MotionCheck))                  \
   X(EnergyReduce, energy_reduce,                                                                 \
     (ParticlePos, ParticleVel, BodyPos, BodyVel, BodyAngMom, BodyAngVel, EnergyPartials),        \
