@@ -45,10 +45,11 @@ __global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
   const float ni = kShifts ? shared::particle_shift_count(in.count[i], p.plane_count) : 0.0f;
   const auto add_contact = [&](uint j) {
     if (by_impulse && j < p.rigid_particle_count) return;
+    // Two fluid particles: skipped before their loads (most of a liquid's list), as on Vulkan.
+    if (kShifts && shared::shift_pair_skipped(uint(i), j, p.fluid_first, p.fluid_count)) return;
     const vec4 pj = in.pos[j];
     const vec4 vj = in.vel[j];
     if constexpr (kShifts) {
-      if (shared::shift_pair_skipped(uint(i), j, p.fluid_first, p.fluid_count)) return;
       // A rigid body's particle gathers the reactions of its contacts with other kinds'.
       const float nj = shared::particle_shift_count(in.count[j], p.plane_count);
       if (i < p.rigid_particle_count) {

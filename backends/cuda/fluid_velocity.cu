@@ -1,9 +1,9 @@
-// fluid_velocity: one thread per fluid particle (with MOTES_FLAG_FLUID_ADHESION per particle); a
-// fluid particle's change of velocity at the velocity level, a gather over its neighbours in list
-// order (over capacity: the 27 cells of the last build, whose extra particles add zeros): XSPH
-// viscosity, vorticity confinement and cohesion over its fluid neighbours within h, adhesion over
-// its solid ones; from the velocities fluid_vorticity copied to FluidVelOld, into ParticleVel (w
-// kept; shared/fluid.h). With the flag a solid particle that can move takes the reaction to its
+// fluid_velocity: one thread per fluid particle; its change of velocity at the velocity level, a
+// gather over its neighbours in list order (over capacity: the 27 cells of the last build, whose
+// extra particles add zeros): XSPH viscosity, vorticity confinement and cohesion over its fluid
+// neighbours within h, adhesion over its solid ones; from the velocities fluid_vorticity copied
+// to FluidVelOld, into ParticleVel (w kept; shared/fluid.h). With MOTES_FLAG_FLUID_ADHESION a
+// second kernel, a thread per particle: a solid particle that can move takes the reaction to its
 // fluid neighbours' adhesion (a rigid one's in ParticleForce, a free one's into its ParticleVel).
 // Each thread writes only its own entries. As backends/openmp/fluid_velocity.cpp.
 #include "cuda_device.h"
@@ -59,29 +59,35 @@ __device__ void each_neighbour(const shared::StepParams& p, const FluidVelocityI
   });
 }
 
-__global__ void fluid_velocity_kernel(shared::StepParams p, FluidVelocityInputs in,
-                                      vec4* __restrict__ vel, vec4* __restrict__ force) {
-  const bool solids = (p.flags & MOTES_FLAG_FLUID_ADHESION) != 0u;
+// With MOTES_FLAG_FLUID_ADHESION: every solid particle that can move takes the reaction to its
+// fluid neighbours' adhesion (a kernel of its own: the fluid's kernel keeps its registers).
+__global__ void fluid_adhesion_reaction_kernel(shared::StepParams p, FluidVelocityInputs in,
+                                               vec4* __restrict__ vel, vec4* __restrict__ force) {
   const std::uint64_t k = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
-  if (k >= (solids ? p.particle_count : p.fluid_count)) return;
-  const uint i = (solids ? 0u : p.fluid_first) + uint(k);
-  if (!shared::fluid_particle(i, p.fluid_first, p.fluid_count)) {
-    const vec4 pb = in.pos[i];
-    const vec4 vb = vel[i];
-    vec3 reaction(0.0f);
-    if (vb.w != 0.0f) {
-      each_neighbour(p, in, i, [&](uint j) {
-        if (!shared::fluid_particle(j, p.fluid_first, p.fluid_count)) return;
-        reaction += shared::fluid_adhesion_reaction(shared::xyz(in.pos[j]), shared::xyz(pb), pb.w,
-                                                    in.fluids[in.material[j]], p.gravity_dt.w);
-      });
-    }
-    const bool rigid = i < p.rigid_particle_count;
-    if (rigid) force[i] = vec4(reaction, 0.0f);
-    vel[i] = shared::fluid_adhesion_taken(vb, reaction, rigid);
-    return;
+  if (k >= p.particle_count) return;
+  const uint i = uint(k);
+  if (shared::fluid_particle(i, p.fluid_first, p.fluid_count)) return;
+  const vec4 pb = in.pos[i];
+  const vec4 vb = vel[i];
+  vec3 reaction(0.0f);
+  if (vb.w != 0.0f) {
+    each_neighbour(p, in, i, [&](uint j) {
+      if (!shared::fluid_particle(j, p.fluid_first, p.fluid_count)) return;
+      reaction += shared::fluid_adhesion_reaction(shared::xyz(in.pos[j]), shared::xyz(pb), pb.w,
+                                                  in.fluids[in.material[j]], p.gravity_dt.w);
+    });
   }
-  const uint at = i - p.fluid_first;
+  const bool rigid = i < p.rigid_particle_count;
+  if (rigid) force[i] = vec4(reaction, 0.0f);
+  vel[i] = shared::fluid_adhesion_taken(vb, reaction, rigid);
+}
+
+__global__ void fluid_velocity_kernel(shared::StepParams p, FluidVelocityInputs in,
+                                      vec4* __restrict__ vel) {
+  const std::uint64_t k = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
+  if (k >= p.fluid_count) return;
+  const uint i = p.fluid_first + uint(k);
+  const uint at = uint(k);
   const vec3 xi = shared::xyz(in.pos[i]);
   const shared::FluidMaterial f = in.fluids[in.material[i]];
   const float rho0 = f.density_h.x;
@@ -125,8 +131,7 @@ __global__ void fluid_velocity_kernel(shared::StepParams p, FluidVelocityInputs 
 
 void CudaDevice::launch_fluid_velocity(const shared::StepParams& p) {
   const bool solids = (p.flags & MOTES_FLAG_FLUID_ADHESION) != 0u;
-  const uint n = solids ? p.particle_count : p.fluid_count;
-  if (n == 0) return;
+  if (p.fluid_count == 0 && !(solids && p.particle_count != 0)) return;
   const FluidVelocityInputs in{buf<vec4>(Buffer::ParticlePos),
                                buf<uint>(Buffer::ParticleBody),
                                buf<uint>(Buffer::ParticleMaterial),
@@ -142,8 +147,14 @@ void CudaDevice::launch_fluid_velocity(const shared::StepParams& p) {
                                buf<vec4>(Buffer::FluidVelOld),
                                buf<vec4>(Buffer::FluidAux),
                                buf<vec4>(Buffer::FluidNormal)};
-  fluid_velocity_kernel<<<blocks_for(n), kBlock, 0, stream_>>>(
-      p, in, buf<vec4>(Buffer::ParticleVel), buf<vec4>(Buffer::ParticleForce));
+  vec4* vel = buf<vec4>(Buffer::ParticleVel);
+  if (p.fluid_count != 0) {
+    fluid_velocity_kernel<<<blocks_for(p.fluid_count), kBlock, 0, stream_>>>(p, in, vel);
+  }
+  if (solids && p.particle_count != 0) {  // writes only the solids' entries: no order needed
+    fluid_adhesion_reaction_kernel<<<blocks_for(p.particle_count), kBlock, 0, stream_>>>(
+        p, in, vel, buf<vec4>(Buffer::ParticleForce));
+  }
 }
 
 }  // namespace motes::cuda
