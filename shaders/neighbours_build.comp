@@ -1,6 +1,6 @@
 #version 450
 // neighbours_build (after neighbours_build_begin.comp or neighbours_update.comp): every dynamic
-// particle (one thread per particle id) lists the
+// particle (one thread per particle, in grid order) lists the
 // particles of other bodies closer than r_i + r_j + skin (shared/neighbours.h) in the canonical
 // order of the 27-cell walk, keeps the first K (entry k at k * N + i) and writes its full count;
 // as backends/openmp/neighbours_build.cpp. The figures of the build (particles over capacity,
@@ -16,13 +16,16 @@ shared uint group_over;
 shared uint group_most;
 
 void main() {
-  uint i = thread_index();
+  uint k = thread_index();
   if (gl_LocalInvocationID.x == 0u) {
     group_over = 0u;
     group_most = 0u;
   }
   barrier();
-  if (i < p.particle_count) {
+  if (k < p.particle_count) {
+    // Threads in grid order: a subgroup's particles share their cells, whose candidates it then
+    // reads together (each list is the same whichever thread builds it).
+    uint i = grid_order[k];
     vec4 pi = particle_pos[i];
     neighbour_ref_pos[i] = pi;
     uint c = 0u;

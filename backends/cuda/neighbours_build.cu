@@ -2,7 +2,7 @@
 // r_i + r_j + skin (shared/neighbours.h), in the canonical order of the 27-cell walk, its first K
 // entries kept (entry k at k * N + i) and its full count written; as
 // backends/openmp/neighbours_build.cpp. Two launches: one thread starts the build in
-// NeighbourState, then a thread per particle; the build's figures are reduced per block and added
+// NeighbourState, then a thread per particle in grid order; the build's figures are reduced per block and added
 // with integer atomics.
 #include "cuda_device.h"
 #include "shared/grid_walk.h"
@@ -51,8 +51,11 @@ __global__ void neighbours_build_kernel(shared::StepParams p, BuildInputs in, Bu
     block_most = 0;
   }
   __syncthreads();
-  const std::uint64_t i = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
-  if (i < p.particle_count) {
+  const std::uint64_t k = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
+  if (k < p.particle_count) {
+    // Threads in grid order: a warp's particles share their cells, whose candidates the warp
+    // then reads together (each list is the same whichever thread builds it).
+    const uint i = in.order[k];
     const vec4 pi = in.pos[i];
     out.ref[i] = pi;
     uint c = 0;
@@ -61,12 +64,12 @@ __global__ void neighbours_build_kernel(shared::StepParams p, BuildInputs in, Bu
     if (in.vel[i].w != 0.0f) {  // static particles never move and get no force
       const uint body_i = in.body[i];
       const float support_i =
-          shared::neighbour_fluid_support(pi, uint(i), p.fluid_first, p.fluid_count);
+          shared::neighbour_fluid_support(pi, i, p.fluid_first, p.fluid_count);
       const std::size_t stride = p.particle_count;
       shared::grid_walk(p, pi, in.cell_start, [&](uint lo, uint hi) {
         for (uint t = lo; t < hi; ++t) {
           const uint j = in.order[t];
-          if (shared::contact_skipped(body_i, in.sbody[t], uint(i), j, in.exclusions,
+          if (shared::contact_skipped(body_i, in.sbody[t], i, j, in.exclusions,
                                       p.particle_count, p.linked_first) ||
               !shared::neighbour_within(
                   pi, in.spos[t], p.neighbour_skin,
