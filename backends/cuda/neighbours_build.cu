@@ -2,8 +2,8 @@
 // r_i + r_j + skin (shared/neighbours.h), in the canonical order of the 27-cell walk, its first K
 // entries kept (entry k at k * N + i) and its full count written; as
 // backends/openmp/neighbours_build.cpp. Two launches: one thread starts the build in
-// NeighbourState, then a thread per particle in grid order; the build's figures are reduced per block and added
-// with integer atomics.
+// NeighbourState, then a thread per particle in grid order; the build's figures are reduced per
+// block and added with integer atomics.
 #include "cuda_device.h"
 #include "shared/grid_walk.h"
 #include "shared/impulse.h"
@@ -63,14 +63,13 @@ __global__ void neighbours_build_kernel(shared::StepParams p, BuildInputs in, Bu
     bool same = true;
     if (in.vel[i].w != 0.0f) {  // static particles never move and get no force
       const uint body_i = in.body[i];
-      const float support_i =
-          shared::neighbour_fluid_support(pi, i, p.fluid_first, p.fluid_count);
+      const float support_i = shared::neighbour_fluid_support(pi, i, p.fluid_first, p.fluid_count);
       const std::size_t stride = p.particle_count;
       shared::grid_walk(p, pi, in.cell_start, [&](uint lo, uint hi) {
         for (uint t = lo; t < hi; ++t) {
           const uint j = in.order[t];
-          if (shared::contact_skipped(body_i, in.sbody[t], i, j, in.exclusions,
-                                      p.particle_count, p.linked_first) ||
+          if (shared::contact_skipped(body_i, in.sbody[t], i, j, in.exclusions, p.particle_count,
+                                      p.linked_first) ||
               !shared::neighbour_within(
                   pi, in.spos[t], p.neighbour_skin,
                   shared::max(support_i, shared::neighbour_fluid_support(
