@@ -29,6 +29,46 @@ namespace {
 // memory first.
 constexpr std::uint64_t kMaxDominoes = 100'000'000 / 15;
 
+// Host memory a W1 size takes to build and run, per sphere, before the device's own check
+// (Simulation::create): the scene's BodySpec (272 B), the simulation's BodyInfo (72 B) and the
+// host layout. Measured with openmp on the development VM (docs/benchmarks.md, "W1 beyond host
+// memory"): peak RSS 2,445 MB at 4,194,304 spheres and 672 MB at 1,048,576, 563 B a sphere
+// between them, of which 196 B is the openmp device's memory; rounded up.
+constexpr std::uint64_t kW1HostBytesPerSphere = 400;
+// The device memory of a W1 sphere where the device is host memory (openmp): 196 B measured.
+constexpr std::uint64_t kW1OpenmpDeviceBytesPerSphere = 230;
+
+// MemAvailable of /proc/meminfo in bytes; nothing where it cannot be read.
+std::optional<std::uint64_t> available_host_memory() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  std::uint64_t kib = 0;
+  std::string unit;
+  while (in >> key >> kib >> unit) {
+    if (key == "MemAvailable:") return kib * 1024u;
+  }
+  return std::nullopt;
+}
+
+// Refuses (fail()) a W1 size whose scene would not fit in the host's available memory: building
+// it would otherwise run the machine out of memory instead of saying so.
+void check_w1_host_memory(std::uint64_t spheres, bool device_on_host) {
+  const std::optional<std::uint64_t> available = available_host_memory();
+  if (!available) return;
+  const std::uint64_t per_sphere =
+      kW1HostBytesPerSphere + (device_on_host ? kW1OpenmpDeviceBytesPerSphere : 0u);
+  const std::uint64_t need = spheres * per_sphere;
+  if (need <= *available) return;
+  constexpr double kGB = 1e9;
+  fail(fmt::format(
+      "W1 at {} spheres needs about {:.1f} GB of host memory ({} B a sphere: the scene, its "
+      "bodies and their layout{}), and {:.1f} GB is available here (MemAvailable): refused; at "
+      "most {} spheres fit",
+      spheres, static_cast<double>(need) / kGB, per_sphere,
+      device_on_host ? ", and the openmp device's memory" : "",
+      static_cast<double>(*available) / kGB, *available / per_sphere));
+}
+
 struct BenchOptions {
   std::string workload = "all";
   std::vector<std::uint64_t> sizes = {16384, 65536, 262144, 1048576};
@@ -431,8 +471,10 @@ void run_realtime_scene(const std::string& path, const BenchOptions& o, nlohmann
 /// "Real time").
 void run_realtime(const BenchOptions& o) {
   const std::vector<std::string> files = realtime_scene_files(o);
+  std::string device_backend;
   {
     auto probe = must(motes::open_device(o.backend, o.device, {o.threads}));
+    device_backend = probe->info().backend;
     fmt::print(
         "motes bench realtime on {} device {}: {} ({}); each scene {} simulated s in frames of "
         "1/{} s (one step call each), stepping only; median of {} repeats after a warm-up\n",
@@ -483,12 +525,14 @@ void run_bench(const BenchOptions& o) {
     if (!motes::settle_dimensions(n, nx, ny, nz)) {
       fail(
           fmt::format("--sizes: {} is not a W1 size (16384, 65536, 262144, 1048576, 4194304, "
-                      "16777216, 67108864, 134217728)",
+                      "16777216, 67108864, 134217728, 268435456)",
                       n));
     }
   }
+  std::string device_backend;
   {
     auto probe = must(motes::open_device(o.backend, o.device, {o.threads}));
+    device_backend = probe->info().backend;
     fmt::print(
         "motes bench on {} device {}: {} ({}); ms/step: median of {} repeats after a warm-up; "
         "kernel columns: one more run with kernel timing on (up to 500 steps)\n",
@@ -530,6 +574,12 @@ void run_bench(const BenchOptions& o) {
     for (std::uint64_t n : o.sizes) {
       int nx = 0, ny = 0, nz = 0;
       motes::settle_dimensions(n, nx, ny, nz);
+      bool fits = false;
+      attempt([&] {
+        check_w1_host_memory(n, device_backend == "openmp");
+        fits = true;
+      });
+      if (!fits) continue;
       const motes::Scene scene = motes::settle_workload(nx, ny, nz);
       if (o.phase != "dense") {
         attempt([&] {

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -485,6 +486,38 @@ TEST(Cli, BenchRealtimeNamesScenesItCannotRun) {
       tmp, {"bench", "--workload", "realtime", "--scenes", tmp / "empty", "--backend", "openmp"});
   EXPECT_EQ(empty.exit_code, 2) << describe(empty);
   EXPECT_TRUE(contains(empty.err, "holds no .json scene file")) << describe(empty);
+}
+
+// W1 at 268,435,456 spheres is a size (issue 30), but building its scene takes about 400 B of host
+// memory a sphere (630 B with the openmp device's): where MemAvailable is short of that, bench
+// refuses it before building anything, names both numbers and runs the other sizes.
+TEST(Cli, BenchRefusesAW1SizeBeyondHostMemory) {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key, unit;
+  std::uint64_t kib = 0, available = 0;
+  while (meminfo >> key >> kib >> unit) {
+    if (key == "MemAvailable:") available = kib * 1024u;
+  }
+  if (available == 0) GTEST_SKIP() << "no MemAvailable in /proc/meminfo";
+  constexpr std::uint64_t kSpheres = 268435456;
+  if (available >= kSpheres * 630u) {
+    GTEST_SKIP() << "this machine has room for W1 at 268,435,456 on openmp: it would run it";
+  }
+  TempDir tmp;
+  const Outcome o = run_motes(
+      tmp, {"bench", "--workload", "settle", "--phase", "both", "--sizes", "16384,268435456",
+            "--backend", "openmp", "--falling-steps", "2", "--dense-steps", "2", "--settle-steps",
+            "2", "--repeats", "1", "--cache", tmp / "cache"});
+  EXPECT_EQ(o.exit_code, 2) << describe(o);
+  EXPECT_TRUE(contains(o.err,
+                       "W1 at 268435456 spheres needs about 169.1 GB of host memory (630 "
+                       "B a sphere"))
+      << describe(o);
+  EXPECT_TRUE(contains(o.err, "is available here (MemAvailable): refused; at most "))
+      << describe(o);
+  EXPECT_TRUE(contains(o.out, "settle    falling      16384")) << "the other size still runs\n"
+                                                               << describe(o);
+  EXPECT_TRUE(contains(o.out, "settle    dense        16384")) << describe(o);
 }
 
 }  // namespace

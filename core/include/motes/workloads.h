@@ -22,7 +22,7 @@ Scene settle_workload(int nx, int ny, int nz, std::uint64_t seed = 12345);
 /// contact law. Lets both codes run the dense phase from one identical state.
 Result<Scene> settle_workload_from_lammps(const std::string& path);
 
-/// NX x NY x NZ for a W1 size in docs/benchmarks.md (16,384 ... 134,217,728); false if not one.
+/// NX x NY x NZ for a W1 size in docs/benchmarks.md (16,384 ... 268,435,456); false if not one.
 bool settle_dimensions(std::uint64_t particles, int& nx, int& ny, int& nz);
 
 /// W2 "dominoes": `count` dominoes of 1 x 3 x 5 particles (d = 0.01 m) in `rows` parallel rows
