@@ -471,10 +471,8 @@ void run_realtime_scene(const std::string& path, const BenchOptions& o, nlohmann
 /// "Real time").
 void run_realtime(const BenchOptions& o) {
   const std::vector<std::string> files = realtime_scene_files(o);
-  std::string device_backend;
   {
     auto probe = must(motes::open_device(o.backend, o.device, {o.threads}));
-    device_backend = probe->info().backend;
     fmt::print(
         "motes bench realtime on {} device {}: {} ({}); each scene {} simulated s in frames of "
         "1/{} s (one step call each), stepping only; median of {} repeats after a warm-up\n",
