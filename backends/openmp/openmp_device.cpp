@@ -118,6 +118,8 @@ Status OpenMPDevice::allocate(const Sizes& sizes) {
     ids_tmp_.assign(sizes.particles, 0);
     buffers_ = std::move(fresh);
     forget_impulse_passes();
+    impulse_mirror_.clear();
+    contact_pair_id_.clear();
   } catch (const std::bad_alloc&) {
     return Status::error(
         fmt::format("out of host memory allocating {} particles and {} bodies on the openmp device",
@@ -156,7 +158,10 @@ Status OpenMPDevice::write_at(Buffer b, std::size_t offset, const void* src, std
 void OpenMPDevice::wrote(Buffer b) {
   impulse_contacts_ready_ = false;  // what the kept contact frames were made from may have changed
   impulse_points_ready_ = false;    // and the particles' places (poses, offsets)
-  if (b == Buffer::NeighbourList || b == Buffer::NeighbourCount) impulse_mirror_.clear();
+  if (b == Buffer::NeighbourList || b == Buffer::NeighbourCount) {
+    impulse_mirror_.clear();
+    contact_pair_id_.clear();
+  }
   // New positions or lists: the last counting pass no longer says who touches whom.
   if (b == Buffer::ParticlePos || b == Buffer::NeighbourList || b == Buffer::NeighbourCount) {
     forget_impulse_passes();

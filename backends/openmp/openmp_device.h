@@ -1,6 +1,7 @@
 // The CPU backend: every kernel family as OpenMP loops over the shared physics headers.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -139,6 +140,27 @@ class OpenMPDevice final : public Device {
   /// and each slot's contact impulse of the sweep (w: counted).
   std::vector<std::uint32_t> impulse_mirror_;
   std::vector<shared::vec4> impulse_pair_;
+  /// contacts_compute evaluates a contact of two particles that list each other once
+  /// (contact_pairs.cpp): per list slot k of particle i (k N + i), the pair's number
+  /// (kNoPair: none, the particle evaluates it itself), made at the first contacts_compute after
+  /// the lists changed (emptied with impulse_mirror_); per pair its ids (lower first) and its
+  /// force on the lower id; per particle its slots without a pair, and whether any of its pairs
+  /// touched this call (1) or not (0: they all add nothing).
+  static constexpr std::uint32_t kNoPair = 0xffffffffu;
+  std::vector<std::uint32_t> contact_pair_id_;
+  std::vector<std::array<std::uint32_t, 2>> contact_pair_ends_;
+  std::vector<shared::vec4> contact_pairs_;
+  std::vector<std::uint32_t> contact_unpaired_;
+  std::vector<std::uint8_t> contact_touched_;
+  void contact_pairs_index(const ContactInputs& in, std::size_t n, std::uint32_t capacity);
+  /// Makes the pairs' numbers for these lists; false (and every particle evaluates its own
+  /// contacts) when there is no memory for them.
+  bool share_pairs(const ContactInputs& in, std::size_t n, std::uint32_t capacity);
+  /// Each shared pair's force on its lower id, and which particles' pairs touch.
+  void contact_pairs_compute(const shared::StepParams& p, const ContactInputs& in);
+  /// True when the law of materials a and b is the law of b and a (the table of
+  /// core/src/contact_laws.cpp always is; a buffer written by hand need not be).
+  static bool laws_symmetric(const shared::ContactLaw* laws, std::uint32_t materials);
   /// impulses_sweep.cpp: a contact within reach at the last counting pass (its numbers in
   /// impulse_blocks_); bodies a and b (b == the body count: a plane); the slots of its
   /// accumulated impulse in ContactImpulse (kNone: none, it starts from 0 every sweep).
