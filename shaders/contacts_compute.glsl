@@ -82,7 +82,7 @@ void main() {
 #endif
   if (c <= p.neighbour_capacity) {
     for (uint k = 0u; k < c; ++k) {
-      uint j = neighbour_list[k * p.particle_count + i];
+      uint j = list_entry(k, i);
       if (by_impulse && j < p.rigid_particle_count) continue;
       f += contact_term(i, j, xi, ui, pi.w, vi.w, ni, law_base);
     }

@@ -33,7 +33,7 @@ void main() {
   uint c = neighbour_count[i];
   if (c <= p.neighbour_capacity) {
     for (uint s = 0u; s < c; ++s) {
-      add_neighbour(neighbour_list[s * p.particle_count + i], xi, f, rho, gathered);
+      add_neighbour(list_entry(s, i), xi, f, rho, gathered);
     }
   } else {
     uint body_i = particle_body[i];

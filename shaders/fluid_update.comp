@@ -39,7 +39,7 @@ vec3 rigid_reaction(uint b) {
   vec3 sum = vec3(0.0f);
   uint c = neighbour_count[b];
   if (c <= p.neighbour_capacity) {
-    for (uint s = 0u; s < c; ++s) sum += reaction_term(neighbour_list[s * p.particle_count + b], xb, rb);
+    for (uint s = 0u; s < c; ++s) sum += reaction_term(list_entry(s, b), xb, rb);
     return sum;
   }
   uint body_b = particle_body[b];
@@ -72,7 +72,7 @@ void main() {
   uint c = neighbour_count[i];
   if (c <= p.neighbour_capacity) {
     for (uint s = 0u; s < c; ++s) {
-      dx += shift_term(neighbour_list[s * p.particle_count + i], xi, lambda_i, f);
+      dx += shift_term(list_entry(s, i), xi, lambda_i, f);
     }
   } else {
     uint body_i = particle_body[i];

@@ -59,7 +59,7 @@ vec3 adhesion_reaction(uint b) {
   vec3 sum = vec3(0.0f);
   uint c = neighbour_count[b];
   if (c <= p.neighbour_capacity) {
-    for (uint s = 0u; s < c; ++s) sum += reaction_term(neighbour_list[s * p.particle_count + b], xb, rb);
+    for (uint s = 0u; s < c; ++s) sum += reaction_term(list_entry(s, b), xb, rb);
     return sum;
   }
   uint body_b = particle_body[b];
@@ -99,7 +99,7 @@ void main() {
   uint c = neighbour_count[i];
   if (c <= p.neighbour_capacity) {
     for (uint s = 0u; s < c; ++s) {
-      add_neighbour(neighbour_list[s * p.particle_count + i], xi, vi, omega_i.w, ni, rhoi, f, g);
+      add_neighbour(list_entry(s, i), xi, vi, omega_i.w, ni, rhoi, f, g);
     }
   } else {
     uint body_i = particle_body[i];

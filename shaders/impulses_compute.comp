@@ -58,7 +58,7 @@ void main() {
   uint c = neighbour_count[i];
   if (c <= p.neighbour_capacity) {
     for (uint k = 0u; k < c; ++k) {
-      uint j = neighbour_list[k * p.particle_count + i];
+      uint j = list_entry(k, i);
       if (j >= p.rigid_particle_count) continue;
       bool slotted = impulse_pair_slotted(c, neighbour_count[j], p.neighbour_capacity);
       uint slot = k * nr + i;

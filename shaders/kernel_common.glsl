@@ -40,6 +40,9 @@ layout(std430, binding = B_GRID_CELL_START) buffer GridCellStartBuf { uint grid_
 layout(std430, binding = B_SORTED_POS) buffer SortedPosBuf { vec4 sorted_pos[]; };
 layout(std430, binding = B_SORTED_BODY) buffer SortedBodyBuf { uint sorted_body[]; };
 layout(std430, binding = B_NEIGHBOUR_LIST) buffer NeighbourListBuf { uint neighbour_list[]; };
+layout(std430, binding = B_NEIGHBOUR_LIST_1) buffer NeighbourList1Buf { uint neighbour_list_1[]; };
+layout(std430, binding = B_NEIGHBOUR_LIST_2) buffer NeighbourList2Buf { uint neighbour_list_2[]; };
+layout(std430, binding = B_NEIGHBOUR_LIST_3) buffer NeighbourList3Buf { uint neighbour_list_3[]; };
 layout(std430, binding = B_NEIGHBOUR_COUNT) buffer NeighbourCountBuf { uint neighbour_count[]; };
 layout(std430, binding = B_NEIGHBOUR_REF_POS) buffer NeighbourRefPosBuf { vec4 neighbour_ref_pos[]; };
 layout(std430, binding = B_NEIGHBOUR_STATE) buffer NeighbourStateBuf { uint neighbour_state[]; };
@@ -79,6 +82,39 @@ layout(std430, binding = B_GRID_ARRIVAL) buffer GridArrivalBuf { uint grid_arriv
 layout(std430, binding = B_GRID_UNSORTED) buffer GridUnsortedBuf { uint grid_unsorted[]; };
 layout(std430, binding = B_SCAN_SCRATCH) buffer ScanScratchBuf { uint scan_scratch[]; };
 layout(std430, binding = B_INDIRECT_ARGS) buffer IndirectArgsBuf { uint indirect_args[]; };
+
+// Entry k of particle i's neighbour list (entry k at k N + i of the whole list). A list too large
+// for one storage buffer is split into column blocks of p.neighbour_columns columns (0: one block),
+// bound as B_NEIGHBOUR_LIST, then _1 to _3.
+uint list_entry(uint k, uint i) {
+  uint b = p.neighbour_columns == 0u ? 0u : k / p.neighbour_columns;
+  uint at = (k - b * p.neighbour_columns) * p.particle_count + i;
+  if (b == 0u) return neighbour_list[at];
+  if (b == 1u) return neighbour_list_1[at];
+  if (b == 2u) return neighbour_list_2[at];
+  return neighbour_list_3[at];
+}
+
+// Sets entry k of particle i to j; returns whether it was j already.
+bool list_set(uint k, uint i, uint j) {
+  uint b = p.neighbour_columns == 0u ? 0u : k / p.neighbour_columns;
+  uint at = (k - b * p.neighbour_columns) * p.particle_count + i;
+  uint was;
+  if (b == 0u) {
+    was = neighbour_list[at];
+    neighbour_list[at] = j;
+  } else if (b == 1u) {
+    was = neighbour_list_1[at];
+    neighbour_list_1[at] = j;
+  } else if (b == 2u) {
+    was = neighbour_list_2[at];
+    neighbour_list_2[at] = j;
+  } else {
+    was = neighbour_list_3[at];
+    neighbour_list_3[at] = j;
+  }
+  return was == j;
+}
 
 // Workgroups beyond 65,535 are dispatched as a 2D grid (x, y); this is the flat index.
 uint flat_group() { return gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x; }

@@ -47,9 +47,7 @@ void main() {
             continue;
           }
           if (c < p.neighbour_capacity) {
-            uint at = c * p.particle_count + i;
-            same = same && neighbour_list[at] == j;
-            neighbour_list[at] = j;
+            same = list_set(c, i, j) && same;
           }
           ++c;
         }

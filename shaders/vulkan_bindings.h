@@ -64,7 +64,14 @@
 // same for when it runs (written once at allocate); neighbours_update.comp copies or zeroes the
 // first.
 #define B_INDIRECT_ARGS 55
-#define B_COUNT 56
+// uint: the neighbour list's column blocks after the first (B_NEIGHBOUR_LIST), when one buffer
+// cannot hold every column (maxStorageBufferRange): block b holds columns [b C, (b + 1) C) with
+// C = StepParams::neighbour_columns (kernel_common.glsl: list_entry).
+#define B_NEIGHBOUR_LIST_1 56
+#define B_NEIGHBOUR_LIST_2 57
+#define B_NEIGHBOUR_LIST_3 58
+#define NEIGHBOUR_LIST_BLOCKS 4
+#define B_COUNT 59
 
 // Threads per workgroup of every kernel; the scan handles 4 elements per thread.
 #define WORKGROUP_SIZE 256

@@ -75,6 +75,12 @@ const char* binding_name(std::uint32_t binding) {
       return "ScanScratch (scratch)";
     case B_INDIRECT_ARGS:
       return "IndirectArgs (scratch)";
+    case B_NEIGHBOUR_LIST_1:
+      return "NeighbourList (columns of block 1)";
+    case B_NEIGHBOUR_LIST_2:
+      return "NeighbourList (columns of block 2)";
+    case B_NEIGHBOUR_LIST_3:
+      return "NeighbourList (columns of block 3)";
     default:
       return "?";
   }
@@ -118,6 +124,11 @@ std::uint64_t spirv_bindings(const std::uint32_t* words, std::size_t count) {
 }
 
 VkDeviceSize round_up(VkDeviceSize x, VkDeviceSize to) { return (x + to - 1) / to * to; }
+
+/// The binding of the neighbour list's column block k.
+std::uint32_t list_binding(std::uint32_t k) {
+  return k == 0 ? std::uint32_t{B_NEIGHBOUR_LIST} : B_NEIGHBOUR_LIST_1 + (k - 1);
+}
 
 /// Bytes of the region a buffer's descriptor covers (never 0: Vulkan has no empty buffers).
 VkDeviceSize padded(VkDeviceSize data_bytes) {
@@ -214,6 +225,10 @@ Status VulkanDevice::init_queue(std::uint32_t queue_index) {
   if (const char* env = std::getenv("MOTES_VULKAN_MAX_GROUPS_X"); env != nullptr && *env != '\0') {
     const long v = std::strtol(env, nullptr, 10);
     if (v >= 1 && v < 65535) max_groups_x_ = static_cast<std::uint64_t>(v);
+  }
+  if (const char* env = std::getenv("MOTES_VULKAN_LIST_COLUMNS"); env != nullptr && *env != '\0') {
+    const long v = std::strtol(env, nullptr, 10);
+    if (v >= 1 && v < 65536) list_columns_cap_ = static_cast<std::uint32_t>(v);
   }
   vkGetDeviceQueue(device_, physical_.compute_family, queue_index, &queue_);
   vkGetPhysicalDeviceMemoryProperties(physical_.handle, &memory_);
@@ -516,9 +531,12 @@ Status VulkanDevice::allocate(const Sizes& sizes) {
     rebuild_args.insert(rebuild_args.end(), {grid[0], grid[1], grid[2], 0u});
   }
 
+  list_columns_ = list_columns(sizes);
   for (std::uint32_t i = 0; i < kBindingCount; ++i) {
     VkDeviceSize bytes = 0;
-    if (i < kBufferCount) {
+    if (const int block = list_block(i); block >= 0) {
+      bytes = list_block_bytes(sizes, list_columns_, static_cast<std::uint32_t>(block));
+    } else if (i < kBufferCount) {
       bytes = buffer_layout(static_cast<Buffer>(i), sizes).bytes();
     } else if (i == B_SCAN_SCRATCH) {
       bytes = VkDeviceSize{scratch_words} * 4;
@@ -625,9 +643,12 @@ BufferSize VulkanDevice::largest_buffer(const Sizes& sizes) const {
   // scan's block sums: fewer than T / (SCAN_BLOCK - 1) + 64 words), each padded as allocate()
   // pads it. The rebuild's indirect arguments are a few hundred bytes.
   BufferSize largest;
+  const std::uint32_t columns = list_columns(sizes);
   for (std::uint32_t i = 0; i < kBindingCount; ++i) {
     std::uint64_t bytes = 0;
-    if (i < kBufferCount) {
+    if (const int block = list_block(i); block >= 0) {
+      bytes = list_block_bytes(sizes, columns, static_cast<std::uint32_t>(block));
+    } else if (i < kBufferCount) {
       bytes = buffer_layout(static_cast<Buffer>(i), sizes).bytes();
     } else if (i == B_SCAN_SCRATCH) {
       bytes = ((std::uint64_t{sizes.table} + 1) / (SCAN_BLOCK - 1) + 64) * 4;
@@ -651,12 +672,70 @@ BufferLimit VulkanDevice::buffer_limit() const {
   return limit;
 }
 
+std::uint32_t VulkanDevice::list_columns(const Sizes& sizes) const {
+  const std::uint32_t k = sizes.neighbour_capacity;
+  const VkDeviceSize column = VkDeviceSize{sizes.particles} * 4;
+  if (k == 0 || column == 0) return 0;
+  const VkDeviceSize limit = buffer_limit().bytes;
+  std::uint64_t fit = limit / column;  // columns one buffer holds, padded as allocate pads it
+  while (fit > 0 && padded(fit * column) > limit) --fit;
+  if (list_columns_cap_ != 0) fit = std::min<std::uint64_t>(fit, list_columns_cap_);
+  if (fit >= k) return 0;  // one buffer holds the whole list
+  // At most NEIGHBOUR_LIST_BLOCKS blocks: wider ones than fit are refused by allocate's check.
+  const std::uint32_t fewest = (k + NEIGHBOUR_LIST_BLOCKS - 1) / NEIGHBOUR_LIST_BLOCKS;
+  return std::max(static_cast<std::uint32_t>(fit), fewest);
+}
+
+int VulkanDevice::list_block(std::uint32_t binding) {
+  if (binding == B_NEIGHBOUR_LIST) return 0;
+  if (binding >= B_NEIGHBOUR_LIST_1 && binding <= B_NEIGHBOUR_LIST_3) {
+    return static_cast<int>(binding - B_NEIGHBOUR_LIST_1) + 1;
+  }
+  return -1;
+}
+
+VkDeviceSize VulkanDevice::list_block_bytes(const Sizes& sizes, std::uint32_t columns,
+                                            std::uint32_t block) {
+  const std::uint32_t k = sizes.neighbour_capacity;
+  const std::uint32_t width = columns == 0 ? k : columns;
+  const std::uint64_t first = std::uint64_t{block} * width;
+  if (first >= k) return 0;
+  return std::min<std::uint64_t>(width, k - first) * VkDeviceSize{sizes.particles} * 4;
+}
+
+std::vector<VulkanDevice::Piece> VulkanDevice::pieces(Buffer b, VkDeviceSize offset,
+                                                      VkDeviceSize bytes) const {
+  std::vector<Piece> out;
+  if (b != Buffer::NeighbourList) {
+    out.push_back({static_cast<std::uint32_t>(b), offset, 0, bytes});
+    return out;
+  }
+  // The column blocks are consecutive ranges of the whole list (entry k of particle i at k N + i).
+  VkDeviceSize start = 0;
+  for (std::uint32_t k = 0; k < NEIGHBOUR_LIST_BLOCKS; ++k) {
+    const VkDeviceSize end = start + buffers_[list_binding(k)].data_bytes;
+    const VkDeviceSize lo = std::max(offset, start);
+    const VkDeviceSize hi = std::min(offset + bytes, end);
+    if (lo < hi) out.push_back({list_binding(k), lo - start, lo - offset, hi - lo});
+    start = end;
+  }
+  return out;
+}
+
+VkDeviceSize VulkanDevice::data_bytes(Buffer b) const {
+  if (b != Buffer::NeighbourList) return buffers_[static_cast<std::size_t>(b)].data_bytes;
+  VkDeviceSize sum = 0;
+  for (std::uint32_t k = 0; k < NEIGHBOUR_LIST_BLOCKS; ++k) {
+    sum += buffers_[list_binding(k)].data_bytes;
+  }
+  return sum;
+}
+
 Status VulkanDevice::write(Buffer b, const void* src, std::size_t bytes) {
-  const auto i = static_cast<std::size_t>(b);
   if (!allocated_) return Status::error("vulkan: write before allocate");
-  if (bytes > buffers_[i].data_bytes) {
+  if (bytes > data_bytes(b)) {
     return Status::error(fmt::format("vulkan: writing {} bytes into {} of {} bytes", bytes,
-                                     buffer_name(b), buffers_[i].data_bytes));
+                                     buffer_name(b), data_bytes(b)));
   }
   if (b == Buffer::BodyFirst) {  // which impulses_apply shader suits the bodies
     largest_body_ = 0;
@@ -678,8 +757,10 @@ Status VulkanDevice::write(Buffer b, const void* src, std::size_t bytes) {
   if (Status s = ensure_staging(bytes); !s) return s;
   std::memcpy(staging_.mapped, src, bytes);
   return run_once([&](VkCommandBuffer cb) {
-    const VkBufferCopy region{0, 0, bytes};
-    vkCmdCopyBuffer(cb, staging_.buffer, buffers_[i].buffer, 1, &region);
+    for (const Piece& piece : pieces(b, 0, bytes)) {
+      const VkBufferCopy region{piece.at, piece.offset, piece.bytes};
+      vkCmdCopyBuffer(cb, staging_.buffer, buffers_[piece.binding].buffer, 1, &region);
+    }
   });
 }
 
@@ -687,35 +768,37 @@ Status VulkanDevice::write_at(Buffer b, std::size_t offset, const void* src, std
   // BodyFirst's whole contents choose the impulses_apply shader: the patched buffer goes through
   // write.
   if (b == Buffer::BodyFirst) return Device::write_at(b, offset, src, bytes);
-  const auto i = static_cast<std::size_t>(b);
   if (!allocated_) return Status::error("vulkan: write before allocate");
-  if (offset > buffers_[i].data_bytes || bytes > buffers_[i].data_bytes - offset) {
+  if (offset > data_bytes(b) || bytes > data_bytes(b) - offset) {
     return Status::error(fmt::format("vulkan: writing {} bytes at {} into {} of {} bytes", bytes,
-                                     offset, buffer_name(b), buffers_[i].data_bytes));
+                                     offset, buffer_name(b), data_bytes(b)));
   }
   if (bytes == 0) return Status::ok();
   if (Status s = flush(); !s) return s;
   if (Status s = ensure_staging(bytes); !s) return s;
   std::memcpy(staging_.mapped, src, bytes);
   return run_once([&](VkCommandBuffer cb) {
-    const VkBufferCopy region{0, offset, bytes};
-    vkCmdCopyBuffer(cb, staging_.buffer, buffers_[i].buffer, 1, &region);
+    for (const Piece& piece : pieces(b, offset, bytes)) {
+      const VkBufferCopy region{piece.at, piece.offset, piece.bytes};
+      vkCmdCopyBuffer(cb, staging_.buffer, buffers_[piece.binding].buffer, 1, &region);
+    }
   });
 }
 
 Status VulkanDevice::read(Buffer b, void* dst, std::size_t bytes) {
-  const auto i = static_cast<std::size_t>(b);
   if (!allocated_) return Status::error("vulkan: read before allocate");
-  if (bytes > buffers_[i].data_bytes) {
+  if (bytes > data_bytes(b)) {
     return Status::error(fmt::format("vulkan: reading {} bytes from {} of {} bytes", bytes,
-                                     buffer_name(b), buffers_[i].data_bytes));
+                                     buffer_name(b), data_bytes(b)));
   }
   if (bytes == 0) return synchronize();
   if (Status s = flush(); !s) return s;
   if (Status s = ensure_staging(bytes); !s) return s;
   if (Status s = run_once([&](VkCommandBuffer cb) {
-        const VkBufferCopy region{0, 0, bytes};
-        vkCmdCopyBuffer(cb, buffers_[i].buffer, staging_.buffer, 1, &region);
+        for (const Piece& piece : pieces(b, 0, bytes)) {
+          const VkBufferCopy region{piece.offset, piece.at, piece.bytes};
+          vkCmdCopyBuffer(cb, buffers_[piece.binding].buffer, staging_.buffer, 1, &region);
+        }
       });
       !s) {
     return s;

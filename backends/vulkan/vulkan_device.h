@@ -250,6 +250,27 @@ class VulkanDevice final : public Device {
   /// Workgroups per dispatch dimension: 65,535 (Vulkan's guaranteed minimum), or less when
   /// MOTES_VULKAN_MAX_GROUPS_X says so (tests use it to exercise the 2D dispatch on small sizes).
   std::uint64_t max_groups_x_ = 65535;
+  /// The neighbour list's columns per storage buffer (0: one buffer holds them all), set by
+  /// allocate; at most list_columns_cap_ columns a block when set (MOTES_VULKAN_LIST_COLUMNS, so
+  /// that tests reach the split list at small sizes).
+  std::uint32_t list_columns_ = 0;
+  std::uint32_t list_columns_cap_ = 0;
+  /// Columns per block of the neighbour list for these sizes: 0 when one storage buffer holds the
+  /// whole list, else as many as one buffer holds, and at least K / NEIGHBOUR_LIST_BLOCKS.
+  [[nodiscard]] std::uint32_t list_columns(const Sizes& sizes) const;
+  /// The column block a binding holds (-1: not the list's).
+  static int list_block(std::uint32_t binding);
+  static VkDeviceSize list_block_bytes(const Sizes& sizes, std::uint32_t columns,
+                                       std::uint32_t block);
+  /// Where bytes [offset, offset + bytes) of buffer b live: binding, offset there, offset in the
+  /// caller's bytes, length (the neighbour list's column blocks are consecutive ranges of it).
+  struct Piece {
+    std::uint32_t binding;
+    VkDeviceSize offset, at, bytes;
+  };
+  [[nodiscard]] std::vector<Piece> pieces(Buffer b, VkDeviceSize offset, VkDeviceSize bytes) const;
+  /// The bytes of b's data (the neighbour list: of every block).
+  [[nodiscard]] VkDeviceSize data_bytes(Buffer b) const;
   bool use_subgroups_ = false;  ///< the subgroup-arithmetic variant of the block scan
   std::vector<Op> pending_;
   std::vector<Recording> recordings_;

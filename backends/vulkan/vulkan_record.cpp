@@ -110,7 +110,9 @@ void VulkanDevice::bind(VkCommandBuffer cb, Pipeline pipeline, const PushConstan
   vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
   vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layouts_[i], 0, 1, &sets_[i],
                           0, nullptr);
-  vkCmdPushConstants(cb, pipeline_layouts_[i], VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+  PushConstants q = push;
+  q.params.neighbour_columns = list_columns_;  // the list's blocks (kernel_common.glsl: list_entry)
+  vkCmdPushConstants(cb, pipeline_layouts_[i], VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(q), &q);
 }
 
 void VulkanDevice::dispatch_groups(VkCommandBuffer cb, Pipeline pipeline,

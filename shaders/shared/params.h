@@ -95,7 +95,7 @@ struct StepParams {
   uint halo_first;            // halo_pack, halo_unpack: their first word in HaloIndex
   uint fluid_first;           // Nf: particles [Nf, Nf + fluid_count) are fluid (docs/fluids.md),
   uint fluid_count;           // a range of free particles ending at Ns; 0: no fluid
-  uint reserved0;             // 0
+  uint neighbour_columns;     // Vulkan: list columns per storage buffer (0: one buffer holds all)
   uint reserved1;             // 0
 };
 
