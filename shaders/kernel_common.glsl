@@ -86,8 +86,14 @@ layout(std430, binding = B_INDIRECT_ARGS) buffer IndirectArgsBuf { uint indirect
 // Entry k of particle i's neighbour list (entry k at k N + i of the whole list). A list too large
 // for one storage buffer is split into column blocks of p.neighbour_columns columns (0: one block),
 // bound as B_NEIGHBOUR_LIST, then _1 to _3.
+uint list_block(uint k) {  // comparisons, not a division: this is on every neighbour's path
+  uint c = p.neighbour_columns;
+  if (c == 0u || k < c) return 0u;
+  return k < 2u * c ? 1u : (k < 3u * c ? 2u : 3u);
+}
+
 uint list_entry(uint k, uint i) {
-  uint b = p.neighbour_columns == 0u ? 0u : k / p.neighbour_columns;
+  uint b = list_block(k);
   uint at = (k - b * p.neighbour_columns) * p.particle_count + i;
   if (b == 0u) return neighbour_list[at];
   if (b == 1u) return neighbour_list_1[at];
@@ -97,7 +103,7 @@ uint list_entry(uint k, uint i) {
 
 // Sets entry k of particle i to j; returns whether it was j already.
 bool list_set(uint k, uint i, uint j) {
-  uint b = p.neighbour_columns == 0u ? 0u : k / p.neighbour_columns;
+  uint b = list_block(k);
   uint at = (k - b * p.neighbour_columns) * p.particle_count + i;
   uint was;
   if (b == 0u) {
