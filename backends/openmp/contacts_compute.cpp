@@ -5,9 +5,6 @@
 // A contact of two particles that list each other is evaluated once, by the lower id, when the
 // contact laws are symmetric (contact_pairs.cpp): the same terms, half the work.
 // With MOTES_FLAG_POSITION: the shifts of position contacts and their number (contacts_shift.cpp).
-#include <algorithm>
-#include <array>
-#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <new>
@@ -54,20 +51,26 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
   // A pair of rigid particles under impulse contacts gets no force here from either side.
   const auto no_force = [&](uint a, uint b) { return impulses && a < rigid && b < rigid; };
 
-  // The shared pairs first, each for its lower id; which particles' pairs touch.
-  const uint* pair_id = nullptr;
-  const vec4* pair_force = nullptr;
-  const std::uint8_t* touched = nullptr;
-  const uint* unpaired = nullptr;
-  if (laws_symmetric(laws, materials) && share_pairs(in, stride, capacity)) {
-    contact_pairs_compute(p, in);
-    pair_id = contact_pair_id_.data();
-    pair_force = contact_pairs_.data();
-    touched = contact_touched_.data();
-    unpaired = contact_unpaired_.data();
+  // Every list slot's term first: a shared pair's for both its slots, the others by their own.
+  // Worth it when at least half the entries touched at the last call (a dense pile; not while
+  // they fall apart, where a slot's write and read cost more than the distance it saves). Both
+  // ways give the same sums, and the choice follows the counts: deterministic.
+  const uint* slot_first = nullptr;
+  const vec4* slot_force = nullptr;
+  std::uint64_t touching = 0;
+  std::uint64_t entries = 0;
+  const bool worth = shared_pairs_ == SharedPairs::Always ||
+                     (shared_pairs_ == SharedPairs::Auto && contact_entries_ > 0 &&
+                      2 * contact_touching_ >= contact_entries_);
+  if (worth && laws_symmetric(laws, materials) && share_pairs(in, stride, capacity)) {
+    touching = contact_slots_compute(p, in);
+    entries = contact_slot_force_.size();
+    slot_first = contact_slot_first_.data();
+    slot_force = contact_slot_force_.data();
   }
 
-#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n))
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(n)) \
+    reduction(+ : touching, entries)
   for (std::int64_t i = 0; i < n; ++i) {
     const vec4 pi = pos[i];
     const vec4 vi = vel[i];
@@ -83,28 +86,19 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
     auto add_contact = [&](uint j) {
       if (no_force(uint(i), j)) return;
       const vec4 pj = pos[j];
+      const vec3 d = shared::xyz(pj) - xi;  // apart: particle_contact_force's own first test
+      if (shared::dot(d, d) >= (pi.w + pj.w) * (pi.w + pj.w)) return;
+      ++touching;
       const vec4 vj = vel[j];
       f += shared::particle_contact_force(xi, ui, pi.w, vi.w, shared::xyz(pj), shared::xyz(vj),
                                           pj.w, vj.w, law_row[material[j]], p.flags);
     };
     const uint c = count[i];
-    // Nothing to add from the list when its pairs all missed and it has no slot of its own.
-    const bool quiet = pair_id != nullptr && touched[i] == 0u && unpaired[i] == 0u;
-    if (c <= capacity) {
-      for (uint k = 0; k < (quiet ? 0u : c); ++k) {
-        const std::size_t at = std::size_t{k} * stride + std::size_t(i);
-        const uint j = list[at];
-        const uint id = pair_id != nullptr ? pair_id[at] : kNoPair;
-        if (id == kNoPair) {
-          add_contact(j);
-        } else if (touched[i] != 0u && !no_force(uint(i), j)) {
-          // The lower id's force, or its negation (0 - x: a pair out of contact adds +0 on both
-          // sides, as its own evaluation would).
-          const vec3 lower = shared::xyz(pair_force[id]);
-          const vec3 higher = vec3(0.0f) - lower;
-          f += j > uint(i) ? lower : higher;
-        }
-      }
+    if (c <= capacity && slot_force != nullptr) {
+      for (uint s = slot_first[i]; s < slot_first[i + 1]; ++s) f += shared::xyz(slot_force[s]);
+    } else if (c <= capacity) {
+      for (uint k = 0; k < c; ++k) add_contact(list[std::size_t{k} * stride + std::size_t(i)]);
+      entries += c;
     } else {
       const uint body_i = body[i];
       const shared::GridRanges ranges = shared::grid_ranges(p, ref[i], cell_start);
@@ -126,38 +120,60 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
     }
     force[i] = vec4(f, 0.0f);
   }
+  contact_touching_ = touching;
+  contact_entries_ = entries;
   record(Kernel::ContactsCompute, start);
 }
 
-void OpenMPDevice::contact_pairs_compute(const shared::StepParams& p, const ContactInputs& in) {
-  const auto pairs = static_cast<std::int64_t>(contact_pairs_.size());
+std::uint64_t OpenMPDevice::contact_slots_compute(const shared::StepParams& p,
+                                                  const ContactInputs& in) {
   const uint materials = p.material_count;
+  const std::size_t stride = p.particle_count;
   const bool impulses = (p.flags & MOTES_FLAG_IMPULSE) != 0u;
-  const std::array<uint, 2>* ends = contact_pair_ends_.data();
-  vec4* out = contact_pairs_.data();
-  std::uint8_t* touched = contact_touched_.data();
-  std::fill(contact_touched_.begin(), contact_touched_.end(), std::uint8_t{0});
-#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(pairs))
-  for (std::int64_t q = 0; q < pairs; ++q) {
-    const uint a = ends[q][0];
-    const uint b = ends[q][1];
+  const uint rigid = p.rigid_particle_count;
+  vec4* out = contact_slot_force_.data();
+  // The force on particle a from b, or 0: neither moves (nobody reads it), or two rigid particles
+  // under impulse contacts (impulses_compute has them).
+  const auto term = [&](uint a, uint b) {
     const vec4 pa = in.pos[a];
-    const vec4 va = in.vel[a];
     const vec4 pb = in.pos[b];
+    // Apart: 0 (particle_contact_force's own first test), before anything else is read.
+    const vec3 d = shared::xyz(pb) - shared::xyz(pa);
+    const float reach = pa.w + pb.w;
+    if (shared::dot(d, d) >= reach * reach) return vec3(0.0f);
+    const vec4 va = in.vel[a];
     const vec4 vb = in.vel[b];
-    vec3 f(0.0f);
-    // Neither moves (nobody reads it), or two rigid particles under impulse contacts: no force.
-    if ((va.w != 0.0f || vb.w != 0.0f) && !(impulses && b < p.rigid_particle_count)) {
-      f = shared::particle_contact_force(
-          shared::xyz(pa), shared::xyz(va), pa.w, va.w, shared::xyz(pb), shared::xyz(vb), pb.w,
-          vb.w, in.laws[std::size_t{in.material[a]} * materials + in.material[b]], p.flags);
-    }
-    out[q] = vec4(f, 0.0f);
-    if (f.x != 0.0f || f.y != 0.0f || f.z != 0.0f) {  // the bytes may be another thread's pair's
-      std::atomic_ref<std::uint8_t>(touched[a]).store(1u, std::memory_order_relaxed);
-      std::atomic_ref<std::uint8_t>(touched[b]).store(1u, std::memory_order_relaxed);
-    }
+    if ((va.w == 0.0f && vb.w == 0.0f) || (impulses && a < rigid && b < rigid)) return vec3(0.0f);
+    return shared::particle_contact_force(
+        shared::xyz(pa), shared::xyz(va), pa.w, va.w, shared::xyz(pb), shared::xyz(vb), pb.w, vb.w,
+        in.laws[std::size_t{in.material[a]} * materials + in.material[b]], p.flags);
+  };
+  const ContactPair* pairs = contact_pair_list_.data();
+  const auto pair_count = static_cast<std::int64_t>(contact_pair_list_.size());
+  std::uint64_t touching = 0;
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(pair_count)) \
+    reduction(+ : touching)
+  for (std::int64_t q = 0; q < pair_count; ++q) {
+    const ContactPair pr = pairs[q];
+    const vec3 f = term(pr.a, pr.b);
+    touching += f.x != 0.0f || f.y != 0.0f || f.z != 0.0f ? 2u : 0u;
+    out[pr.slot_a] = vec4(f, 0.0f);
+    // 0 - f: a pair out of contact gives +0 on both sides, as each side's own evaluation would.
+    out[pr.slot_b] = vec4(vec3(0.0f) - f, 0.0f);
   }
+  const ContactSlot* own = contact_own_slots_.data();
+  const auto own_count = static_cast<std::int64_t>(contact_own_slots_.size());
+  const uint* first = contact_slot_first_.data();
+#pragma omp parallel for num_threads(team_) schedule(static) if (parallel(own_count)) \
+    reduction(+ : touching)
+  for (std::int64_t q = 0; q < own_count; ++q) {
+    const ContactSlot sl = own[q];
+    const uint j = in.list[std::size_t{sl.k} * stride + sl.i];
+    const vec3 f = term(sl.i, j);
+    touching += f.x != 0.0f || f.y != 0.0f || f.z != 0.0f ? 1u : 0u;
+    out[first[sl.i] + sl.k] = vec4(f, 0.0f);
+  }
+  return touching;
 }
 
 bool OpenMPDevice::laws_symmetric(const shared::ContactLaw* laws, uint materials) {
@@ -177,14 +193,13 @@ bool OpenMPDevice::laws_symmetric(const shared::ContactLaw* laws, uint materials
 
 bool OpenMPDevice::share_pairs(const ContactInputs& in, std::size_t n, uint capacity) {
   try {
-    contact_pairs_index(in, n, capacity);
-    return true;
+    return contact_pairs_index(in, n, capacity);
   } catch (const std::bad_alloc&) {  // no room for the pairs: every particle evaluates its own
-    contact_pair_id_ = {};
-    contact_pair_ends_ = {};
-    contact_pairs_ = {};
-    contact_unpaired_ = {};
-    contact_touched_ = {};
+    contact_pairs_ready_ = false;
+    contact_slot_first_ = {};
+    contact_pair_list_ = {};
+    contact_own_slots_ = {};
+    contact_slot_force_ = {};
     return false;
   }
 }

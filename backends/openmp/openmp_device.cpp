@@ -80,6 +80,12 @@ OpenMPDevice::OpenMPDevice(int threads, int min_parallel)
   share_ = CpuShare(threads_, threads <= 0 && !(adapt != nullptr && std::string(adapt) == "0"));
   team_ = share_.team();
   info_ = describe(threads_);
+  // contacts_compute's shared pairs: "0" never, "1" always (tests reach both ways), else by the
+  // last call's touching entries.
+  if (const char* pairs = std::getenv("MOTES_OPENMP_SHARED_PAIRS"); pairs != nullptr) {
+    if (std::string(pairs) == "0") shared_pairs_ = SharedPairs::Never;
+    if (std::string(pairs) == "1") shared_pairs_ = SharedPairs::Always;
+  }
   if (share_.adapting()) info_.detail += ", fewer while other processes keep the CPUs busy";
 }
 
@@ -119,7 +125,7 @@ Status OpenMPDevice::allocate(const Sizes& sizes) {
     buffers_ = std::move(fresh);
     forget_impulse_passes();
     impulse_mirror_.clear();
-    contact_pair_id_.clear();
+    contact_pairs_ready_ = false;
   } catch (const std::bad_alloc&) {
     return Status::error(
         fmt::format("out of host memory allocating {} particles and {} bodies on the openmp device",
@@ -160,7 +166,7 @@ void OpenMPDevice::wrote(Buffer b) {
   impulse_points_ready_ = false;    // and the particles' places (poses, offsets)
   if (b == Buffer::NeighbourList || b == Buffer::NeighbourCount) {
     impulse_mirror_.clear();
-    contact_pair_id_.clear();
+    contact_pairs_ready_ = false;
   }
   // New positions or lists: the last counting pass no longer says who touches whom.
   if (b == Buffer::ParticlePos || b == Buffer::NeighbourList || b == Buffer::NeighbourCount) {

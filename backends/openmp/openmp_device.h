@@ -141,23 +141,35 @@ class OpenMPDevice final : public Device {
   std::vector<std::uint32_t> impulse_mirror_;
   std::vector<shared::vec4> impulse_pair_;
   /// contacts_compute evaluates a contact of two particles that list each other once
-  /// (contact_pairs.cpp): per list slot k of particle i (k N + i), the pair's number
-  /// (kNoPair: none, the particle evaluates it itself), made at the first contacts_compute after
-  /// the lists changed (emptied with impulse_mirror_); per pair its ids (lower first) and its
-  /// force on the lower id; per particle its slots without a pair, and whether any of its pairs
-  /// touched this call (1) or not (0: they all add nothing).
+  /// (contact_pairs.cpp), made at the first contacts_compute after the lists changed
+  /// (contact_pairs_ready_ false: neighbours_build, allocate, a write to the lists). Each list
+  /// slot's term lives in contact_slot_force_, particle i's from contact_slot_first_[i]; a pair
+  /// writes both its slots, a slot no pair covers (contact_own_slots_) is evaluated by its
+  /// particle.
   static constexpr std::uint32_t kNoPair = 0xffffffffu;
-  std::vector<std::uint32_t> contact_pair_id_;
-  std::vector<std::array<std::uint32_t, 2>> contact_pair_ends_;
-  std::vector<shared::vec4> contact_pairs_;
-  std::vector<std::uint32_t> contact_unpaired_;
-  std::vector<std::uint8_t> contact_touched_;
-  void contact_pairs_index(const ContactInputs& in, std::size_t n, std::uint32_t capacity);
-  /// Makes the pairs' numbers for these lists; false (and every particle evaluates its own
-  /// contacts) when there is no memory for them.
+  struct ContactPair {
+    std::uint32_t a, b, slot_a, slot_b;  ///< the ids (a < b) and their slots' places
+  };
+  struct ContactSlot {
+    std::uint32_t i, k;  ///< particle i's list slot k
+  };
+  bool contact_pairs_ready_ = false;
+  std::vector<std::uint32_t> contact_slot_first_;
+  std::vector<ContactPair> contact_pair_list_;
+  std::vector<ContactSlot> contact_own_slots_;
+  std::vector<shared::vec4> contact_slot_force_;
+  /// Makes the pairs for these lists; false when the slots do not fit 32-bit places.
+  bool contact_pairs_index(const ContactInputs& in, std::size_t n, std::uint32_t capacity);
+  /// contact_pairs_index, and false (every particle then evaluates its own contacts) when there
+  /// is no memory for it.
   bool share_pairs(const ContactInputs& in, std::size_t n, std::uint32_t capacity);
-  /// Each shared pair's force on its lower id, and which particles' pairs touch.
-  void contact_pairs_compute(const shared::StepParams& p, const ContactInputs& in);
+  /// Every slot's term: the pairs' and the own slots'; returns the slots whose term is not 0.
+  std::uint64_t contact_slots_compute(const shared::StepParams& p, const ContactInputs& in);
+  /// The last contacts_compute's list entries within capacity, and those that touched: it shares
+  /// pairs when at least half touched.
+  std::uint64_t contact_touching_ = 0, contact_entries_ = 0;
+  enum class SharedPairs : std::uint8_t { Auto, Never, Always };
+  SharedPairs shared_pairs_ = SharedPairs::Auto;  ///< MOTES_OPENMP_SHARED_PAIRS
   /// True when the law of materials a and b is the law of b and a (the table of
   /// core/src/contact_laws.cpp always is; a buffer written by hand need not be).
   static bool laws_symmetric(const shared::ContactLaw* laws, std::uint32_t materials);
