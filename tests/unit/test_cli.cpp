@@ -478,8 +478,8 @@ TEST(Cli, BenchRealtimeNamesScenesItCannotRun) {
   EXPECT_TRUE(contains(empty.err, "holds no .json scene file")) << describe(empty);
 }
 
-// W1 at 268,435,456 spheres is a size (issue 30), but building its scene takes about 400 B of host
-// memory a sphere (630 B with the openmp device's): where MemAvailable is short of that, bench
+// W1 at 268,435,456 spheres is a size (issue 30), but building its scene takes about 420 B of host
+// memory a sphere (880 B with the openmp device's): where MemAvailable is short of that, bench
 // refuses it before building anything, names both numbers and runs the other sizes.
 TEST(Cli, BenchRefusesAW1SizeBeyondHostMemory) {
   std::ifstream meminfo("/proc/meminfo");
@@ -490,7 +490,7 @@ TEST(Cli, BenchRefusesAW1SizeBeyondHostMemory) {
   }
   if (available == 0) GTEST_SKIP() << "no MemAvailable in /proc/meminfo";
   constexpr std::uint64_t kSpheres = 268435456;
-  if (available >= kSpheres * 630u) {
+  if (available >= kSpheres * 880u) {
     GTEST_SKIP() << "this machine has room for W1 at 268,435,456 on openmp: it would run it";
   }
   TempDir tmp;
@@ -500,7 +500,7 @@ TEST(Cli, BenchRefusesAW1SizeBeyondHostMemory) {
             "2", "--repeats", "1", "--cache", tmp / "cache"});
   EXPECT_EQ(o.exit_code, 2) << describe(o);
   EXPECT_TRUE(contains(o.err,
-                       "W1 at 268435456 spheres needs about 169.1 GB of host memory (630 "
+                       "W1 at 268435456 spheres needs about 236.2 GB of host memory (880 "
                        "B a sphere"))
       << describe(o);
   EXPECT_TRUE(contains(o.err, "is available here (MemAvailable): refused; at most "))
