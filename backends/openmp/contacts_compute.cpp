@@ -16,6 +16,18 @@
 
 namespace motes::openmp {
 
+namespace {
+
+// particle_contact_force's own first test (apart: no force), made before the partner's velocity
+// and material are read: most list entries are apart while particles fall.
+bool apart(const shared::vec4& a, const shared::vec4& b) {
+  const shared::vec3 d = shared::xyz(b) - shared::xyz(a);
+  const float reach = a.w + b.w;
+  return shared::dot(d, d) >= reach * reach;
+}
+
+}  // namespace
+
 using shared::uint;
 using shared::vec3;
 using shared::vec4;
@@ -86,8 +98,7 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
     auto add_contact = [&](uint j) {
       if (no_force(uint(i), j)) return;
       const vec4 pj = pos[j];
-      const vec3 d = shared::xyz(pj) - xi;  // apart: particle_contact_force's own first test
-      if (shared::dot(d, d) >= (pi.w + pj.w) * (pi.w + pj.w)) return;
+      if (apart(pi, pj)) return;
       ++touching;
       const vec4 vj = vel[j];
       f += shared::particle_contact_force(xi, ui, pi.w, vi.w, shared::xyz(pj), shared::xyz(vj),
@@ -137,10 +148,7 @@ std::uint64_t OpenMPDevice::contact_slots_compute(const shared::StepParams& p,
   const auto term = [&](uint a, uint b) {
     const vec4 pa = in.pos[a];
     const vec4 pb = in.pos[b];
-    // Apart: 0 (particle_contact_force's own first test), before anything else is read.
-    const vec3 d = shared::xyz(pb) - shared::xyz(pa);
-    const float reach = pa.w + pb.w;
-    if (shared::dot(d, d) >= reach * reach) return vec3(0.0f);
+    if (apart(pa, pb)) return vec3(0.0f);
     const vec4 va = in.vel[a];
     const vec4 vb = in.vel[b];
     if ((va.w == 0.0f && vb.w == 0.0f) || (impulses && a < rigid && b < rigid)) return vec3(0.0f);
