@@ -96,7 +96,9 @@ int main(int argc, char** argv) try {
   if (!particles) return fail(particles.message());
   // The view: the first frame's extent in x and y, with a margin (a snapshot, once).
   float lo[2] = {1e30f, 1e30f}, hi[2] = {-1e30f, -1e30f};
-  for (const motes::shared::vec4& p : sim->snapshot().value().particle_pos) {
+  motes::Result<motes::Snapshot> first = sim->snapshot();
+  if (!first) return fail(first.message());
+  for (const motes::shared::vec4& p : first->particle_pos) {
     lo[0] = std::min(lo[0], p.x), hi[0] = std::max(hi[0], p.x);
     lo[1] = std::min(lo[1], p.y), hi[1] = std::max(hi[1], p.y);
   }

@@ -53,7 +53,10 @@ class Result {
     if (!value_) throw std::logic_error("Result::value() on an error: " + status_.message());
     return *value_;
   }
-  T&& value() && {
+  /// By value, so that a line such as `for (auto& p : sim.snapshot().value().particle_pos)` is
+  /// safe: a reference into the temporary Result would dangle there (C++20 does not extend the
+  /// Result's life through a call).
+  T value() && {
     if (!value_) throw std::logic_error("Result::value() on an error: " + status_.message());
     return std::move(*value_);
   }
