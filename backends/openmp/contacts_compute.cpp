@@ -4,7 +4,10 @@
 // then: the same pairs in the same order. No atomics: each particle writes only its own force.
 // A contact of two particles that list each other is evaluated once, by the lower id, when the
 // contact laws are symmetric (contact_pairs.cpp): the same terms, half the work.
+// A particle tests only the planes it may touch before the next list build (plane_masks.cpp): a
+// plane it skips would have added exactly 0.
 // With MOTES_FLAG_POSITION: the shifts of position contacts and their number (contacts_shift.cpp).
+#include <bit>
 #include <chrono>
 #include <cstdint>
 #include <new>
@@ -60,6 +63,7 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
   vec4* force = buf<vec4>(Buffer::ParticleForce);
   const bool impulses = (p.flags & MOTES_FLAG_IMPULSE) != 0u;
   const uint rigid = p.rigid_particle_count;
+  const std::uint32_t* plane_mask = plane_masks(p, ref);
   // A pair of rigid particles under impulse contacts gets no force here from either side.
   const auto no_force = [&](uint a, uint b) { return impulses && a < rigid && b < rigid; };
 
@@ -124,10 +128,18 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
       }
     }
     const bool by_impulse = shared::impulse_particle(p.flags, uint(i), rigid);
-    for (uint k = 0; k < (by_impulse ? 0u : p.plane_count); ++k) {
-      const shared::PlaneData pl = planes[k];
-      f += shared::plane_contact_force(xi, ui, pi.w, vi.w, pl.normal_offset, law_row[pl.material],
-                                       p.flags);
+    if (!by_impulse && plane_mask != nullptr) {  // the planes in reach, in order
+      for (std::uint32_t m = plane_mask[i]; m != 0u; m &= m - 1u) {
+        const shared::PlaneData pl = planes[std::countr_zero(m)];
+        f += shared::plane_contact_force(xi, ui, pi.w, vi.w, pl.normal_offset, law_row[pl.material],
+                                         p.flags);
+      }
+    } else {
+      for (uint k = 0; k < (by_impulse ? 0u : p.plane_count); ++k) {
+        const shared::PlaneData pl = planes[k];
+        f += shared::plane_contact_force(xi, ui, pi.w, vi.w, pl.normal_offset, law_row[pl.material],
+                                         p.flags);
+      }
     }
     force[i] = vec4(f, 0.0f);
   }

@@ -20,6 +20,7 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
   const auto start = std::chrono::steady_clock::now();
   impulse_mirror_.clear();       // new lists: impulses_compute finds each slot's mirror again
   contact_pairs_ready_ = false;  // and contacts_compute its shared pairs
+  plane_masks_ready_ = false;    // and the planes each particle may touch
   const auto n = static_cast<std::int64_t>(p.particle_count);
   const std::size_t stride = p.particle_count;
   const uint capacity = p.neighbour_capacity;

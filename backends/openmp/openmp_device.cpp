@@ -86,6 +86,10 @@ OpenMPDevice::OpenMPDevice(int threads, int min_parallel)
     if (std::string(pairs) == "0") shared_pairs_ = SharedPairs::Never;
     if (std::string(pairs) == "1") shared_pairs_ = SharedPairs::Always;
   }
+  // contacts_compute's plane masks (plane_masks.cpp): "0" tests every plane (tests compare).
+  if (const char* masks = std::getenv("MOTES_OPENMP_PLANE_MASKS"); masks != nullptr) {
+    plane_masks_on_ = std::string(masks) != "0";
+  }
   if (share_.adapting()) info_.detail += ", fewer while other processes keep the CPUs busy";
 }
 
@@ -126,6 +130,7 @@ Status OpenMPDevice::allocate(const Sizes& sizes) {
     forget_impulse_passes();
     impulse_mirror_.clear();
     contact_pairs_ready_ = false;
+    plane_masks_ready_ = false;
   } catch (const std::bad_alloc&) {
     return Status::error(
         fmt::format("out of host memory allocating {} particles and {} bodies on the openmp device",
@@ -164,6 +169,7 @@ Status OpenMPDevice::write_at(Buffer b, std::size_t offset, const void* src, std
 void OpenMPDevice::wrote(Buffer b) {
   impulse_contacts_ready_ = false;  // what the kept contact frames were made from may have changed
   impulse_points_ready_ = false;    // and the particles' places (poses, offsets)
+  plane_masks_ready_ = false;       // the places, radii or planes they were made from
   if (b == Buffer::NeighbourList || b == Buffer::NeighbourCount) {
     impulse_mirror_.clear();
     contact_pairs_ready_ = false;

@@ -168,6 +168,15 @@ class OpenMPDevice final : public Device {
   /// The last contacts_compute's list entries within capacity, and those that touched: it shares
   /// pairs when at least half touched.
   std::uint64_t contact_touching_ = 0, contact_entries_ = 0;
+  /// Per particle, the planes it may touch before the next list build (bit k: plane k), from
+  /// where the lists were built (plane_masks.cpp); made at the first contacts_compute after a
+  /// build, an allocate or any write (plane_masks_ready_ false).
+  std::vector<std::uint32_t> plane_masks_;
+  bool plane_masks_ready_ = false;
+  bool plane_masks_on_ = true;  ///< MOTES_OPENMP_PLANE_MASKS=0: every particle tests every plane
+  /// The masks for these lists, or nullptr: every particle tests every plane (more than 32
+  /// planes, no memory for them, or MOTES_OPENMP_PLANE_MASKS=0).
+  const std::uint32_t* plane_masks(const shared::StepParams& p, const shared::vec4* ref);
   enum class SharedPairs : std::uint8_t { Auto, Never, Always };
   SharedPairs shared_pairs_ = SharedPairs::Auto;  ///< MOTES_OPENMP_SHARED_PAIRS
   /// True when the law of materials a and b is the law of b and a (the table of

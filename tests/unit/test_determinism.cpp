@@ -77,16 +77,29 @@ bool bodies_touch(const motes::Snapshot& s) {
   return false;
 }
 
+/// True when a moving particle overlaps one of the scene's planes.
+bool touches_plane(const motes::Snapshot& s, const motes::Scene& scene) {
+  for (std::size_t i = 0; i < s.particle_pos.size(); ++i) {
+    if (s.particle_vel[i].w == 0.0f) continue;  // the static block
+    for (const motes::PlaneSpec& pl : scene.planes) {
+      const double gap = pl.normal.dot(motes_test::to_vec3(s.particle_pos[i]) - pl.point);
+      if (gap < static_cast<double>(s.particle_pos[i].w)) return true;
+    }
+  }
+  return false;
+}
+
 struct RunResult {
   std::uint64_t hash = 0;
-  std::uint64_t contact_steps = 0;  // samples with any contact force (planes included)
-  std::uint64_t body_contacts = 0;  // samples with particles of two bodies overlapping
+  std::uint64_t contact_steps = 0;   // samples with any contact force (planes included)
+  std::uint64_t body_contacts = 0;   // samples with particles of two bodies overlapping
+  std::uint64_t plane_contacts = 0;  // samples with a moving particle against a plane
 };
 
 /// threads = 0: the default device (OpenMP's thread count, small loops on one thread). Otherwise
 /// exactly `threads` threads with every loop split among them, however small (this scene has
 /// fewer particles than the backend's default threshold for going parallel).
-void run(int threads, std::uint64_t steps, RunResult& out) {
+void run(int threads, std::uint64_t steps, RunResult& out, double skin = -1.0) {
   motes::DeviceOptions options;
   options.cpu_threads = threads;
   if (threads > 0) options.cpu_min_parallel = 1;
@@ -97,7 +110,9 @@ void run(int threads, std::uint64_t steps, RunResult& out) {
     const std::string want = std::to_string(threads) + (threads == 1 ? " thread" : " threads");
     ASSERT_EQ(device.value()->info().detail.rfind(want, 0), 0u) << device.value()->info().detail;
   }
-  auto created = motes::Simulation::create(tumbling_scene(), std::move(device).value());
+  motes::Scene scene = tumbling_scene();
+  scene.settings.neighbour_skin = skin;
+  auto created = motes::Simulation::create(scene, std::move(device).value());
   ASSERT_TRUE(created) << created.message();
   motes::Simulation& sim = *created.value();
   for (std::uint64_t done = 0; done < steps; done += 10) {
@@ -113,6 +128,7 @@ void run(int threads, std::uint64_t steps, RunResult& out) {
     auto s = sim.snapshot();
     ASSERT_TRUE(s) << s.message();
     if (bodies_touch(*s)) ++out.body_contacts;
+    if (touches_plane(*s, scene)) ++out.plane_contacts;
   }
   ASSERT_TRUE(sim.check_finite());
   auto hash = sim.state_hash();
@@ -184,6 +200,34 @@ TEST(Determinism, SharedContactPairsGiveTheStateOfOwnEvaluations) {
   EXPECT_GT(own.body_contacts, kThreadSteps / 40) << "the bodies hardly collided";
   EXPECT_EQ(own.hash, shared_one.hash);
   EXPECT_EQ(own.hash, shared_two.hash);
+}
+
+// contacts_compute on openmp tests only the planes a particle may reach before the next list
+// build (backends/openmp/plane_masks.cpp); a skipped plane would have added exactly 0. The state
+// is that of every particle testing every plane (MOTES_OPENMP_PLANE_MASKS=0), to the bit: with
+// the default skin, at 1 and 2 threads, and with no skin (lists made every step). A mask that
+// left out a plane coming into reach between two builds fails it.
+TEST(Determinism, PlaneMasksGiveTheStateOfEveryPlaneTested) {
+  // The bodies reach the walls and the floor after about 0.03 s: all of kSteps.
+  const auto with = [](const char* masks, int threads, double skin, RunResult& out) {
+    ::setenv("MOTES_OPENMP_PLANE_MASKS", masks, 1);
+    run(threads, kSteps, out, skin);
+    ::unsetenv("MOTES_OPENMP_PLANE_MASKS");
+  };
+  RunResult every;
+  RunResult masked_one;
+  RunResult masked_two;
+  ASSERT_NO_FATAL_FAILURE(with("0", 1, -1.0, every));
+  ASSERT_NO_FATAL_FAILURE(with("1", 1, -1.0, masked_one));
+  ASSERT_NO_FATAL_FAILURE(with("1", 2, -1.0, masked_two));
+  EXPECT_GT(every.plane_contacts, kSteps / 40) << "hardly anything hit a plane: too weak";
+  EXPECT_EQ(every.hash, masked_one.hash);
+  EXPECT_EQ(every.hash, masked_two.hash);
+  RunResult every_unskinned;
+  RunResult masked_unskinned;
+  ASSERT_NO_FATAL_FAILURE(with("0", 1, 0.0, every_unskinned));
+  ASSERT_NO_FATAL_FAILURE(with("1", 1, 0.0, masked_unskinned));
+  EXPECT_EQ(every_unskinned.hash, masked_unskinned.hash);
 }
 
 }  // namespace
