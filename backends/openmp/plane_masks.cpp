@@ -6,7 +6,6 @@
 // at +0 and so never is -0, which adding +0 would change). A gap that is not a number keeps the
 // plane. With no skin the lists are made every step where the particles are: the test is then
 // the force's own (gap < r).
-#include <algorithm>
 #include <cstdint>
 #include <new>
 
