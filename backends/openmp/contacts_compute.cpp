@@ -72,7 +72,7 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
   // they fall apart, where a slot's write and read cost more than the distance it saves). Both
   // ways give the same sums, and the choice follows the counts: deterministic.
   const uint* slot_first = nullptr;
-  const vec4* slot_force = nullptr;
+  const vec3* slot_force = nullptr;
   std::uint64_t touching = 0;
   std::uint64_t entries = 0;
   const bool worth = shared_pairs_ == SharedPairs::Always ||
@@ -110,7 +110,7 @@ void OpenMPDevice::contacts_compute(const shared::StepParams& p) {
     };
     const uint c = count[i];
     if (c <= capacity && slot_force != nullptr) {
-      for (uint s = slot_first[i]; s < slot_first[i + 1]; ++s) f += shared::xyz(slot_force[s]);
+      for (uint s = slot_first[i]; s < slot_first[i + 1]; ++s) f += slot_force[s];
     } else if (c <= capacity) {
       for (uint k = 0; k < c; ++k) add_contact(list[std::size_t{k} * stride + std::size_t(i)]);
       entries += c;
@@ -154,7 +154,7 @@ std::uint64_t OpenMPDevice::contact_slots_compute(const shared::StepParams& p,
   const std::size_t stride = p.particle_count;
   const bool impulses = (p.flags & MOTES_FLAG_IMPULSE) != 0u;
   const uint rigid = p.rigid_particle_count;
-  vec4* out = contact_slot_force_.data();
+  vec3* out = contact_slot_force_.data();
   // The force on particle a from b, or 0: neither moves (nobody reads it), or two rigid particles
   // under impulse contacts (impulses_compute has them).
   const auto term = [&](uint a, uint b) {
@@ -177,9 +177,9 @@ std::uint64_t OpenMPDevice::contact_slots_compute(const shared::StepParams& p,
     const ContactPair pr = pairs[q];
     const vec3 f = term(pr.a, pr.b);
     touching += f.x != 0.0f || f.y != 0.0f || f.z != 0.0f ? 2u : 0u;
-    out[pr.slot_a] = vec4(f, 0.0f);
+    out[pr.slot_a] = f;
     // 0 - f: a pair out of contact gives +0 on both sides, as each side's own evaluation would.
-    out[pr.slot_b] = vec4(vec3(0.0f) - f, 0.0f);
+    out[pr.slot_b] = vec3(0.0f) - f;
   }
   const ContactSlot* own = contact_own_slots_.data();
   const auto own_count = static_cast<std::int64_t>(contact_own_slots_.size());
@@ -191,7 +191,7 @@ std::uint64_t OpenMPDevice::contact_slots_compute(const shared::StepParams& p,
     const uint j = in.list[std::size_t{sl.k} * stride + sl.i];
     const vec3 f = term(sl.i, j);
     touching += f.x != 0.0f || f.y != 0.0f || f.z != 0.0f ? 1u : 0u;
-    out[first[sl.i] + sl.k] = vec4(f, 0.0f);
+    out[first[sl.i] + sl.k] = f;
   }
   return touching;
 }

@@ -157,7 +157,7 @@ class OpenMPDevice final : public Device {
   std::vector<std::uint32_t> contact_slot_first_;
   std::vector<ContactPair> contact_pair_list_;
   std::vector<ContactSlot> contact_own_slots_;
-  std::vector<shared::vec4> contact_slot_force_;
+  std::vector<shared::vec3> contact_slot_force_;  ///< 12 B a slot (vec4: 4% slower dense)
   /// Makes the pairs for these lists; false when the slots do not fit 32-bit places.
   bool contact_pairs_index(const ContactInputs& in, std::size_t n, std::uint32_t capacity);
   /// contact_pairs_index, and false (every particle then evaluates its own contacts) when there
