@@ -24,9 +24,15 @@ namespace {
 /// kShifts: position contacts (MOTES_FLAG_POSITION: shifts and their number, shared/
 /// particle_shift.h); a kernel of its own, so that the force law's keeps its registers and loads
 /// (one kernel for both made the force law's 1 M falling spheres 10% slower on an H200).
+/// The force law's kernel is held to 5 blocks of kBlock threads an SM (at most 51 registers: it
+/// takes 48; left free it took 56, and 4 blocks fitted): W1 falling at 16.8 M 1.195 -> 1.059
+/// ms/step on an H200, dense at 1 M 0.168 -> 0.155 (6 blocks, 40 registers and a larger stack:
+/// falling 0.973, dense 0.212). docs/benchmarks.md, "Registers and occupancy". The shifts' kernel
+/// is held to no fewer than 1 block (61 registers, 63 before: 4 blocks an SM either way).
 template <bool kShifts>
-__global__ void contacts_compute_kernel(shared::StepParams p, ContactInputs in,
-                                        const uint* exclusions, vec4* __restrict__ force) {
+__global__ void __launch_bounds__(CudaDevice::kBlock, kShifts ? 1 : 5)
+    contacts_compute_kernel(shared::StepParams p, ContactInputs in, const uint* exclusions,
+                            vec4* __restrict__ force) {
   const std::uint64_t i = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
   if (i >= p.particle_count) return;
   const vec4 pi = in.pos[i];

@@ -41,10 +41,14 @@ __device__ shared::ImpulseBody impulse_body(const ImpulseInputs& in, uint b, uin
                                  in.body_angvel[b], in.vel0[b], in.angvel0[b], flags);
 }
 
-__global__ void impulses_compute_kernel(shared::StepParams p, ImpulseInputs in,
-                                        vec4* __restrict__ impulse, vec4* __restrict__ moment,
-                                        vec4* __restrict__ acc_main, vec4* __restrict__ acc_split,
-                                        const uint* __restrict__ stamp) {
+/// Held to 3 blocks of kBlock threads an SM (at most 85 registers: it takes 80): left free it took
+/// 145, one block an SM, 12% of the SM's warps, and waited on its loads; W2's 100,000 impulse
+/// dominoes on an H200 3.79 -> 2.63 ms/step (2 blocks: 2.80; 4, 64 registers and spills: 3.18).
+/// docs/benchmarks.md, "Registers and occupancy".
+__global__ void __launch_bounds__(CudaDevice::kBlock, 3)
+    impulses_compute_kernel(shared::StepParams p, ImpulseInputs in, vec4* __restrict__ impulse,
+                            vec4* __restrict__ moment, vec4* __restrict__ acc_main,
+                            vec4* __restrict__ acc_split, const uint* __restrict__ stamp) {
   const std::uint64_t t = std::uint64_t{blockIdx.x} * blockDim.x + threadIdx.x;
   if (t >= p.rigid_particle_count) return;
   const auto i = static_cast<uint>(t);
