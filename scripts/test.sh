@@ -17,6 +17,10 @@ export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
 # Each would also see the others as load and run on one thread (backends/openmp/cpu_share.h): keep
 # the thread counts the tests ask for (tests/unit/test_cpu_share.cpp checks the adapting itself).
 export MOTES_CPU_ADAPT=${MOTES_CPU_ADAPT:-0}
+# The seeded property scenes (tests/properties) run their OpenMP simulations on one thread: small
+# scenes of many short kernels cost less CPU time so than on two threads that wait for each other
+# while another test has the second core (tests/properties/random_scenes.h, device_options).
+export MOTES_PROPERTY_THREADS=${MOTES_PROPERTY_THREADS:-1}
 # Vulkan runs with the Khronos validation layer (synchronization validation included): any message
 # it prints fails the test that caused it.
 export MOTES_VULKAN_VALIDATION=${MOTES_VULKAN_VALIDATION:-1}

@@ -8,12 +8,14 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <numbers>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "motes/devices.h"
 #include "motes/scene.h"
 
 namespace motes_props {
@@ -108,5 +110,18 @@ struct Batch {
 
 /// Fails (empty scene, error in `why`) if two cases share a slot (seeds equal modulo 256).
 Batch make_batch(const std::vector<Case>& cases, std::string& why);
+
+/// The device options of the property scenes: MOTES_PROPERTY_THREADS OpenMP threads (unset or 0:
+/// OpenMP's default). scripts/test.sh asks for 1: ctest runs two tests side by side on CI's two
+/// cores, and these small scenes' many short kernels then cost less CPU time on one thread than
+/// on two that wait for each other (20 seeds of the pile, two batches side by side: 145 against
+/// 181 CPU seconds). The bits are the same on any number of threads.
+inline motes::DeviceOptions device_options() {
+  motes::DeviceOptions options;
+  if (const char* v = std::getenv("MOTES_PROPERTY_THREADS"); v != nullptr && *v != '\0') {
+    options.cpu_threads = std::atoi(v);
+  }
+  return options;
+}
 
 }  // namespace motes_props

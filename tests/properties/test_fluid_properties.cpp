@@ -181,7 +181,8 @@ std::vector<Outcome> run(const std::string& backend, const std::vector<Case>& ca
     scene.fluids.push_back(water_of(c));
     scene.fluids.back().material = material;
   }
-  motes::Result<std::unique_ptr<motes::Device>> device = motes::open_device(backend, -1, {});
+  motes::Result<std::unique_ptr<motes::Device>> device =
+      motes::open_device(backend, -1, motes_props::device_options());
   if (!device) {
     skip = device.message();
     return out;
@@ -396,7 +397,8 @@ TEST_P(RandomAdhesionSplashes, KeepMomentum) {
       cube.soft = soft;
       scene.bodies.push_back(cube);
     }
-    motes::Result<std::unique_ptr<motes::Device>> device = motes::open_device(backend, -1, {});
+    motes::Result<std::unique_ptr<motes::Device>> device =
+        motes::open_device(backend, -1, motes_props::device_options());
     if (!device) GTEST_SKIP() << "no " << backend << " device: " << device.message();
     auto created = motes::Simulation::create(scene, std::move(device).value());
     ASSERT_TRUE(created) << created.message();

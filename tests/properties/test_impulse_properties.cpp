@@ -19,6 +19,7 @@
 // for CI's two cores; the sanitizer build 2, 1 and 8 for their first 0.5 s; vulkan's pile is seed
 // 4 and its stack seed 2, the others seed 1: default_first_seed; a count set here starts at 1),
 // MOTES_PROPERTY_DURATION (s: stop there, rest not checked),
+// MOTES_PROPERTY_THREADS (OpenMP threads; scripts/test.sh: 1, random_scenes.h says why),
 // MOTES_PROPERTY_FIRST (first seed, default 1), MOTES_PROPERTY_KIND (only this kind),
 // MOTES_PROPERTY_BATCH (cases per simulation, default 20), MOTES_PROPERTY_SEED (one seed alone),
 // MOTES_PROPERTY_DUMP (a folder: each case's last state, for scripts/static_balance.py);
@@ -182,7 +183,8 @@ std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Cas
   if (const int v = env_int("MOTES_PROPERTY_SUBSTEPS", 0); v > 0) {
     batch.scene.settings.impulse_substeps = v;
   }
-  motes::Result<std::unique_ptr<motes::Device>> device = motes::open_device(backend, -1, {});
+  motes::Result<std::unique_ptr<motes::Device>> device =
+      motes::open_device(backend, -1, motes_props::device_options());
   if (!device) {
     skip = device.message();
     return out;
