@@ -83,6 +83,7 @@ struct BenchOptions {
   std::uint64_t falling_steps = 2000;
   std::uint64_t dense_steps = 5000;
   std::uint64_t settle_steps = 60000;
+  double skin = -1.0;  // W1's neighbour-list skin (m) in the timed runs; < 0: the scene's own
   int dominoes = 1000;
   int domino_rows = 10;
   std::uint64_t domino_steps = 2000;
@@ -322,6 +323,22 @@ std::string ensure_settled(const motes::Scene& scene, const BenchOptions& o, std
   must(sim->check_finite());
   must(sim->save_state(path));
   return path;
+}
+
+/// The settled state at `path` (ensure_settled), read by a simulation of the scene it was made
+/// with.
+motes::Snapshot settled_state(const motes::Scene& scene, const BenchOptions& o,
+                              const std::string& path) {
+  auto sim = make_sim(scene, o);
+  must(sim->load_state(path));
+  return must(sim->snapshot());
+}
+
+/// W1's scene with the skin --skin asks for in its timed runs (the settled start state is made
+/// with the scene's own, so that every skin starts the dense phase from the same pile).
+motes::Scene with_skin(motes::Scene scene, const BenchOptions& o) {
+  if (o.skin > 0.0) scene.settings.neighbour_skin = o.skin;
+  return scene;
 }
 
 nlohmann::json to_json(const Measurement& m) {
@@ -586,9 +603,10 @@ void run_bench(const BenchOptions& o) {
       });
       if (!fits) continue;
       const motes::Scene scene = motes::settle_workload(nx, ny, nz);
+      const motes::Scene timed = with_skin(scene, o);
       if (o.phase != "dense") {
         attempt([&] {
-          Measurement m = measure(scene, o, o.falling_steps, [](motes::Simulation&) {});
+          Measurement m = measure(timed, o, o.falling_steps, [](motes::Simulation&) {});
           m.workload = "settle";
           m.phase = "falling";
           print_row(m);
@@ -599,12 +617,20 @@ void run_bench(const BenchOptions& o) {
         attempt([&] {
           Measurement m;
           if (lammps_state && lammps_state->bodies.size() == n) {
-            m = measure(*lammps_state, o, o.dense_steps, [](motes::Simulation&) {});
+            m = measure(with_skin(*lammps_state, o), o, o.dense_steps, [](motes::Simulation&) {});
             m.phase = "dense*";
           } else {
             const std::string path = ensure_settled(scene, o, n);
-            m = measure(scene, o, o.dense_steps,
-                        [&](motes::Simulation& s) { must(s.load_state(path)); });
+            if (o.skin > 0.0) {
+              // The checkpoint belongs to the scene's own settings: read there, its state is
+              // written into the timed simulations with the other skin.
+              const motes::Snapshot state = settled_state(scene, o, path);
+              m = measure(timed, o, o.dense_steps,
+                          [&](motes::Simulation& s) { must(s.write_state(state)); });
+            } else {
+              m = measure(timed, o, o.dense_steps,
+                          [&](motes::Simulation& s) { must(s.load_state(path)); });
+            }
             m.phase = "dense";
           }
           m.workload = "settle";
@@ -747,6 +773,11 @@ void add_bench_command(CLI::App& app) {
                   "steps run once to make the W1 dense-phase start state")
       ->check(whole_number(1))
       ->capture_default_str();
+  cmd->add_option("--skin", opts->skin,
+                  "W1: neighbour-list skin in metres in the timed runs (lists rebuilt when a "
+                  "sphere has moved 0.45 of it; default a tenth of the diameter, 0.001); the "
+                  "settled start state is made with the default")
+      ->check(CLI::Range(1e-6, 0.01));
   cmd->add_option("--dominoes", opts->dominoes,
                   "W2: number of dominoes (15 particles each; at most 100,000,000 particles)")
       ->check(whole_number_of<int>(1, kMaxDominoes))

@@ -505,6 +505,40 @@ TEST(Cli, BenchDenseBuildsCountOnlyTheTimedSteps) {
   }
 }
 
+// --skin sets W1's neighbour-list skin in the timed runs (issue 30: what a larger skin gives the
+// dense pile): a 3 mm skin rebuilds the falling spheres' lists less often than the default 1 mm,
+// the dense phase starts from the pile settled with the default (the checkpoint of that scene,
+// its state written into the other), and a skin beyond a diameter is refused by name.
+TEST(Cli, BenchSkinSetsW1sListSkin) {
+  TempDir tmp;
+  std::vector<nlohmann::json> rows;
+  for (const char* skin : {"", "0.003"}) {
+    const std::filesystem::path json = tmp / fmt::format("bench{}.json", skin);
+    std::vector<std::string> args = {
+        "bench",       "--workload",     "settle", "--phase",         "both", "--sizes",
+        "16384",       "--backend",      "openmp", "--falling-steps", "1000", "--dense-steps",
+        "50",          "--settle-steps", "1000",   "--repeats",       "1",    "--cache",
+        tmp / "cache", "--json",         json};
+    if (*skin != '\0') args.insert(args.end(), {"--skin", skin});
+    const Outcome o = run_motes(tmp, args);
+    ASSERT_EQ(o.exit_code, 0) << describe(o);
+    std::ifstream in(json);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    ASSERT_TRUE(j.is_array() && j.size() == 2u) << j.dump(2);
+    EXPECT_EQ(j[1]["phase"], "dense") << j.dump(2);
+    for (const nlohmann::json& r : j) {
+      const std::string want = fmt::format("skin {} m", *skin == '\0' ? "0.001" : skin);
+      EXPECT_TRUE(contains(r["neighbour_search"].get<std::string>(), want)) << r.dump(2);
+    }
+    rows.push_back(j[0]);
+  }
+  EXPECT_LT(rows[1]["neighbour_builds"].get<int>(), rows[0]["neighbour_builds"].get<int>())
+      << rows[0].dump(2) << rows[1].dump(2);
+  const Outcome refused = run_motes(tmp, {"bench", "--workload", "settle", "--skin", "0.5"});
+  EXPECT_NE(refused.exit_code, 0) << describe(refused);
+  EXPECT_TRUE(contains(refused.err, "--skin")) << describe(refused);
+}
+
 // W1 at 268,435,456 spheres is a size (issue 30), but building its scene takes about 420 B of host
 // memory a sphere (880 B with the openmp device's): where MemAvailable is short of that, bench
 // refuses it before building anything, names both numbers and runs the other sizes.
