@@ -334,13 +334,6 @@ motes::Snapshot settled_state(const motes::Scene& scene, const BenchOptions& o,
   return must(sim->snapshot());
 }
 
-/// W1's scene with the skin --skin asks for in its timed runs (the settled start state is made
-/// with the scene's own, so that every skin starts the dense phase from the same pile).
-motes::Scene with_skin(motes::Scene scene, const BenchOptions& o) {
-  if (o.skin > 0.0) scene.settings.neighbour_skin = o.skin;
-  return scene;
-}
-
 nlohmann::json to_json(const Measurement& m) {
   const double med = median(m.seconds);
   nlohmann::json kernels = nlohmann::json::object();
@@ -577,6 +570,7 @@ void run_bench(const BenchOptions& o) {
   std::optional<motes::Scene> lammps_state;
   if (!o.dense_from.empty()) {
     lammps_state = must(motes::settle_workload_from_lammps(o.dense_from));
+    if (o.skin > 0.0) lammps_state->settings.neighbour_skin = o.skin;
     fmt::print("dense* = the dense phase from LAMMPS's settled state {} ({} spheres)\n",
                o.dense_from, lammps_state->bodies.size());
   }
@@ -602,11 +596,17 @@ void run_bench(const BenchOptions& o) {
         fits = true;
       });
       if (!fits) continue;
-      const motes::Scene scene = motes::settle_workload(nx, ny, nz);
-      const motes::Scene timed = with_skin(scene, o);
+      // The timed runs take --skin's skin; the settled start state is made and read with the
+      // scene's own (so that every skin starts the dense phase from the same pile). Set in
+      // place: at 268,435,456 spheres a copy of the scene (about 280 B a sphere) does not fit
+      // beside it on the GPU machine.
+      motes::Scene scene = motes::settle_workload(nx, ny, nz);
+      const double own_skin = scene.settings.neighbour_skin;
+      const double timed_skin = o.skin > 0.0 ? o.skin : own_skin;
+      scene.settings.neighbour_skin = timed_skin;
       if (o.phase != "dense") {
         attempt([&] {
-          Measurement m = measure(timed, o, o.falling_steps, [](motes::Simulation&) {});
+          Measurement m = measure(scene, o, o.falling_steps, [](motes::Simulation&) {});
           m.workload = "settle";
           m.phase = "falling";
           print_row(m);
@@ -617,18 +617,20 @@ void run_bench(const BenchOptions& o) {
         attempt([&] {
           Measurement m;
           if (lammps_state && lammps_state->bodies.size() == n) {
-            m = measure(with_skin(*lammps_state, o), o, o.dense_steps, [](motes::Simulation&) {});
+            m = measure(*lammps_state, o, o.dense_steps, [](motes::Simulation&) {});
             m.phase = "dense*";
           } else {
+            scene.settings.neighbour_skin = own_skin;
             const std::string path = ensure_settled(scene, o, n);
             if (o.skin > 0.0) {
               // The checkpoint belongs to the scene's own settings: read there, its state is
               // written into the timed simulations with the other skin.
               const motes::Snapshot state = settled_state(scene, o, path);
-              m = measure(timed, o, o.dense_steps,
+              scene.settings.neighbour_skin = timed_skin;
+              m = measure(scene, o, o.dense_steps,
                           [&](motes::Simulation& s) { must(s.write_state(state)); });
             } else {
-              m = measure(timed, o, o.dense_steps,
+              m = measure(scene, o, o.dense_steps,
                           [&](motes::Simulation& s) { must(s.load_state(path)); });
             }
             m.phase = "dense";

@@ -1,5 +1,6 @@
 // The motes command, run as a user would: exit codes, messages and the files it writes.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <nlohmann/json.hpp>
@@ -537,6 +538,30 @@ TEST(Cli, BenchSkinSetsW1sListSkin) {
   const Outcome refused = run_motes(tmp, {"bench", "--workload", "settle", "--skin", "0.5"});
   EXPECT_NE(refused.exit_code, 0) << describe(refused);
   EXPECT_TRUE(contains(refused.err, "--skin")) << describe(refused);
+}
+
+// The host memory W1 takes stays within the estimate bench refuses sizes by (cmd_bench.cpp:
+// kW1HostBytesPerSphere, 420 B a sphere, and for the openmp device its buffers, 196 B a sphere in
+// the falling phase), with 160 MiB for the program itself: at 4,194,304 spheres 2.50 GB
+// (2026-12-01), against 2.75 GB here. A copy of the scene (about 280 B a sphere) once took it
+// to 3.64 GB, and on the GPU machine W1 at 268,435,456 spheres past the machine's memory: killed,
+// not refused.
+TEST(Cli, BenchW1HostMemoryStaysWithinItsEstimate) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer's shadow memory is not the program's";
+#else
+  constexpr std::uint64_t kSpheres = 4194304;
+  TempDir tmp;
+  const Outcome o = run_motes(tmp, {"bench", "--workload", "settle", "--phase", "falling",
+                                    "--sizes", std::to_string(kSpheres), "--backend", "openmp",
+                                    "--threads", "1", "--falling-steps", "1", "--repeats", "1"});
+  ASSERT_EQ(o.exit_code, 0) << describe(o);
+  rusage usage{};
+  ASSERT_EQ(getrusage(RUSAGE_CHILDREN, &usage), 0);
+  const auto peak = static_cast<std::uint64_t>(usage.ru_maxrss) * 1024u;  // ru_maxrss: KiB
+  const std::uint64_t limit = kSpheres * (420u + 196u) + (160u << 20u);
+  EXPECT_LE(peak, limit) << "peak RSS " << peak << " B, " << peak / kSpheres << " B a sphere";
+#endif
 }
 
 // W1 at 268,435,456 spheres is a size (issue 30), but building its scene takes about 420 B of host
