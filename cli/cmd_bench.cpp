@@ -779,7 +779,7 @@ void add_bench_command(CLI::App& app) {
                   "W1: neighbour-list skin in metres in the timed runs (lists rebuilt when a "
                   "sphere has moved 0.45 of it; default a tenth of the diameter, 0.001); the "
                   "settled start state is made with the default")
-      ->check(CLI::Range(1e-6, 0.01));
+      ->check(finite_between(1e-6, 0.01));
   cmd->add_option("--dominoes", opts->dominoes,
                   "W2: number of dominoes (15 particles each; at most 100,000,000 particles)")
       ->check(whole_number_of<int>(1, kMaxDominoes))

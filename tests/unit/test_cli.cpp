@@ -509,7 +509,8 @@ TEST(Cli, BenchDenseBuildsCountOnlyTheTimedSteps) {
 // --skin sets W1's neighbour-list skin in the timed runs (issue 30: what a larger skin gives the
 // dense pile): a 3 mm skin rebuilds the falling spheres' lists less often than the default 1 mm,
 // the dense phase starts from the pile settled with the default (the checkpoint of that scene,
-// its state written into the other), and a skin beyond a diameter is refused by name.
+// its state written into the other), and a skin of zero, beyond a diameter or not a number is
+// refused by name.
 TEST(Cli, BenchSkinSetsW1sListSkin) {
   TempDir tmp;
   std::vector<nlohmann::json> rows;
@@ -535,9 +536,11 @@ TEST(Cli, BenchSkinSetsW1sListSkin) {
   }
   EXPECT_LT(rows[1]["neighbour_builds"].get<int>(), rows[0]["neighbour_builds"].get<int>())
       << rows[0].dump(2) << rows[1].dump(2);
-  const Outcome refused = run_motes(tmp, {"bench", "--workload", "settle", "--skin", "0.5"});
-  EXPECT_NE(refused.exit_code, 0) << describe(refused);
-  EXPECT_TRUE(contains(refused.err, "--skin")) << describe(refused);
+  for (const char* bad : {"0.5", "nan", "0"}) {
+    const Outcome refused = run_motes(tmp, {"bench", "--workload", "settle", "--skin", bad});
+    EXPECT_NE(refused.exit_code, 0) << describe(refused);
+    EXPECT_TRUE(contains(refused.err, "--skin")) << describe(refused);
+  }
 }
 
 // The host memory W1 takes stays within the estimate bench refuses sizes by (cmd_bench.cpp:
