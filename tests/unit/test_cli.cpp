@@ -551,20 +551,25 @@ TEST(Cli, BenchSkinSetsW1sListSkin) {
 // not refused.
 TEST(Cli, BenchW1HostMemoryStaysWithinItsEstimate) {
 #if defined(__SANITIZE_ADDRESS__)
-  GTEST_SKIP() << "AddressSanitizer's shadow memory is not the program's";
+  // AddressSanitizer's shadow memory is not the program's: the sanitizer stage runs the same
+  // path at 262,144 spheres for memory errors and leaves the peak to the first stage.
+  constexpr std::uint64_t kSpheres = 262144;
+  constexpr bool kCheckPeak = false;
 #else
   constexpr std::uint64_t kSpheres = 4194304;
+  constexpr bool kCheckPeak = true;
+#endif
   TempDir tmp;
   const Outcome o = run_motes(tmp, {"bench", "--workload", "settle", "--phase", "falling",
                                     "--sizes", std::to_string(kSpheres), "--backend", "openmp",
                                     "--threads", "1", "--falling-steps", "1", "--repeats", "1"});
   ASSERT_EQ(o.exit_code, 0) << describe(o);
+  if (!kCheckPeak) return;
   rusage usage{};
   ASSERT_EQ(getrusage(RUSAGE_CHILDREN, &usage), 0);
   const auto peak = static_cast<std::uint64_t>(usage.ru_maxrss) * 1024u;  // ru_maxrss: KiB
   const std::uint64_t limit = kSpheres * (420u + 196u) + (160u << 20u);
   EXPECT_LE(peak, limit) << "peak RSS " << peak << " B, " << peak / kSpheres << " B a sphere";
-#endif
 }
 
 // W1 at 268,435,456 spheres is a size (issue 30), but building its scene takes about 420 B of host
