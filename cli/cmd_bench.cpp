@@ -33,8 +33,9 @@ constexpr std::uint64_t kMaxDominoes = 100'000'000 / 15;
 // (Simulation::create): the scene's BodySpec (272 B), the simulation's BodyInfo (72 B) and the
 // host layout. Measured with openmp on the development VM (docs/benchmarks.md, "W1 beyond host
 // memory"): peak RSS 2,445 MB at 4,194,304 spheres and 672 MB at 1,048,576, 563 B a sphere
-// between them, of which 196 B is the openmp device's memory; and on the H200 machine with CUDA,
-// 108.1 GB at 268,435,456 spheres: 403 B a sphere (2026-11-30); rounded up.
+// between them, of which 196 B is the openmp device's memory (575 B on 2026-12-01); and on the
+// H200 machine with CUDA, 108,126,840 KiB at 268,435,456 spheres: 412 B a sphere (2026-11-30 and
+// 2026-12-01); rounded up.
 constexpr std::uint64_t kW1HostBytesPerSphere = 420;
 // The device memory of a W1 sphere where the device is host memory (openmp): 196 B of buffers,
 // and in the dense phase 251 B of shared contact pairs (backends/openmp/contact_pairs.cpp; peak
