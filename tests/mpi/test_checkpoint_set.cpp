@@ -19,6 +19,7 @@
 #include "motes/simulation.h"
 #include "motes/workloads.h"
 #include "mpi_support.h"
+#include "sanitized_build.h"
 
 namespace motes {
 namespace {
@@ -190,24 +191,27 @@ TEST(CheckpointSet, EveryKindResumesBitwise) {
   // (the plane contacts' accumulated impulses, every rigid body one group), with a small margin so
   // that the ranks partition at list rebuilds.
   const int n = size_of(MPI_COMM_WORLD);
+  // The sanitizer build (tests/sanitized_build.h): a checkpoint at 50 steps of 100, the same paths.
+  const std::uint64_t first = motes_test::sanitized_or<std::uint64_t>(100, 50);
+  const std::uint64_t steps = 2 * first;
   DistributedOptions mixed;
   mixed.margin = 0.001;
   mixed.decomposition = std::array<int, 3>{n == 4 ? 2 : 1, 1, n == 4 ? 2 : n};
   {
     SCOPED_TRACE("mixed");
-    expect_bitwise_resume(example("mixed"), 100, 200, mixed, false);
+    expect_bitwise_resume(example("mixed"), first, steps, mixed, false);
   }
   {
     // Rigid bodies in the halos: their poses and momenta travel with their particles.
     SCOPED_TRACE("dice");
-    expect_bitwise_resume(example("dice"), 100, 200, {}, false, true);
+    expect_bitwise_resume(example("dice"), first, steps, {}, false, true);
   }
   DistributedOptions slabs;
   slabs.margin = 0.001;
   slabs.decomposition = std::array<int, 3>{n, 1, 1};
   {
     SCOPED_TRACE("impulse_dominoes");
-    expect_bitwise_resume(example("impulse_dominoes"), 100, 200, slabs, true);
+    expect_bitwise_resume(example("impulse_dominoes"), first, steps, slabs, true);
   }
 }
 

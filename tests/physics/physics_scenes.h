@@ -17,38 +17,24 @@
 #include "motes/shapes.h"
 #include "motes/simulation.h"
 #include "motes/status.h"
+#include "sanitized_build.h"
 #include "shared/common.h"
 
 namespace motes_test {
 
 /// How many of a seeded test's seeds run: all of them, or in the sanitizer build
-/// (tests/CMakeLists.txt defines MOTES_PHYSICS_SANITIZED there) the first `sanitized`. That stage
-/// looks for memory errors and undefined behaviour along the code paths, which the first seed
-/// already takes; the physics of every seed is checked in the first stage (a 10 s column took 83 s
-/// under the sanitizers).
+/// (tests/sanitized_build.h) the first `sanitized`. The first seed already takes the code paths;
+/// the physics of every seed is checked in the first stage (a 10 s column took 83 s under the
+/// sanitizers).
 inline std::uint32_t seeds_to_run(std::uint32_t all, std::uint32_t sanitized = 1) {
-#ifdef MOTES_PHYSICS_SANITIZED
-  return sanitized < all ? sanitized : all;
-#else
-  (void)sanitized;
-  return all;
-#endif
+  return sanitized_or(all, sanitized);
 }
 
 /// How many frames a long unseeded test steps: all of them, or in the sanitizer build its first
 /// `sanitized`, where it checks nothing but the paths (the physics is checked in the first stage,
 /// as seeds_to_run's); `physics_checked()` says which.
-inline int frames_to_run(int all, int sanitized) {
-  return static_cast<int>(
-      seeds_to_run(static_cast<std::uint32_t>(all), static_cast<std::uint32_t>(sanitized)));
-}
-inline bool physics_checked() {
-#ifdef MOTES_PHYSICS_SANITIZED
-  return false;
-#else
-  return true;
-#endif
-}
+inline int frames_to_run(int all, int sanitized) { return sanitized_or(all, sanitized); }
+inline bool physics_checked() { return !kSanitized; }
 
 /// xyz of a device vec4, widened to double.
 inline Eigen::Vector3d to_vec3(const motes::shared::vec4& v) {

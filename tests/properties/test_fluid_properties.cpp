@@ -37,6 +37,7 @@
 #include "motes/shapes.h"
 #include "motes/simulation.h"
 #include "random_scenes.h"
+#include "sanitized_build.h"
 
 namespace motes_fluid_props {
 namespace {
@@ -48,11 +49,7 @@ constexpr double kEnergyMargin = 0.01;  // as RandomPositionScenes'
 constexpr double kFrame = 1.0 / 60.0;
 constexpr int kSubsteps = 24;  // RandomPositionScenes': the fastest drops need them
 constexpr double kG = 9.81;
-#ifdef MOTES_PROPERTY_QUICK
-constexpr bool kQuick = true;
-#else
-constexpr bool kQuick = false;
-#endif
+constexpr bool kQuick = motes_test::kSanitized;  // fewer seeds, the first 0.5 s
 
 int env_int(const char* name, int fallback) {
   const char* v = std::getenv(name);

@@ -50,6 +50,7 @@
 #include "motes/devices.h"
 #include "motes/simulation.h"
 #include "random_scenes.h"
+#include "sanitized_build.h"
 
 namespace motes_props {
 namespace {
@@ -68,11 +69,8 @@ constexpr double kUprightTilt = 10.0 * 3.14159265358979323846 / 180.0;
 /// motion, as its dt does).
 constexpr double kPositionFrame = 1.0 / 60.0;
 constexpr int kPositionSubsteps = 24;
-#ifdef MOTES_PROPERTY_QUICK
-constexpr bool kQuick = true;  // the sanitizer build: fewer seeds, the first 0.5 s
-#else
-constexpr bool kQuick = false;
-#endif
+constexpr bool kQuick =
+    motes_test::kSanitized;  // the sanitizer build: fewer seeds, the first 0.5 s
 
 Eigen::Vector3d v3(const motes::shared::vec4& v) {
   return {static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z)};
