@@ -14,7 +14,7 @@ packages=(build-essential cmake ninja-build pkg-config git
   glslang-tools spirv-tools libvulkan-dev libvulkan-volk-dev libvulkan1 mesa-vulkan-drivers
   vulkan-validationlayers libstb-dev ffmpeg python3-dev python3-pybind11 python3-numpy python3-scipy
   libglfw3-dev xvfb xdotool
-  python3-pytest libopenmpi-dev openmpi-bin)
+  python3-pytest libopenmpi-dev openmpi-bin ccache)
 
 if [ "${MOTES_SKIP_INSTALL:-0}" != 1 ]; then
   missing=()
@@ -35,6 +35,15 @@ if [ "${MOTES_SKIP_INSTALL:-0}" != 1 ]; then
 fi
 
 echo "== configuring $build"
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+# MOTES_COMPILER_LAUNCHER (scripts/test.sh sets ccache): what runs each C++ compile.
+launcher=()
+if [ -n "${MOTES_COMPILER_LAUNCHER:-}" ]; then
+  if command -v "$MOTES_COMPILER_LAUNCHER" >/dev/null; then
+    launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER="$MOTES_COMPILER_LAUNCHER")
+  else
+    echo "motes setup: $MOTES_COMPILER_LAUNCHER not found; compiling without it" >&2
+  fi
+fi
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "$@" >/dev/null
 echo "== building"
 cmake --build "$build" -j "${JOBS:-$(nproc)}"

@@ -7,6 +7,12 @@ build=${MOTES_TEST_BUILD:-$root/build-test}
 # Each stage says when it starts (seconds since the start), so a slow CI run shows where it went.
 stage() { echo "== test.sh: $1 (at ${SECONDS} s)"; }
 stage "set-up and build"
+# The build and the installed package's lean build (scripts/check-package.sh) compile most of the
+# library's files with the same commands: ccache compiles them once (its cache beside the build,
+# paths taken relative to the repository, each file's headers from the compiler's own list). The
+# sanitizer build shares no command with them and runs without it.
+export MOTES_COMPILER_LAUNCHER=ccache CCACHE_DIR=${CCACHE_DIR:-$build-ccache} CCACHE_BASEDIR=$root \
+  CCACHE_DEPEND=1 CCACHE_NOHASHDIR=1
 "$root/scripts/setup.sh" "$build" -DMOTES_WERROR=ON
 stage "format check"
 "$root/scripts/check-format.sh"
@@ -52,7 +58,7 @@ MOTES_SKIP_INSTALL=1 "$root/scripts/check-package.sh" "$build"
 # memcheck and racecheck check them (scripts/gpu/run-suite.sh sanitize).
 if [ "${MOTES_SANITIZER_STAGE:-1}" = 1 ]; then
   stage "sanitizer build"
-  MOTES_SKIP_INSTALL=1 "$root/scripts/setup.sh" "$build-sanitize" -DMOTES_WERROR=ON \
+  MOTES_COMPILER_LAUNCHER= MOTES_SKIP_INSTALL=1 "$root/scripts/setup.sh" "$build-sanitize" -DMOTES_WERROR=ON \
     -DMOTES_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMOTES_TEST_VULKAN_VALIDATION=OFF \
     -DMOTES_WITH_CUDA=OFF
   cd "$build-sanitize"
