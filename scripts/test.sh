@@ -58,9 +58,9 @@ MOTES_SKIP_INSTALL=1 "$root/scripts/check-package.sh" "$build"
 # memcheck and racecheck check them (scripts/gpu/run-suite.sh sanitize).
 if [ "${MOTES_SANITIZER_STAGE:-1}" = 1 ]; then
   stage "sanitizer build"
-  MOTES_COMPILER_LAUNCHER= MOTES_SKIP_INSTALL=1 "$root/scripts/setup.sh" "$build-sanitize" -DMOTES_WERROR=ON \
-    -DMOTES_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMOTES_TEST_VULKAN_VALIDATION=OFF \
-    -DMOTES_WITH_CUDA=OFF
+  MOTES_COMPILER_LAUNCHER= MOTES_SKIP_INSTALL=1 "$root/scripts/setup.sh" "$build-sanitize" \
+    -DMOTES_WERROR=ON -DMOTES_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DMOTES_TEST_VULKAN_VALIDATION=OFF -DMOTES_WITH_CUDA=OFF
   cd "$build-sanitize"
   stage "sanitizer tests"
   MOTES_VULKAN_VALIDATION=0 \

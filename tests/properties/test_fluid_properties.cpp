@@ -49,7 +49,8 @@ constexpr double kEnergyMargin = 0.01;  // as RandomPositionScenes'
 constexpr double kFrame = 1.0 / 60.0;
 constexpr int kSubsteps = 24;  // RandomPositionScenes': the fastest drops need them
 constexpr double kG = 9.81;
-constexpr bool kQuick = motes_test::kSanitized;  // fewer seeds, the first 0.5 s
+// The sanitizer build (tests/sanitized_build.h): fewer seeds, the first 0.5 s.
+constexpr bool kQuick = motes_test::kSanitized;
 
 int env_int(const char* name, int fallback) {
   const char* v = std::getenv(name);

@@ -69,8 +69,8 @@ constexpr double kUprightTilt = 10.0 * 3.14159265358979323846 / 180.0;
 /// motion, as its dt does).
 constexpr double kPositionFrame = 1.0 / 60.0;
 constexpr int kPositionSubsteps = 24;
-constexpr bool kQuick =
-    motes_test::kSanitized;  // the sanitizer build: fewer seeds, the first 0.5 s
+// The sanitizer build (tests/sanitized_build.h): fewer seeds, the first 0.5 s.
+constexpr bool kQuick = motes_test::kSanitized;
 
 Eigen::Vector3d v3(const motes::shared::vec4& v) {
   return {static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z)};
