@@ -238,7 +238,8 @@ double compulsory_bytes(motes::Kernel k, const Measurement& m) {
                                        // gather id and member per membership, each frame once;
                                        // write pos, vel
       return (52.0 + 32.0) * m.soft_particles + 52.0 * m.cluster_members + 272.0 * m.clusters;
-    case motes::Kernel::ConstraintsSolve:  // per projection: read the constraint, both
+    case motes::Kernel::ConstraintsSolve:  // (a launch per colour, or all in one: the same)
+    case motes::Kernel::ConstraintsRelax:  // per projection: read the constraint, both
                                            // particles' pos, vel; write their pos, vel; in
                                            // the last sweep also read their ref
       return (16.0 + 64.0 + 64.0) * static_cast<double>(m.constraint_sweeps) +
@@ -558,8 +559,8 @@ void run_bench(const BenchOptions& o) {
   // Column labels of the kernel families, in motes::Kernel order (JSON has the full names).
   constexpr std::array kLabels = {"nb_upd",   "grid",     "nb_build", "contacts", "b_reduce",
                                   "b_integr", "p_update", "p_integr", "cl_fit",   "cl_goal",
-                                  "constr",   "imp_comp", "imp_appl", "fl_dens",  "fl_upd",
-                                  "fl_vort",  "fl_vel"};
+                                  "constr",   "c_relax",  "imp_comp", "imp_appl", "fl_dens",
+                                  "fl_upd",   "fl_vort",  "fl_vel"};
   static_assert(kLabels.size() == kStepKernels, "a label per kernel family of a step");
   std::string ks;
   for (const char* label : kLabels) ks += fmt::format(" {:>8}", label);

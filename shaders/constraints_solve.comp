@@ -19,10 +19,7 @@ void main() {
     vec4 xb = particle_pos[c.b];
     vec4 va = particle_vel[c.a];
     vec4 vb = particle_vel[c.b];
-    float inv_dt = 1.0f / p.gravity_dt.w;
-    vec3 d = constraint_correction(xa, xb, va.w, vb.w, c.rest, c.stiffness);
-    constraint_apply(xa, va, d * va.w, inv_dt);
-    constraint_apply(xb, vb, d * -vb.w, inv_dt);
+    constraint_project(xa, xb, va, vb, c, 1.0f / p.gravity_dt.w);
     particle_pos[c.a] = xa;
     particle_pos[c.b] = xb;
     particle_vel[c.a] = va;

@@ -19,8 +19,19 @@ layout(push_constant) uniform Push {
   uvec4 args;
 };
 
-layout(std430, binding = B_PARTICLE_POS) buffer ParticlePosBuf { vec4 particle_pos[]; };
-layout(std430, binding = B_PARTICLE_VEL) buffer ParticleVelBuf { vec4 particle_vel[]; };
+// A shader whose threads read, after a barrier, particles that other threads of its workgroup
+// wrote (constraints_relax.comp) defines MOTES_PARTICLES_COHERENT first.
+#ifdef MOTES_PARTICLES_COHERENT
+#define MOTES_PARTICLES_ACCESS coherent
+#else
+#define MOTES_PARTICLES_ACCESS
+#endif
+layout(std430, binding = B_PARTICLE_POS) MOTES_PARTICLES_ACCESS buffer ParticlePosBuf {
+  vec4 particle_pos[];
+};
+layout(std430, binding = B_PARTICLE_VEL) MOTES_PARTICLES_ACCESS buffer ParticleVelBuf {
+  vec4 particle_vel[];
+};
 layout(std430, binding = B_PARTICLE_LOCAL) readonly buffer ParticleLocalBuf { vec4 particle_local[]; };
 layout(std430, binding = B_PARTICLE_BODY) readonly buffer ParticleBodyBuf { uint particle_body[]; };
 layout(std430, binding = B_PARTICLE_MATERIAL) readonly buffer ParticleMaterialBuf { uint particle_material[]; };
@@ -49,6 +60,9 @@ layout(std430, binding = B_NEIGHBOUR_STATE) buffer NeighbourStateBuf { uint neig
 layout(std430, binding = B_CONTACT_LAWS) readonly buffer ContactLawsBuf { ContactLaw contact_laws[]; };
 layout(std430, binding = B_PLANES) readonly buffer PlanesBuf { PlaneData planes[]; };
 layout(std430, binding = B_CONSTRAINTS) readonly buffer ConstraintsBuf { Constraint constraints[]; };
+layout(std430, binding = B_CONSTRAINT_COLOURS) readonly buffer ConstraintColoursBuf {
+  uint constraint_colours[];
+};
 layout(std430, binding = B_CLUSTERS) readonly buffer ClustersBuf { Cluster clusters[]; };
 layout(std430, binding = B_CLUSTER_MEMBERS) readonly buffer ClusterMembersBuf { ClusterMember cluster_members[]; };
 layout(std430, binding = B_CLUSTER_FRAMES) buffer ClusterFramesBuf { ClusterFrame cluster_frames[]; };

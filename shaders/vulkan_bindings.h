@@ -31,47 +31,48 @@
 #define B_CONTACT_LAWS 24
 #define B_PLANES 25
 #define B_CONSTRAINTS 26
-#define B_LINK_EXCLUSIONS 27
-#define B_CLUSTERS 28
-#define B_CLUSTER_MEMBERS 29
-#define B_CLUSTER_FRAMES 30
-#define B_CLUSTER_GATHER 31
-#define B_PARTICLE_MOMENT 32
-#define B_BODY_VEL_START 33
-#define B_BODY_ANGVEL_START 34
-#define B_BODY_VEL_PUSH 35
-#define B_BODY_ANGMOM_PUSH 36
-#define B_CONTACT_IMPULSE 37
-#define B_IMPULSE_STAMP 38
-#define B_MOTION_CHECK 39
-#define B_ENERGY_PARTIALS 40
-#define B_HALO_INDEX 41
-#define B_HALO_DATA 42
-#define B_PARTITION_REF_POS 43
-#define B_PARTITION_CHECK 44
-#define B_CONTACT_IMPULSE_SPLIT 45
-#define B_BODY_POS_LOW 46
-#define B_FLUID_STATE 47
-#define B_FLUID_MATERIALS 48
-#define B_FLUID_VEL_OLD 49
-#define B_FLUID_AUX 50
-#define B_FLUID_NORMAL 51
+#define B_CONSTRAINT_COLOURS 27
+#define B_LINK_EXCLUSIONS 28
+#define B_CLUSTERS 29
+#define B_CLUSTER_MEMBERS 30
+#define B_CLUSTER_FRAMES 31
+#define B_CLUSTER_GATHER 32
+#define B_PARTICLE_MOMENT 33
+#define B_BODY_VEL_START 34
+#define B_BODY_ANGVEL_START 35
+#define B_BODY_VEL_PUSH 36
+#define B_BODY_ANGMOM_PUSH 37
+#define B_CONTACT_IMPULSE 38
+#define B_IMPULSE_STAMP 39
+#define B_MOTION_CHECK 40
+#define B_ENERGY_PARTIALS 41
+#define B_HALO_INDEX 42
+#define B_HALO_DATA 43
+#define B_PARTITION_REF_POS 44
+#define B_PARTITION_CHECK 45
+#define B_CONTACT_IMPULSE_SPLIT 46
+#define B_BODY_POS_LOW 47
+#define B_FLUID_STATE 48
+#define B_FLUID_MATERIALS 49
+#define B_FLUID_VEL_OLD 50
+#define B_FLUID_AUX 51
+#define B_FLUID_NORMAL 52
 // Scratch buffers of the backend (not part of motes::Buffer).
-#define B_GRID_ARRIVAL 52  // uint (N): arrival rank of a particle in its bucket (atomic, any order)
-#define B_GRID_UNSORTED 53  // uint (N): particle ids grouped by bucket, in arrival order
-#define B_SCAN_SCRATCH 54   // uint: block sums of every level of the bucket-count scan
+#define B_GRID_ARRIVAL 53  // uint (N): arrival rank of a particle in its bucket (atomic, any order)
+#define B_GRID_UNSORTED 54  // uint (N): particle ids grouped by bucket, in arrival order
+#define B_SCAN_SCRATCH 55   // uint: block sums of every level of the bucket-count scan
 // uint: VkDispatchIndirectCommand (4 words each) of every pass of a conditional rebuild, then the
 // same for when it runs (written once at allocate); neighbours_update.comp copies or zeroes the
 // first.
-#define B_INDIRECT_ARGS 55
+#define B_INDIRECT_ARGS 56
 // uint: the neighbour list's column blocks after the first (B_NEIGHBOUR_LIST), when one buffer
 // cannot hold every column (maxStorageBufferRange): block b holds columns [b C, (b + 1) C) with
 // C = StepParams::neighbour_columns (kernel_common.glsl: list_entry).
-#define B_NEIGHBOUR_LIST_1 56
-#define B_NEIGHBOUR_LIST_2 57
-#define B_NEIGHBOUR_LIST_3 58
+#define B_NEIGHBOUR_LIST_1 57
+#define B_NEIGHBOUR_LIST_2 58
+#define B_NEIGHBOUR_LIST_3 59
 #define NEIGHBOUR_LIST_BLOCKS 4
-#define B_COUNT 59
+#define B_COUNT 60
 
 // Threads per workgroup of every kernel; the scan handles 4 elements per thread.
 #define WORKGROUP_SIZE 256

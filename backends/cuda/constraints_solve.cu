@@ -9,7 +9,6 @@
 namespace motes::cuda {
 
 using shared::uint;
-using shared::vec3;
 using shared::vec4;
 
 namespace {
@@ -26,10 +25,7 @@ __global__ void constraints_solve_kernel(shared::StepParams p,
     vec4 xb = pos[c.b];
     vec4 va = vel[c.a];
     vec4 vb = vel[c.b];
-    const float inv_dt = 1.0f / p.gravity_dt.w;
-    const vec3 d = shared::constraint_correction(xa, xb, va.w, vb.w, c.rest, c.stiffness);
-    shared::constraint_apply(xa, va, d * va.w, inv_dt);
-    shared::constraint_apply(xb, vb, d * -vb.w, inv_dt);
+    shared::constraint_project(xa, xb, va, vb, c, 1.0f / p.gravity_dt.w);
     pos[c.a] = xa;
     pos[c.b] = xb;
     vel[c.a] = va;

@@ -11,7 +11,6 @@
 namespace motes::openmp {
 
 using shared::uint;
-using shared::vec3;
 using shared::vec4;
 
 void OpenMPDevice::constraints_solve(const shared::StepParams& p) {
@@ -31,11 +30,7 @@ void OpenMPDevice::constraints_solve(const shared::StepParams& p) {
               : moved)
   for (std::int64_t k = first; k < end; ++k) {
     const shared::Constraint c = constraints[k];
-    const float wa = vel[c.a].w;
-    const float wb = vel[c.b].w;
-    const vec3 d = shared::constraint_correction(pos[c.a], pos[c.b], wa, wb, c.rest, c.stiffness);
-    shared::constraint_apply(pos[c.a], vel[c.a], d * wa, inv_dt);
-    shared::constraint_apply(pos[c.b], vel[c.b], d * -wb, inv_dt);
+    shared::constraint_project(pos[c.a], pos[c.b], vel[c.a], vel[c.b], c, inv_dt);
     moved |= (check && (shared::neighbour_moved_too_far(pos[c.a], ref[c.a], p.neighbour_skin) ||
                         shared::neighbour_moved_too_far(pos[c.b], ref[c.b], p.neighbour_skin)))
                  ? 1u

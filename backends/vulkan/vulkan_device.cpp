@@ -29,6 +29,7 @@ static_assert(B_NEIGHBOUR_STATE == static_cast<int>(Buffer::NeighbourState));
 static_assert(B_CONTACT_LAWS == static_cast<int>(Buffer::ContactLaws));
 static_assert(B_PLANES == static_cast<int>(Buffer::Planes));
 static_assert(B_CONSTRAINTS == static_cast<int>(Buffer::Constraints));
+static_assert(B_CONSTRAINT_COLOURS == static_cast<int>(Buffer::ConstraintColours));
 static_assert(B_CLUSTERS == static_cast<int>(Buffer::Clusters));
 static_assert(B_CLUSTER_GATHER == static_cast<int>(Buffer::ClusterGather));
 static_assert(B_PARTICLE_MOMENT == static_cast<int>(Buffer::ParticleMoment));

@@ -78,6 +78,8 @@ const char* buffer_name(Buffer b) {
       return "Planes";
     case Buffer::Constraints:
       return "Constraints";
+    case Buffer::ConstraintColours:
+      return "ConstraintColours";
     case Buffer::Clusters:
       return "Clusters";
     case Buffer::ClusterMembers:
@@ -231,6 +233,8 @@ BufferLayout buffer_layout(Buffer b, const Sizes& s) {
       return {sizeof(shared::PlaneData), s.planes};
     case Buffer::Constraints:
       return {sizeof(shared::Constraint), s.constraints};
+    case Buffer::ConstraintColours:
+      return {kUint, s.constraints > 0 ? std::size_t{s.constraint_colours} + 1 : 0};
     case Buffer::Clusters:
       return {sizeof(shared::Cluster), s.clusters};
     case Buffer::ClusterMembers:

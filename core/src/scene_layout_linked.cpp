@@ -173,6 +173,7 @@ Status build_linked(const Scene& scene, const SceneCounts& counts, HostLayout& o
     next += static_cast<std::uint32_t>(spec.points.size());
   }
   out.linked.colouring = colour_constraints(constraints, out.sizes.particles);
+  out.sizes.constraint_colours = static_cast<std::uint32_t>(out.linked.colouring.colours());
   std::vector<std::uint32_t>& words = out.linked.exclusions;
   words = std::move(exclusions.start);
   words.insert(words.end(), exclusions.list.begin(), exclusions.list.end());

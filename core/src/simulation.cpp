@@ -7,6 +7,7 @@
 #include <bit>
 #include <cmath>
 #include <cstddef>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <optional>
@@ -78,6 +79,9 @@ Status write_layout(Device& d, const layout::HostLayout& host) {
   };
   // A rank of a run over MPI ranks: the partition's reference positions.
   if (host.sizes.partition != 0) uploads.push_back(of(Buffer::PartitionRefPos, p.pos));
+  if (host.sizes.constraints != 0) {
+    uploads.push_back(of(Buffer::ConstraintColours, host.linked.colouring.first));
+  }
   // Impulse contacts: every centre of mass starts as its float (nothing below it).
   const std::vector<vec4> low(host.sizes.impulse != 0 ? r.pos.size() : 0, vec4(0.0f));
   if (!low.empty()) uploads.push_back(of(Buffer::BodyPosLow, low));
@@ -124,6 +128,18 @@ vec4 lowest_point(const Eigen::Vector3d& gravity, const std::vector<vec4>& pos,
     if (emitters.empty() || !parked(i)) consider(pos[i]);
   }
   return lowest.value_or(vec4(0.0f));
+}
+
+/// The most constraints relaxed in one launch (constraints_relax): the device's
+/// DeviceInfo::one_launch_constraints, or MOTES_CONSTRAINTS_RELAX_LIMIT=C (0: always a launch per
+/// colour; benchmarks and tests compare the two ways).
+std::uint64_t constraints_relax_limit(const Device& device) {
+  const char* value = std::getenv("MOTES_CONSTRAINTS_RELAX_LIMIT");
+  const std::uint64_t own = device.info().one_launch_constraints;
+  if (value == nullptr || *value == '\0') return own;
+  char* end = nullptr;
+  const unsigned long long limit = std::strtoull(value, &end, 10);
+  return end != nullptr && *end == '\0' ? limit : own;
 }
 
 }  // namespace
@@ -219,6 +235,7 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
   rigid_first_ = host.rigid.first;
   rigid_inv_inertia_ = host.rigid.inv_inertia;
   colour_first_ = host.linked.colouring.first;
+  relax_limit_ = constraints_relax_limit(d);
   sphere_turns_ = std::move(host.sphere_turns);
   emitters_ = host.emitters;
 
@@ -290,9 +307,20 @@ Status Simulation::step(std::uint64_t count) {
 }
 
 void Simulation::relax_constraints() {
-  // settings.constraint_iterations sweeps over the colours of the cloth and rope constraints, one
-  // launch per colour (docs/architecture.md, "Cloth and ropes").
-  for (int it = 0; it < settings_.constraint_iterations && colour_first_.size() > 1; ++it) {
+  // settings.constraint_iterations sweeps over the colours of the cloth and rope constraints
+  // (docs/architecture.md, "Cloth and ropes"): all in one launch when they are few, else one
+  // launch per colour. Both give the same bits.
+  if (colour_first_.size() < 2 || settings_.constraint_iterations < 1) return;
+  if (colour_first_.back() <= relax_limit_) {
+    shared::StepParams all = params_;
+    all.flags |= MOTES_FLAG_SKIN_CHECK;  // in the last sweep
+    all.constraint_first = 0;
+    all.constraint_count = static_cast<std::uint32_t>(colour_first_.size() - 1);
+    all.constraint_sweeps = static_cast<std::uint32_t>(settings_.constraint_iterations);
+    device_->enqueue(Kernel::ConstraintsRelax, all);
+    return;
+  }
+  for (int it = 0; it < settings_.constraint_iterations; ++it) {
     for (std::size_t c = 0; c + 1 < colour_first_.size(); ++c) {
       shared::StepParams colour = params_;
       // Only the last sweep's positions are the ones the next contacts see.

@@ -120,6 +120,16 @@ MOTES_FN void constraint_apply(MOTES_INOUT(vec4) pos, MOTES_INOUT(vec4) vel, vec
   vel = vec4(xyz(vel) + shift * inv_dt, vel.w);
 }
 
+/// One projection of constraint c: constraint_correction, then each particle moved by it in
+/// proportion to its inverse mass (the velocity's w) with constraint_apply. What constraints_solve
+/// and constraints_relax do to each constraint, on every backend.
+MOTES_FN void constraint_project(MOTES_INOUT(vec4) xa, MOTES_INOUT(vec4) xb, MOTES_INOUT(vec4) va,
+                                 MOTES_INOUT(vec4) vb, Constraint c, float inv_dt) {
+  vec3 d = constraint_correction(xa, xb, va.w, vb.w, c.rest, c.stiffness);
+  constraint_apply(xa, va, d * va.w, inv_dt);
+  constraint_apply(xb, vb, d * -vb.w, inv_dt);
+}
+
 MOTES_SHARED_END
 
 #ifdef __cplusplus

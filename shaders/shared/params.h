@@ -87,7 +87,7 @@ struct StepParams {
   uint linked_first;          // Nl: particles [Nl, N) are cloth and rope particles (shared/links.h)
   float linked_damping;       // fraction of their velocity the linked particles lose per substep
   uint constraint_first;      // constraints_solve: the colour's first constraint
-  uint constraint_count;      // constraints_solve: its number of constraints
+  uint constraint_count;      // constraints_solve: its number of constraints (relax: colours)
   uint soft_first;            // Ns: particles [Ns, Nl) are soft-body particles (shape matching)
   uint cluster_count;         // S: shape-matching clusters (shared/shape_matching.h)
   uint halo_particles;        // halo_pack, halo_unpack: particle entries (shared/halo.h)
@@ -96,7 +96,7 @@ struct StepParams {
   uint fluid_first;           // Nf: particles [Nf, Nf + fluid_count) are fluid (docs/fluids.md),
   uint fluid_count;           // a range of free particles ending at Ns; 0: no fluid
   uint neighbour_columns;     // Vulkan: list columns per storage buffer (0: one buffer holds all)
-  uint reserved1;             // 0
+  uint constraint_sweeps;     // constraints_relax: its sweeps over every colour; 0 elsewhere
 };
 
 /// Contact law of one pair of materials (symmetric): F_n = k d - gamma_n m* v_n,
@@ -134,7 +134,8 @@ static_assert(offsetof(motes::shared::StepParams, cluster_count) == 80, "StepPar
 // No padding bytes: queued calls are compared with memcmp to find the step's repeating cycle
 // (kernel_queue.cpp), and a padding byte's garbage would hide it (every flush a new graph).
 static_assert(offsetof(motes::shared::StepParams, fluid_first) == 96, "StepParams layout");
-static_assert(offsetof(motes::shared::StepParams, reserved1) + sizeof(motes::shared::uint) ==
+static_assert(offsetof(motes::shared::StepParams, constraint_sweeps) +
+                      sizeof(motes::shared::uint) ==
                   sizeof(motes::shared::StepParams),
               "StepParams must have no padding");
 static_assert(sizeof(motes::shared::ContactLaw) == 32, "ContactLaw layout");

@@ -8,8 +8,6 @@
 
 namespace motes_ref {
 
-using motes::shared::vec3;
-
 bool constraints_solve(Particles& particles, const std::vector<Constraint>& constraints,
                        const StepParams& p, const std::vector<vec4>& ref) {
   const float inv_dt = 1.0f / p.gravity_dt.w;
@@ -22,12 +20,8 @@ bool constraints_solve(Particles& particles, const std::vector<Constraint>& cons
           "constraints_solve: two constraints of one colour share a particle");
     }
     used[c.a] = used[c.b] = true;
-    const float wa = particles.vel[c.a].w;
-    const float wb = particles.vel[c.b].w;
-    const vec3 d = motes::shared::constraint_correction(particles.pos[c.a], particles.pos[c.b], wa,
-                                                        wb, c.rest, c.stiffness);
-    motes::shared::constraint_apply(particles.pos[c.a], particles.vel[c.a], d * wa, inv_dt);
-    motes::shared::constraint_apply(particles.pos[c.b], particles.vel[c.b], d * -wb, inv_dt);
+    motes::shared::constraint_project(particles.pos[c.a], particles.pos[c.b], particles.vel[c.a],
+                                      particles.vel[c.b], c, inv_dt);
     for (const uint i : {c.a, c.b}) {
       if (!ref.empty() && (p.flags & MOTES_FLAG_SKIN_CHECK) != 0) {
         moved =

@@ -186,6 +186,14 @@ bool particles_integrate(Particles& particles, const std::vector<vec4>& force, c
 bool constraints_solve(Particles& particles, const std::vector<Constraint>& constraints,
                        const StepParams& p, const std::vector<vec4>& ref = {});
 
+/// constraints_relax: p.constraint_sweeps sweeps, each over the colours [0, p.constraint_count)
+/// of `colours` (colour k: constraints [colours[k], colours[k + 1])) in order, each colour as
+/// constraints_solve; only the last sweep tests `ref` (with MOTES_FLAG_SKIN_CHECK). Returns
+/// whether a particle it moved there ends too far from `ref`.
+bool constraints_relax(Particles& particles, const std::vector<Constraint>& constraints,
+                       const std::vector<uint>& colours, const StepParams& p,
+                       const std::vector<vec4>& ref = {});
+
 /// clusters_fit: for each cluster, its members' centre of mass (shared::cluster_centre_add) and
 /// sums of positions and velocities (cluster_sums_add) in member order, in float as the device
 /// does, then cluster_frame from the cluster's rotation in `frames`, and the third pass

@@ -36,6 +36,7 @@ namespace fs = std::filesystem;
 using motes::Buffer;
 using motes_test::TempDir;
 
+using motes_test::has_device;
 using motes_test::kMixedScene;
 
 /// The device buffers a checkpoint holds (core/src/checkpoint.cpp), compared byte for byte.
@@ -64,17 +65,6 @@ std::uint64_t fnv1a(const unsigned char* p, std::size_t n) { return motes::fnv1a
 void fix_checksum(std::vector<unsigned char>& bytes) {
   const std::uint64_t h = fnv1a(bytes.data(), bytes.size() - 8);
   std::memcpy(bytes.data() + bytes.size() - 8, &h, 8);
-}
-
-/// Whether `backend` has a device here; `why` says why not.
-bool has_device(const std::string& backend, std::string& why) {
-  for (const motes::BackendReport& r : motes::list_backends()) {
-    if (r.backend != backend) continue;
-    why = r.unavailable_reason;
-    return !r.devices.empty();
-  }
-  why = "unknown backend";
-  return false;
 }
 
 /// The mixed scene, or W1 at 16 x 8 x 16 spheres pressed to 0.99 d (docs/conformance.md's

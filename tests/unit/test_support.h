@@ -88,6 +88,17 @@ inline void add_grid_triangles(motes::TriangleMesh& m, int along, int across) {
   }
 }
 
+/// Whether `backend` has a device here; `why` says why not.
+inline bool has_device(const std::string& backend, std::string& why) {
+  for (const motes::BackendReport& r : motes::list_backends()) {
+    if (r.backend != backend) continue;
+    why = r.unavailable_reason;
+    return !r.devices.empty();
+  }
+  why = "unknown backend";
+  return false;
+}
+
 /// OpenMP, and Vulkan where it is built (CI: lavapipe); CUDA has tests of its own, which say when
 /// they are skipped.
 inline std::vector<std::string> cpu_backends() {

@@ -307,7 +307,7 @@ class Simulation {
   /// The device's sizes: rigid bodies first (sizes().bodies of them), then the free spheres, then
   /// the cloth and rope particles.
   [[nodiscard]] const Sizes& sizes() const { return sizes_; }
-  /// First constraint of each colour (colours + 1 entries; Device::constraints_solve).
+  /// First constraint of each colour (colours + 1 entries; ConstraintColours).
   [[nodiscard]] const std::vector<std::uint32_t>& constraint_colours() const {
     return colour_first_;
   }
@@ -373,6 +373,10 @@ class Simulation {
   std::vector<shared::vec4> rigid_inv_inertia_;
   /// Constraints of colour c are Constraints [colour_first_[c], colour_first_[c + 1]).
   std::vector<std::uint32_t> colour_first_;
+  /// At most this many constraints are relaxed in one launch (constraints_relax); more go a launch
+  /// per colour (constraints_solve). DeviceInfo::one_launch_constraints, or
+  /// MOTES_CONSTRAINTS_RELAX_LIMIT.
+  std::uint64_t relax_limit_ = 0;
   std::vector<EmitterRange> emitters_;
   /// Position contacts: the scene has dynamic rigid bodies (their passes run).
   bool position_bodies_ = false;

@@ -57,6 +57,9 @@ enum class Buffer : std::uint32_t {
   Planes,       ///< PlaneData (P)
   // Cloth and ropes: their particles are [Nl, N) (StepParams.linked_first).
   Constraints,  ///< Constraint (C): distance constraints, grouped by colour (shared/links.h)
+  /// uint (colours + 1 with constraints, else 0): each colour's first constraint in Constraints,
+  /// then C (constraints_relax reads it; constraints_solve takes its range in StepParams).
+  ConstraintColours,
   /// uint (N - Nl + 1 + E; empty without a cloth from a triangle mesh): for each linked particle,
   /// where its list of the particles within two links starts, then the lists, ascending
   /// (shared/links.h, contact_listed).
@@ -179,6 +182,9 @@ struct Sizes {
   std::uint32_t partition = 0;        ///< 1: PartitionRefPos (N) and PartitionCheck (1) exist
   std::uint32_t fluid_particles = 0;  ///< particles of fluids (FluidState, FluidVelOld, FluidAux,
                                       ///< FluidNormal; FluidMaterials when > 0)
+  /// The constraints' colours (ConstraintColours has one more word); after the fields the setup
+  /// hash covers (the colouring itself is hashed with the layout).
+  std::uint32_t constraint_colours = 0;
 };
 
 /// Bytes of one element and number of elements of a buffer.
@@ -259,6 +265,12 @@ struct DeviceInfo {
   int index = 0;        ///< index within the backend
   std::string name;     ///< e.g. CPU model, GPU name
   std::string detail;   ///< threads, driver, memory, subgroup size...
+  /// The most cloth and rope constraints the core relaxes in one launch on this device
+  /// (constraints_relax, one workgroup); a scene with more takes a launch per colour and sweep
+  /// (constraints_solve). On an H200 one workgroup beats a launch per colour up to about 12,000
+  /// constraints (CUDA) and 13,700 (Vulkan), docs/benchmarks.md; lavapipe runs one workgroup
+  /// slower than the launches (0). MOTES_CONSTRAINTS_RELAX_LIMIT=C overrides it.
+  std::uint64_t one_launch_constraints = 8192;
 };
 
 /// A backend device. Kernels are enqueued in order; errors surface at synchronize().

@@ -48,6 +48,13 @@
 //   + p.constraint_count), no two of which share a particle, each projected once
 //   (shared/links.h: constraint_correction) on ParticlePos and ParticleVel; asks for a rebuild
 //   when a particle it moved is too far from its NeighbourRefPos.
+// constraints_relax: every sweep of every colour in one launch, for sets small enough for one
+//   workgroup: p.constraint_sweeps sweeps, each over the p.constraint_count colours in order,
+//   colour k being Constraints [ConstraintColours[k], ConstraintColours[k + 1]); each colour
+//   exactly as constraints_solve, one after the other, so the result is that of
+//   p.constraint_sweeps x p.constraint_count constraints_solve calls, bit for bit. With
+//   MOTES_FLAG_SKIN_CHECK only the last sweep asks for a rebuild (as the core flags the last
+//   sweep's constraints_solve calls).
 // impulses_compute: impulse contacts (shared/impulse.h), rigid particles [0, Nr) only:
 //   ParticleForce xyz = the sum of pair_impulse over its list's rigid particles in list order
 //   (each pair evaluated lower id first, negated for the higher; the particles as
@@ -165,6 +172,9 @@
     (ParticlePos, ParticleVel, NeighbourState))                                                  \
   X(ConstraintsSolve, constraints_solve,                                                         \
     (ParticlePos, ParticleVel, NeighbourRefPos, NeighbourState, Constraints),                    \
+    (ParticlePos, ParticleVel, NeighbourState))                                                  \
+  X(ConstraintsRelax, constraints_relax,                                                         \
+    (ParticlePos, ParticleVel, NeighbourRefPos, NeighbourState, Constraints, ConstraintColours), \
     (ParticlePos, ParticleVel, NeighbourState))                                                  \
   X(ImpulsesCompute, impulses_compute,                                                           \
     (ParticlePos, ParticleVel, ParticleLocal, ParticleBody, ParticleMaterial, BodyPos, BodyQuat, \
