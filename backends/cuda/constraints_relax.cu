@@ -19,14 +19,14 @@ namespace {
 constexpr int kRelaxBlock = 1024;
 
 __global__ void __launch_bounds__(kRelaxBlock)
-    constraints_relax_kernel(shared::StepParams p, const shared::Constraint* __restrict__ constraints,
+    constraints_relax_kernel(shared::StepParams p,
+                             const shared::Constraint* __restrict__ constraints,
                              const uint* __restrict__ colours, vec4* pos, vec4* vel,
                              const vec4* __restrict__ ref, uint* __restrict__ state) {
   const float inv_dt = 1.0f / p.gravity_dt.w;
   bool moved = false;
   for (uint sweep = 0; sweep < p.constraint_sweeps; ++sweep) {
-    const bool check =
-        (p.flags & MOTES_FLAG_SKIN_CHECK) != 0 && sweep + 1 == p.constraint_sweeps;
+    const bool check = (p.flags & MOTES_FLAG_SKIN_CHECK) != 0 && sweep + 1 == p.constraint_sweeps;
     for (uint colour = 0; colour < p.constraint_count; ++colour) {
       const uint end = colours[colour + 1];
       for (uint k = colours[colour] + threadIdx.x; k < end; k += kRelaxBlock) {
@@ -40,8 +40,9 @@ __global__ void __launch_bounds__(kRelaxBlock)
         pos[c.b] = xb;
         vel[c.a] = va;
         vel[c.b] = vb;
-        moved = moved || (check && (shared::neighbour_moved_too_far(xa, ref[c.a], p.neighbour_skin) ||
-                                    shared::neighbour_moved_too_far(xb, ref[c.b], p.neighbour_skin)));
+        moved =
+            moved || (check && (shared::neighbour_moved_too_far(xa, ref[c.a], p.neighbour_skin) ||
+                                shared::neighbour_moved_too_far(xb, ref[c.b], p.neighbour_skin)));
       }
       __syncthreads();
     }

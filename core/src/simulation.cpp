@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cerrno>
 #include <cmath>
 #include <cstddef>
 #include <cstdlib>
@@ -132,14 +133,20 @@ vec4 lowest_point(const Eigen::Vector3d& gravity, const std::vector<vec4>& pos,
 
 /// The most constraints relaxed in one launch (constraints_relax): the device's
 /// DeviceInfo::one_launch_constraints, or MOTES_CONSTRAINTS_RELAX_LIMIT=C (0: always a launch per
-/// colour; benchmarks and tests compare the two ways).
-std::uint64_t constraints_relax_limit(const Device& device) {
+/// colour; benchmarks and tests compare the two ways); an error when C is not a whole number.
+Result<std::uint64_t> constraints_relax_limit(const Device& device) {
   const char* value = std::getenv("MOTES_CONSTRAINTS_RELAX_LIMIT");
-  const std::uint64_t own = device.info().one_launch_constraints;
-  if (value == nullptr || *value == '\0') return own;
+  if (value == nullptr || *value == '\0') return device.info().one_launch_constraints;
   char* end = nullptr;
+  errno = 0;
   const unsigned long long limit = std::strtoull(value, &end, 10);
-  return end != nullptr && *end == '\0' ? limit : own;
+  if (*value < '0' || *value > '9' || end == nullptr || *end != '\0' || errno == ERANGE) {
+    return Status::error(fmt::format(
+        "MOTES_CONSTRAINTS_RELAX_LIMIT: '{}' is not a number of constraints (a whole number; 0 "
+        "relaxes them a launch per colour)",
+        value));
+  }
+  return static_cast<std::uint64_t>(limit);
 }
 
 }  // namespace
@@ -235,7 +242,9 @@ Status Simulation::upload(const Scene& scene, const HaloLists* halo) {
   rigid_first_ = host.rigid.first;
   rigid_inv_inertia_ = host.rigid.inv_inertia;
   colour_first_ = host.linked.colouring.first;
-  relax_limit_ = constraints_relax_limit(d);
+  Result<std::uint64_t> relax_limit = constraints_relax_limit(d);
+  if (!relax_limit) return relax_limit.status();
+  relax_limit_ = relax_limit.value();
   sphere_turns_ = std::move(host.sphere_turns);
   emitters_ = host.emitters;
 

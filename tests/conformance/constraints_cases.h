@@ -214,9 +214,9 @@ class ConstraintsCaseTest : public DeviceTest {
       free_vel_in.push_back(w.particles.vel[i]);
     }
 
-    begin_case(
-        std::string(relax ? "constraints_relax/" : "constraints_solve/") + layout + " (" + std::to_string(c.colouring.colours()) + " colours)",
-        static_cast<std::uint32_t>(constraints.size()));
+    begin_case(std::string(relax ? "constraints_relax/" : "constraints_solve/") + layout + " (" +
+                   std::to_string(c.colouring.colours()) + " colours)",
+               static_cast<std::uint32_t>(constraints.size()));
     check_close("ParticlePos", pos, want.pos, kConstraintsSolveTolerance, Part::Xyz);
     const double ulp_per_dt = coordinate_ulp(want.pos) / static_cast<double>(w.params.gravity_dt.w);
     check_at_most("ParticleVel", "max dv (ulp/dt)", max_distance(vel, want.vel) / ulp_per_dt,

@@ -1,9 +1,9 @@
-// Cloth and rope constraints relaxed in one launch (constraints_relax; MOTES_CONSTRAINTS_RELAX_LIMIT
-// above the scene's constraints) or a launch per colour and sweep (constraints_solve; the limit
-// 0): the same state to the bit on each backend, in whole scenes with cloth, ropes and
-// attachments, under the force law and under position contacts; and the launches the core makes
-// are the ones it says (kernel timing counts them). Which way a device takes by itself
-// (DeviceInfo::one_launch_constraints) is a matter of speed only.
+// Cloth and rope constraints relaxed in one launch (constraints_relax;
+// MOTES_CONSTRAINTS_RELAX_LIMIT above the scene's constraints) or a launch per colour and sweep
+// (constraints_solve; the limit 0): the same state to the bit on each backend, in whole scenes with
+// cloth, ropes and attachments, under the force law and under position contacts; and the launches
+// the core makes are the ones it says (kernel timing counts them). Which way a device takes by
+// itself (DeviceInfo::one_launch_constraints) is a matter of speed only.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -31,7 +31,7 @@ struct RelaxRun {
 /// `steps` steps of example scene `name` on `backend` with MOTES_CONSTRAINTS_RELAX_LIMIT=`limit`;
 /// timing on for the launch counts when `timed`.
 void run_scene(const std::string& backend, const std::string& name, std::uint64_t steps,
-         const char* limit, bool timed, RelaxRun& out) {
+               const char* limit, bool timed, RelaxRun& out) {
   auto scene = motes::load_scene_file(motes_test::example_path(name));
   ASSERT_TRUE(scene) << scene.message();
   motes::DeviceOptions options;
@@ -87,6 +87,24 @@ TEST_P(ConstraintsOneLaunch, SameStateAsALaunchPerColour) {
     EXPECT_EQ(one_timed.solve_launches, 0u);
     EXPECT_EQ(per_colour_timed.relax_launches, 0u);
     EXPECT_GT(per_colour_timed.solve_launches, one_timed.relax_launches);
+  }
+}
+
+// A limit that is not a whole number is refused when the simulation is made, naming the variable.
+TEST(ConstraintsOneLaunchLimit, NotANumberIsRefused) {
+  auto scene = motes::load_scene_file(motes_test::example_path("rope.json"));
+  ASSERT_TRUE(scene) << scene.message();
+  for (const char* bad : {"many", "-1", "12k", " 5", "99999999999999999999999"}) {
+    SCOPED_TRACE(bad);
+    auto device = motes::open_device("openmp");
+    ASSERT_TRUE(device) << device.message();
+    ::setenv("MOTES_CONSTRAINTS_RELAX_LIMIT", bad, 1);
+    auto sim = motes::Simulation::create(scene.value(), std::move(device).value());
+    ::unsetenv("MOTES_CONSTRAINTS_RELAX_LIMIT");
+    ASSERT_FALSE(sim);
+    EXPECT_NE(sim.message().find("MOTES_CONSTRAINTS_RELAX_LIMIT"), std::string::npos)
+        << sim.message();
+    EXPECT_NE(sim.message().find(bad), std::string::npos) << sim.message();
   }
 }
 
