@@ -230,6 +230,24 @@ class ConstraintsCaseTest : public DeviceTest {
   }
 };
 
+/// The seven cases, as tests of fixture `Suite` (one whose run_case(layout, case, far, checked)
+/// runs them its way).
+#define MOTES_CONSTRAINTS_CASES(Suite)                                                             \
+  TEST_P(Suite, Empty) { run_case("none", random_links(171, 31, 0), false); }                      \
+  TEST_P(Suite, Rope31) { run_case("rope", from_linked(172, rope(31), 0.003f), true); }            \
+  TEST_P(Suite, Cloth25) { run_case("cloth 25x25", from_linked(173, cloth(25), 0.003f), false); }  \
+  TEST_P(Suite, Cloth25Moved) {                                                                    \
+    run_case("cloth 25x25 moved_far", from_linked(173, cloth(25), 0.003f), true);                  \
+  }                                                                                                \
+  TEST_P(Suite, Cloth25MovedUnchecked) {                                                           \
+    /* No launch asks for the skin test: the particle 0.6 skin off asks for nothing. */            \
+    run_case("cloth 25x25 moved_far unchecked", from_linked(173, cloth(25), 0.003f), true, false); \
+  }                                                                                                \
+  TEST_P(Suite, Random1234) { run_case("random links", random_links(174, 1234, 3000), true); }     \
+  TEST_P(Suite, Cloth256) {                                                                        \
+    run_case("cloth 256x256", from_linked(175, cloth(256), 0.002f), false);                        \
+  }
+
 }  // namespace motes_conf
 
 #endif  // MOTES_CONFORMANCE_CONSTRAINTS_CASES_H

@@ -18,24 +18,7 @@ class ConstraintsRelax : public ConstraintsCaseTest {
   }
 };
 
-TEST_P(ConstraintsRelax, Empty) { run_case("none", random_links(171, 31, 0), false); }
-TEST_P(ConstraintsRelax, Rope31) { run_case("rope", from_linked(172, rope(31), 0.003f), true); }
-TEST_P(ConstraintsRelax, Cloth25) {
-  run_case("cloth 25x25", from_linked(173, cloth(25), 0.003f), false);
-}
-TEST_P(ConstraintsRelax, Cloth25Moved) {
-  run_case("cloth 25x25 moved_far", from_linked(173, cloth(25), 0.003f), true);
-}
-TEST_P(ConstraintsRelax, Cloth25MovedUnchecked) {
-  // No launch asks for the skin test: the particle 0.6 skin from its reference asks for nothing.
-  run_case("cloth 25x25 moved_far unchecked", from_linked(173, cloth(25), 0.003f), true, false);
-}
-TEST_P(ConstraintsRelax, Random1234) {
-  run_case("random links", random_links(174, 1234, 3000), true);
-}
-TEST_P(ConstraintsRelax, Cloth256) {
-  run_case("cloth 256x256", from_linked(175, cloth(256), 0.002f), false);
-}
+MOTES_CONSTRAINTS_CASES(ConstraintsRelax)
 
 INSTANTIATE_TEST_SUITE_P(Conformance, ConstraintsRelax, testing::ValuesIn(device_params()),
                          param_name);
