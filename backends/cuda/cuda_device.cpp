@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cerrno>
 #include <cstdlib>
 #include <cstring>
 
@@ -93,6 +94,21 @@ Result<std::unique_ptr<Device>> CudaDevice::open(int ordinal) {
   d->info_ = describe(ordinal, prop);
   static_assert(sizeof(prop.uuid) == sizeof(d->uuid_));
   std::memcpy(d->uuid_.data(), &prop.uuid, sizeof(d->uuid_));
+  d->impulse_list_from_ =
+      std::uint64_t{static_cast<unsigned>(prop.multiProcessorCount)} * kImpulseBlocksPerSm * kBlock;
+  if (const char* from = std::getenv("MOTES_CUDA_IMPULSE_LIST_FROM");
+      from != nullptr && *from != '\0') {
+    char* end = nullptr;
+    errno = 0;
+    const unsigned long long n = std::strtoull(from, &end, 10);
+    if (*from < '0' || *from > '9' || end == nullptr || *end != '\0' || errno == ERANGE) {
+      return Status::error(fmt::format(
+          "MOTES_CUDA_IMPULSE_LIST_FROM: '{}' is not a number of particles (a whole number; 0 "
+          "lists the particles within reach of a contact at every size)",
+          from));
+    }
+    d->impulse_list_from_ = n;
+  }
   const char* host_rebuild = std::getenv("MOTES_CUDA_HOST_REBUILD");
   d->host_rebuild_ = host_rebuild != nullptr && std::strcmp(host_rebuild, "1") == 0;
   for (cudaStream_t* stream : {&d->stream_, &d->body_stream_}) {
@@ -132,9 +148,11 @@ void CudaDevice::release_buffers() {
     p = nullptr;
   }
   bytes_ = {};
-  for (void* p : {static_cast<void*>(ids_), static_cast<void*>(sorted_keys_), sort_temp_}) {
+  for (void* p : {static_cast<void*>(ids_), static_cast<void*>(sorted_keys_), sort_temp_,
+                  static_cast<void*>(impulse_listed_)}) {
     if (p != nullptr) cudaFree(p);
   }
+  impulse_listed_ = nullptr;
   ids_ = nullptr;
   sorted_keys_ = nullptr;
   sort_temp_ = nullptr;
@@ -146,7 +164,11 @@ std::uint64_t CudaDevice::required_bytes(const Sizes& sizes) const {
   // Every buffer and its guard bytes, the sort's ids and keys, and CUB's temporary storage (about
   // the keys and values again, plus its histograms).
   const std::uint64_t n = sizes.particles;
-  return buffers_bytes(sizes) + kBufferCount * (kGuardBytes + 256) + n * 8 + n * 8 + (8u << 20);
+  // With impulse contacts, the list of particles within reach (impulses_compute.cu).
+  const std::uint64_t listed =
+      sizes.impulse != 0 ? (std::uint64_t{sizes.rigid_particles} + 1) * 4 : 0;
+  return buffers_bytes(sizes) + kBufferCount * (kGuardBytes + 256) + n * 8 + n * 8 + listed +
+         (8u << 20);
 }
 
 std::uint64_t CudaDevice::available_bytes() const {
@@ -162,6 +184,7 @@ std::uint64_t CudaDevice::available_bytes() const {
   if (allocated_) {
     for (std::size_t b : bytes_) held += b + kGuardBytes;
     held += sort_temp_bytes_ + 2 * std::uint64_t{sizes_.particles} * sizeof(shared::uint);
+    if (impulse_listed_ != nullptr) held += (std::uint64_t{sizes_.rigid_particles} + 1) * 4;
   }
   return free_bytes + held;
 }
@@ -226,6 +249,17 @@ Status CudaDevice::allocate(const Sizes& sizes) {
   if (cudaError_t e = cudaMalloc(&sort_temp_, std::max<std::size_t>(sort_temp_bytes_, 16));
       e != cudaSuccess) {
     return fail(e, fmt::format("the sort's temporary storage ({} bytes)", sort_temp_bytes_));
+  }
+  if (sizes.impulse != 0) {
+    void* listed = nullptr;
+    const std::size_t bytes = (std::size_t{sizes.rigid_particles} + 1) * sizeof(shared::uint);
+    if (cudaError_t e = cudaMalloc(&listed, bytes); e != cudaSuccess) {
+      return fail(e, "the list of particles within reach of an impulse contact");
+    }
+    impulse_listed_ = static_cast<shared::uint*>(listed);
+    if (cudaError_t e = cudaMemset(listed, 0, bytes); e != cudaSuccess) {
+      return fail(e, "the list of particles within reach of an impulse contact");
+    }
   }
   launch_ids_fill(sizes.particles);
   if (cudaError_t e = cudaGetLastError(); e != cudaSuccess) return fail(e, "the particle ids");

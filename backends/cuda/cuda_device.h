@@ -28,6 +28,8 @@ class CudaDevice final : public Device {
   static constexpr unsigned char kGuardByte = 0xA5;
   /// Threads per block of every motes kernel.
   static constexpr unsigned kBlock = 256;
+  /// impulses_compute's blocks of kBlock threads an SM (its launch bound: impulses_compute.cu).
+  static constexpr unsigned kImpulseBlocksPerSm = 3;
 
   /// Opens CUDA device `ordinal` and creates its stream.
   static Result<std::unique_ptr<Device>> open(int ordinal);
@@ -99,6 +101,12 @@ class CudaDevice final : public Device {
   /// returns how many calls it consumed. A NeighboursUpdate is only launched while a graph is
   /// captured: a kernel sets the condition of an IF node that holds the rebuild.
   std::size_t launch(const std::vector<KernelCall>& calls, std::size_t i, bool fuse = true);
+  /// True when calls[i] is a sweep of impulse contacts (no counting, no position contacts) whose
+  /// substep's counting pass comes before it in `calls` with nothing between but such sweeps and
+  /// impulses_apply calls that move no body (kernels.h: "A sweep ... after its substep's counting
+  /// pass, positions and lists unchanged since"). Decided from the calls alone, so a graph
+  /// captured from them replays the same decision.
+  static bool sweep_follows_count(const std::vector<KernelCall>& calls, std::size_t i);
 
   // One file per kernel family launches it on stream_ (grid_build.cu, contacts_compute.cu...).
 #define MOTES_LAUNCH_DECLARATION(E, name, reads, writes) \
@@ -136,6 +144,17 @@ class CudaDevice final : public Device {
   shared::uint* sorted_keys_ = nullptr;
   void* sort_temp_ = nullptr;
   std::size_t sort_temp_bytes_ = 0;
+  /// The particles a counting pass of impulse contacts found within reach of a contact: [0] their
+  /// count, then their ids (impulses_compute.cu). Allocated with impulse contacts (Sizes::impulse).
+  shared::uint* impulse_listed_ = nullptr;
+  /// Set by launch() for the call it launches: an impulses_compute sweep that may visit only
+  /// impulse_listed_ (sweep_follows_count).
+  bool impulse_sweep_listed_ = false;
+  /// The fewest rigid particles whose counting pass lists them: one wave of impulses_compute
+  /// (kImpulseBlocksPerSm blocks an SM); a sweep of fewer runs in one wave anyway, and reading its
+  /// particle from the list costs it a load's latency. MOTES_CUDA_IMPULSE_LIST_FROM=N sets it
+  /// (tests: 0 lists every count).
+  std::uint64_t impulse_list_from_ = 0;
   /// Host copies of BodyFirst and ParticleBody as last written: the fused body pass is used only
   /// when they agree (body b owns exactly particles [first[b], first[b+1])) and every body is
   /// small, so that it computes what the three separate kernels compute.

@@ -82,8 +82,33 @@ void CudaDevice::enqueue(Kernel k, const shared::StepParams& p) {
   pending_.push_back({k, p});
 }
 
+bool CudaDevice::sweep_follows_count(const std::vector<KernelCall>& calls, std::size_t i) {
+  const shared::StepParams& p = calls[i].params;
+  if (calls[i].kernel != Kernel::ImpulsesCompute ||
+      (p.flags & (MOTES_FLAG_IMPULSE_COUNT | MOTES_FLAG_POSITION)) != 0u) {
+    return false;
+  }
+  while (i-- > 0) {
+    const shared::StepParams& q = calls[i].params;
+    // The same particles, lists and reach (impulse_margin), and no position contacts (whose
+    // impulses_apply moves the bodies).
+    if ((q.flags & MOTES_FLAG_POSITION) != 0u || q.particle_count != p.particle_count ||
+        q.rigid_particle_count != p.rigid_particle_count || q.plane_count != p.plane_count ||
+        q.neighbour_capacity != p.neighbour_capacity || q.neighbour_skin != p.neighbour_skin) {
+      return false;
+    }
+    if (calls[i].kernel == Kernel::ImpulsesCompute) {
+      if ((q.flags & MOTES_FLAG_IMPULSE_COUNT) != 0u) return true;
+      continue;
+    }
+    if (calls[i].kernel != Kernel::ImpulsesApply) return false;
+  }
+  return false;
+}
+
 std::size_t CudaDevice::launch(const std::vector<KernelCall>& calls, std::size_t i, bool fuse) {
   const shared::StepParams& p = calls[i].params;
+  impulse_sweep_listed_ = sweep_follows_count(calls, i);
   if (calls[i].kernel == Kernel::BodiesReduce && fuse && bodies_fusable_ &&
       p.body_count == sizes_.bodies && p.rigid_particle_count == sizes_.rigid_particles &&
       i + 2 < calls.size() && same_call(calls[i + 1], {Kernel::BodiesIntegrate, p}) &&
