@@ -37,8 +37,10 @@ Status Simulation::emit() {
                        static_cast<float>(x.z()), e.radius);
       vel.emplace_back(static_cast<float>(v.x()), static_cast<float>(v.y()),
                        static_cast<float>(v.z()), e.inverse_mass);
-      const Eigen::Vector3d xf(pos.back().x, pos.back().y, pos.back().z);
-      const Eigen::Vector3d vf(vel.back().x, vel.back().y, vel.back().z);
+      const Eigen::Vector3d xf =
+          Eigen::Vector3f(pos.back().x, pos.back().y, pos.back().z).cast<double>();
+      const Eigen::Vector3d vf =
+          Eigen::Vector3f(vel.back().x, vel.back().y, vel.back().z).cast<double>();
       kinetic += 0.5 * mass * vf.squaredNorm();
       potential -= mass * g.dot(xf - energy_origin_);
     }

@@ -70,8 +70,9 @@ double fluid_s_corr_energy(double r, const shared::FluidMaterial& f, double subs
   // (fluid_s_corr), so |F| = sweeps (m / h_s^2) k m h^2 (W(s) / W(dq))^n / rho_0
   // x 45 / (pi h^6) (h - s)^2. Simpson's rule over 256 intervals (the integrand is a polynomial of
   // degree 3n + 2 in s).
-  const double rho0 = f.density_h.x, h = f.density_h.y, m = f.density_h.z;
-  const double k = f.s_corr.x, dq = f.s_corr.z;
+  const double rho0 = static_cast<double>(f.density_h.x), h = static_cast<double>(f.density_h.y),
+               m = static_cast<double>(f.density_h.z);
+  const double k = static_cast<double>(f.s_corr.x), dq = static_cast<double>(f.s_corr.z);
   const int n = static_cast<int>(f.s_corr.y);
   if (!(r < h)) return 0.0;
   const auto poly6 = [h](double s) { return std::pow(1.0 - (s * s) / (h * h), 3); };  // / W(0)
