@@ -4,12 +4,12 @@
 
 #include <algorithm>
 #include <bit>
-#include <cerrno>
 #include <cstdlib>
 #include <cstring>
 
 #include "cuda_backend.h"
 #include "cuda_device.h"
+#include "motes/backend/env.h"
 
 namespace motes::cuda {
 
@@ -96,19 +96,12 @@ Result<std::unique_ptr<Device>> CudaDevice::open(int ordinal) {
   std::memcpy(d->uuid_.data(), &prop.uuid, sizeof(d->uuid_));
   d->impulse_list_from_ =
       std::uint64_t{static_cast<unsigned>(prop.multiProcessorCount)} * kImpulseBlocksPerSm * kBlock;
-  if (const char* from = std::getenv("MOTES_CUDA_IMPULSE_LIST_FROM");
-      from != nullptr && *from != '\0') {
-    char* end = nullptr;
-    errno = 0;
-    const unsigned long long n = std::strtoull(from, &end, 10);
-    if (*from < '0' || *from > '9' || end == nullptr || *end != '\0' || errno == ERANGE) {
-      return Status::error(fmt::format(
-          "MOTES_CUDA_IMPULSE_LIST_FROM: '{}' is not a number of particles (a whole number; 0 "
-          "lists the particles within reach of a contact at every size)",
-          from));
-    }
-    d->impulse_list_from_ = n;
-  }
+  Result<std::optional<std::uint64_t>> from = env_whole_number(
+      "MOTES_CUDA_IMPULSE_LIST_FROM",
+      "a number of particles (a whole number; 0 lists the particles within reach of a contact at "
+      "every size)");
+  if (!from) return from.status();
+  if (from.value()) d->impulse_list_from_ = *from.value();
   const char* host_rebuild = std::getenv("MOTES_CUDA_HOST_REBUILD");
   d->host_rebuild_ = host_rebuild != nullptr && std::strcmp(host_rebuild, "1") == 0;
   for (cudaStream_t* stream : {&d->stream_, &d->body_stream_}) {

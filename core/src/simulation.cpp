@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <bit>
-#include <cerrno>
 #include <cmath>
 #include <cstddef>
 #include <cstdlib>
@@ -13,6 +12,7 @@
 #include <limits>
 #include <optional>
 
+#include "motes/backend/env.h"
 #include "motes/checkpoint.h"
 #include "scene_layout.h"
 #include "shared/body_math.h"
@@ -135,18 +135,11 @@ vec4 lowest_point(const Eigen::Vector3d& gravity, const std::vector<vec4>& pos,
 /// DeviceInfo::one_launch_constraints, or MOTES_CONSTRAINTS_RELAX_LIMIT=C (0: always a launch per
 /// colour; benchmarks and tests compare the two ways); an error when C is not a whole number.
 Result<std::uint64_t> constraints_relax_limit(const Device& device) {
-  const char* value = std::getenv("MOTES_CONSTRAINTS_RELAX_LIMIT");
-  if (value == nullptr || *value == '\0') return device.info().one_launch_constraints;
-  char* end = nullptr;
-  errno = 0;
-  const unsigned long long limit = std::strtoull(value, &end, 10);
-  if (*value < '0' || *value > '9' || end == nullptr || *end != '\0' || errno == ERANGE) {
-    return Status::error(fmt::format(
-        "MOTES_CONSTRAINTS_RELAX_LIMIT: '{}' is not a number of constraints (a whole number; 0 "
-        "relaxes them a launch per colour)",
-        value));
-  }
-  return static_cast<std::uint64_t>(limit);
+  Result<std::optional<std::uint64_t>> limit = env_whole_number(
+      "MOTES_CONSTRAINTS_RELAX_LIMIT",
+      "a number of constraints (a whole number; 0 relaxes them a launch per colour)");
+  if (!limit) return limit.status();
+  return limit.value().value_or(device.info().one_launch_constraints);
 }
 
 }  // namespace
