@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
-#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
@@ -63,16 +62,7 @@ void run_scene(const std::string& backend, const std::string& name, std::uint64_
   ::unsetenv("MOTES_CONSTRAINTS_RELAX_LIMIT");
   ASSERT_TRUE(sim) << sim.message();
   motes::Simulation& s = *sim.value();
-  s.device().set_timing(timed);
-  ASSERT_TRUE(s.step(steps));
-  auto snapshot = s.snapshot();
-  ASSERT_TRUE(snapshot) << snapshot.message();
-  for (const motes::shared::vec4& x : snapshot.value().particle_pos) {
-    ASSERT_TRUE(std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z));
-  }
-  auto hash = s.state_hash();
-  ASSERT_TRUE(hash) << hash.message();
-  out.hash = hash.value();
+  ASSERT_NO_FATAL_FAILURE(motes_test::step_and_hash(s, steps, timed, out.hash));
   const motes::KernelTimes times = s.device().kernel_times();
   out.relax_launches = times.launches[static_cast<std::size_t>(motes::Kernel::ConstraintsRelax)];
   out.solve_launches = times.launches[static_cast<std::size_t>(motes::Kernel::ConstraintsSolve)];

@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <random>
@@ -47,17 +46,7 @@ void run_dominoes(const char* from, bool timed, std::uint32_t seed, std::uint64_
   ASSERT_TRUE(device) << device.message();
   auto sim = motes::Simulation::create(scene.value(), std::move(device).value());
   ASSERT_TRUE(sim) << sim.message();
-  motes::Simulation& s = *sim.value();
-  s.device().set_timing(timed);
-  ASSERT_TRUE(s.step(steps));
-  auto snapshot = s.snapshot();
-  ASSERT_TRUE(snapshot) << snapshot.message();
-  for (const motes::shared::vec4& x : snapshot.value().particle_pos) {
-    ASSERT_TRUE(std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z));
-  }
-  auto h = s.state_hash();
-  ASSERT_TRUE(h) << h.message();
-  hash = h.value();
+  ASSERT_NO_FATAL_FAILURE(motes_test::step_and_hash(*sim.value(), steps, timed, hash));
 }
 
 /// Never listed: more particles than any scene here has.

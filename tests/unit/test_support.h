@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <numbers>
@@ -122,6 +123,23 @@ inline std::unique_ptr<motes::Simulation> simulate_text(const std::string& text,
   auto sim = motes::Simulation::create(*scene, std::move(device.value()));
   EXPECT_TRUE(sim) << sim.message();
   return sim ? std::move(sim.value()) : nullptr;
+}
+
+/// Runs `steps` steps of `s` (kernel timing on when `timed`: CUDA then launches its calls one by
+/// one), requires every particle's position finite and puts the state hash in `hash`; for tests
+/// that compare two ways of stepping to the bit (ASSERT_NO_FATAL_FAILURE around it).
+inline void step_and_hash(motes::Simulation& s, std::uint64_t steps, bool timed,
+                          std::uint64_t& hash) {
+  s.device().set_timing(timed);
+  ASSERT_TRUE(s.step(steps));
+  auto snapshot = s.snapshot();
+  ASSERT_TRUE(snapshot) << snapshot.message();
+  for (const motes::shared::vec4& x : snapshot.value().particle_pos) {
+    ASSERT_TRUE(std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z));
+  }
+  auto h = s.state_hash();
+  ASSERT_TRUE(h) << h.message();
+  hash = h.value();
 }
 
 /// Files the tests read: tests/data/meshes/NAME, the Stanford bunny, examples/scenes/NAME, and
