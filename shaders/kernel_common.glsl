@@ -136,6 +136,21 @@ bool list_set(uint k, uint i, uint j) {
   return was == j;
 }
 
+// Sets entry k of particle i to j, without reading it.
+void list_put(uint k, uint i, uint j) {
+  uint b = list_block(k);
+  uint at = (k - b * p.neighbour_columns) * p.particle_count + i;
+  if (b == 0u) {
+    neighbour_list[at] = j;
+  } else if (b == 1u) {
+    neighbour_list_1[at] = j;
+  } else if (b == 2u) {
+    neighbour_list_2[at] = j;
+  } else {
+    neighbour_list_3[at] = j;
+  }
+}
+
 // Workgroups beyond 65,535 are dispatched as a 2D grid (x, y); this is the flat index.
 uint flat_group() { return gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x; }
 uint thread_index() { return flat_group() * WORKGROUP_SIZE + gl_LocalInvocationID.x; }

@@ -29,10 +29,16 @@ void main() {
     vec4 pi = particle_pos[i];
     neighbour_ref_pos[i] = pi;
     uint c = 0u;
-    uint old_count = neighbour_count[i];
-    bool same = true;
     if (particle_vel[i].w != 0.0f) {  // static particles never move and get no force
       uint body_i = particle_body[i];
+      // Impulse contacts: a particle whose slots were valid under the last build keeps them when
+      // its list comes out as it was; only its old list is read back (the others' entries are
+      // written blind: a read of each would double the build's scattered traffic).
+      uint built = neighbour_state[MOTES_NEIGHBOUR_BUILDS] - 1u;  // the build was counted at its start
+      bool tracked = (p.flags & MOTES_FLAG_IMPULSE) != 0u && i < p.rigid_particle_count &&
+                     impulse_stamp[i] == built;
+      uint old_count = tracked ? neighbour_count[i] : 0u;
+      bool same = true;
       float support_i = neighbour_fluid_support(pi, i, p.fluid_first, p.fluid_count);
       uint lo[27];
       uint hi[27];
@@ -47,16 +53,16 @@ void main() {
             continue;
           }
           if (c < p.neighbour_capacity) {
-            same = list_set(c, i, j) && same;
+            if (tracked && same) {  // read only while it can still match
+              same = list_set(c, i, j);
+            } else {
+              list_put(c, i, j);
+            }
           }
           ++c;
         }
       }
-      // Impulse contacts: a list that comes out as it was keeps its contacts' memory.
-      uint built = neighbour_state[MOTES_NEIGHBOUR_BUILDS] - 1u;  // the build was counted at its start
-      if ((p.flags & MOTES_FLAG_IMPULSE) != 0u && i < p.rigid_particle_count &&
-          impulse_stamp[i] == built &&
-          neighbour_keeps_slots(old_count, c, same, p.neighbour_capacity)) {
+      if (tracked && neighbour_keeps_slots(old_count, c, same, p.neighbour_capacity)) {
         impulse_stamp[i] = built + 1u;
       }
     }

@@ -56,7 +56,10 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
     const uint body_i = body[i];
     const float support_i =
         shared::neighbour_fluid_support(pi, uint(i), p.fluid_first, p.fluid_count);
-    const uint old_count = count[i];
+    // Only a particle whose stamp may move on compares its new list with its old one.
+    const bool tracked =
+        stamps && static_cast<std::size_t>(i) < sizes_.rigid_particles && stamp[i] == built;
+    const uint old_count = tracked ? count[i] : 0u;
     bool same = true;
     uint c = 0;
     shared::grid_walk(p, pi, cell_start, [&](uint lo, uint hi) {
@@ -72,15 +75,14 @@ void OpenMPDevice::neighbours_build(const shared::StepParams& p) {
         }
         if (c < capacity) {
           uint& entry = list[std::size_t{c} * stride + static_cast<std::size_t>(i)];
-          same = same && entry == j;
+          if (tracked && same) same = entry == j;
           entry = j;
         }
         ++c;
       }
     });
     count[i] = c;
-    if (stamps && static_cast<std::size_t>(i) < sizes_.rigid_particles && stamp[i] == built &&
-        shared::neighbour_keeps_slots(old_count, c, same, capacity)) {
+    if (tracked && shared::neighbour_keeps_slots(old_count, c, same, capacity)) {
       stamp[i] = built + 1u;
     }
     over += c > capacity ? 1u : 0u;
