@@ -68,7 +68,8 @@ __global__ void neighbours_build_kernel(shared::StepParams p, BuildInputs in, Bu
       const uint body_i = in.body[i];
       // Impulse contacts: a particle whose slots were valid under the last build keeps them when
       // its list comes out as it was; only its old list is read back (the others' entries are
-      // written blind: a read of each would double the build's scattered traffic).
+      // written blind; measured on an H200, that saved 5% of the dam break's build and nothing of
+      // W1's: docs/benchmarks.md, "The list build's threads and traffic").
       const uint built = out.state[MOTES_NEIGHBOUR_BUILDS] - 1u;  // neighbours_begin counted this
       const bool tracked =
           out.stamp != nullptr && i < p.rigid_particle_count && out.stamp[i] == built;
