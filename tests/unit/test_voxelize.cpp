@@ -598,6 +598,25 @@ TEST(VoxelizeOpen, SliverFanReachesItsTargetCount) {
   EXPECT_EQ(again->points.size(), particles->points.size());
 }
 
+TEST(VoxelizeOpen, SliverWhoseCountJumpsEndsTheSearchNearItsTarget) {
+  // fuzz_mesh's input raw_open_sliver_jumps_slow (docs/fuzzing.md, finding 9): an open sliver 96
+  // units wide and 7 deep whose count near 50 particles jumps between 47 and 61 as the diameter
+  // changes in its sixth digit (its lattice's cells slide against the sliver's faces). The
+  // bisection, which chased those jumps through 30 fills, stops at the first count outside its
+  // ends' counts: the count still near 50, and the diameter gives its count again.
+  TriangleMesh mesh;
+  mesh.source = "jumping sliver";
+  mesh.vertices = {{3, -3, 0}, {0, 0, 0}, {96, -16, 0}, {0, 51, -7}, {0, 0, 0}, {3, 0, 0}};
+  mesh.triangles = {{0, 1, 0}, {0, 4, 2}, {0, 5, 5}, {1, 3, 2}, {0, 1, 5},
+                    {2, 1, 4}, {4, 2, 0}, {2, 1, 2}, {5, 3, 5}};
+  auto particles = voxelize_to(mesh, 50);
+  ASSERT_TRUE(particles) << particles.message();
+  EXPECT_NEAR(static_cast<double>(particles->points.size()), 50.0, 5.0);
+  auto again = voxelize_at(mesh, particles->diameter);
+  ASSERT_TRUE(again) << again.message();
+  EXPECT_EQ(again->points.size(), particles->points.size());
+}
+
 TEST(VoxelizeOpen, RandomFansReachATargetOrSayWhyNot) {
   // Seeded variations of the fan above: 2 to 6 vertices in a cluster, one to three far away, 6 to
   // 20 triangles among them. The search for 50 particles either ends with a diameter that gives
