@@ -37,10 +37,10 @@ export MOTES_PROPERTY_THREADS=${MOTES_PROPERTY_THREADS:-1}
 # it prints fails the test that caused it.
 export MOTES_VULKAN_VALIDATION=${MOTES_VULKAN_VALIDATION:-1}
 # lavapipe hands every dispatch to worker threads (one per core). The tests already run side by
-# side on every core, and at test sizes the hand-offs cost more than they give (the 2-core machine:
-# cloth.json on Vulkan 63 steps/s with two workers, 139 with none; four example scenes on Vulkan
-# under ctest -j2 took 109 s against 83 s): LP_NUM_THREADS=0 runs each dispatch in the thread that
-# submits it. The conformance suite's kernel and scene cases keep two workers
+# side on every core, and at test sizes the hand-offs cost more than they give (the 2-core machine,
+# Mesa 22.3: cloth.json on Vulkan 63 steps/s with two workers, 139 with none; four example scenes
+# on Vulkan under ctest -j2 took 109 s against 83 s): LP_NUM_THREADS=0 runs each dispatch in the
+# thread that submits it. The conformance suite's kernel and scene cases keep two workers
 # (tests/CMakeLists.txt), so that on lavapipe too the workgroups of a dispatch run side by side, as
 # on a GPU; its extra passes (Conformance.VulkanTwoDimensionalDispatch and .PoisonUnreadBuffers)
 # run with none, like the rest.
