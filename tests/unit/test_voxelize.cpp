@@ -577,6 +577,17 @@ TEST(VoxelizeOpen, SheetsWithoutVolumeAreErrors) {
       << counted.message();
 }
 
+/// Voxelized to `target` particles, `mesh` ends within `within` of it, with a diameter that gives
+/// its count again.
+void expect_near_target(const TriangleMesh& mesh, std::size_t target, double within) {
+  auto particles = voxelize_to(mesh, target);
+  ASSERT_TRUE(particles) << particles.message();
+  EXPECT_NEAR(static_cast<double>(particles->points.size()), static_cast<double>(target), within);
+  auto again = voxelize_at(mesh, particles->diameter);
+  ASSERT_TRUE(again) << again.message();
+  EXPECT_EQ(again->points.size(), particles->points.size());
+}
+
 TEST(VoxelizeOpen, SliverFanReachesItsTargetCount) {
   // fuzz_mesh's input raw_open_fan_slow without its triangles of repeated indices: slivers from
   // a cluster near the origin (five vertices at one point, told apart by index only) to a vertex
@@ -590,12 +601,7 @@ TEST(VoxelizeOpen, SliverFanReachesItsTargetCount) {
   mesh.triangles = {{4, 1, 5}, {0, 3, 5}, {0, 4, 1}, {7, 6, 4}, {3, 2, 0},
                     {2, 1, 4}, {5, 6, 4}, {6, 7, 0}, {1, 5, 0}, {5, 4, 2},
                     {3, 7, 2}, {7, 6, 3}, {0, 4, 3}, {4, 7, 1}, {2, 6, 1}};
-  auto particles = voxelize_to(mesh, 50);
-  ASSERT_TRUE(particles) << particles.message();
-  EXPECT_NEAR(static_cast<double>(particles->points.size()), 50.0, 2.5);
-  auto again = voxelize_at(mesh, particles->diameter);
-  ASSERT_TRUE(again) << again.message();
-  EXPECT_EQ(again->points.size(), particles->points.size());
+  expect_near_target(mesh, 50, 2.5);
 }
 
 TEST(VoxelizeOpen, SliverWhoseCountJumpsEndsTheSearchNearItsTarget) {
@@ -609,12 +615,7 @@ TEST(VoxelizeOpen, SliverWhoseCountJumpsEndsTheSearchNearItsTarget) {
   mesh.vertices = {{3, -3, 0}, {0, 0, 0}, {96, -16, 0}, {0, 51, -7}, {0, 0, 0}, {3, 0, 0}};
   mesh.triangles = {{0, 1, 0}, {0, 4, 2}, {0, 5, 5}, {1, 3, 2}, {0, 1, 5},
                     {2, 1, 4}, {4, 2, 0}, {2, 1, 2}, {5, 3, 5}};
-  auto particles = voxelize_to(mesh, 50);
-  ASSERT_TRUE(particles) << particles.message();
-  EXPECT_NEAR(static_cast<double>(particles->points.size()), 50.0, 5.0);
-  auto again = voxelize_at(mesh, particles->diameter);
-  ASSERT_TRUE(again) << again.message();
-  EXPECT_EQ(again->points.size(), particles->points.size());
+  expect_near_target(mesh, 50, 5.0);
 }
 
 TEST(VoxelizeOpen, RandomFansReachATargetOrSayWhyNot) {
