@@ -102,23 +102,6 @@ Result<std::unique_ptr<Device>> CudaDevice::open(int ordinal) {
       "every size)");
   if (!from) return from.status();
   if (from.value()) d->impulse_list_from_ = *from.value();
-  if (const char* order = std::getenv("MOTES_CUDA_LIST_ORDER"); order != nullptr && *order != '\0') {
-    const std::string o = order;
-    if (o == "particle") {
-      d->list_order_ = ListOrder::Particle;
-    } else if (o == "grid") {
-      d->list_order_ = ListOrder::Grid;
-    } else if (o != "auto") {
-      return Status::error("MOTES_CUDA_LIST_ORDER: '" + o + "' is not particle, grid or auto");
-    }
-  }
-  Result<std::optional<std::uint64_t>> span = env_whole_number(
-      "MOTES_CUDA_LIST_STAGE_SPAN",
-      "a number of sorted slots (a whole number; 0 walks every row from global memory)");
-  if (!span) return span.status();
-  if (span.value()) {
-    d->list_stage_span_ = static_cast<shared::uint>(std::min<std::uint64_t>(*span.value(), 1u << 30));
-  }
   const char* host_rebuild = std::getenv("MOTES_CUDA_HOST_REBUILD");
   d->host_rebuild_ = host_rebuild != nullptr && std::strcmp(host_rebuild, "1") == 0;
   for (cudaStream_t* stream : {&d->stream_, &d->body_stream_}) {

@@ -180,14 +180,6 @@ class CudaDevice final : public Device {
 
   std::vector<KernelCall> pending_;
   std::vector<Graph> graphs_;
-  /// neighbours_build's threads (neighbours_build.cu): in particle order, in grid order, or (Auto)
-  /// in grid order when the scene has fluid. MOTES_CUDA_LIST_ORDER=particle|grid|auto.
-  enum class ListOrder { Auto, Particle, Grid };
-  ListOrder list_order_ = ListOrder::Auto;
-  /// The widest span of sorted slots a warp of neighbours_build loads into shared memory for one
-  /// row of its walk; wider rows are walked from global memory. MOTES_CUDA_LIST_STAGE_SPAN=N
-  /// (0: never staged).
-  shared::uint list_stage_span_ = 256;
   bool host_rebuild_ = false;  ///< MOTES_CUDA_HOST_REBUILD=1: calls launched one by one
   std::vector<cudaEvent_t> events_;
   Status error_;

@@ -12,25 +12,6 @@
 #ifdef __cplusplus
 MOTES_SHARED_BEGIN
 
-/// The walk's row tests for a kernel that walks the rows itself (CUDA's neighbours_build, whose
-/// warps share their rows' candidates): row `row` (counted from 0 in grid_walk's order) with
-/// centre bucket centres[row], the earlier rows' centres before it, is one sorted range
-/// [cell_start[c-1], cell_start[c+2]) when grid_row_whole, else its buckets c-1, c, c+1 each
-/// unless grid_bucket_seen, exactly as grid_walk visits them. grid_walk keeps its own copy of
-/// these tests: calling these from it changed the registers of every kernel that inlines it
-/// (contacts_compute's stack frame on sm_90 went from 56 to 80 bytes, W1 dense 25% slower).
-MOTES_FN bool grid_row_whole(const uint* centres, int row, uint mask) {
-  const uint c = centres[row];
-  bool clash = false;
-  for (int r = 0; r < row; ++r) clash = clash || ((c - centres[r] + 2u) & mask) <= 4u;
-  return !clash && c >= 1u && c < mask;
-}
-MOTES_FN bool grid_bucket_seen(const uint* centres, int row, uint b, uint mask) {
-  bool seen = false;
-  for (int r = 0; r < row; ++r) seen = seen || grid_row_covers(centres[r], b, mask);
-  return seen;
-}
-
 /// Calls visit(lo, hi) for each range [lo, hi) of sorted slots visited from the cell of `x`, in
 /// order: rows (dz, dy) for dz = -1..1 and, inside, dy = -1..1; in a row with centre bucket c the
 /// buckets c-1, c, c+1, each bucket only by the first row that covers it (up to 27 ranges; a row
