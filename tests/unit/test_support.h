@@ -31,9 +31,12 @@ class TempDir {
  public:
   TempDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = std::filesystem::temp_directory_path() /
-            ("motes_" + std::string(info->test_suite_name()) + "_" + std::string(info->name()) +
-             "_" + std::to_string(::getpid()));
+    // One folder, not nested ones: a parameterized test's names hold '/' (Backends/Suite,
+    // Case/openmp), whose parent folders removing the leaf would leave behind.
+    std::string name = "motes_" + std::string(info->test_suite_name()) + "_" +
+                       std::string(info->name()) + "_" + std::to_string(::getpid());
+    std::replace(name.begin(), name.end(), '/', '_');
+    path_ = std::filesystem::temp_directory_path() / name;
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }

@@ -47,11 +47,27 @@ constexpr int kHeight = 240;
 // cannot pass a wrong picture).
 constexpr double kSameBelow = 3.0;
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("motes-view-test-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return dir / name;
+fs::path scratch_dir() {
+  return fs::temp_directory_path() / ("motes-view-test-" + std::to_string(getpid()));
 }
+
+fs::path scratch(const std::string& name) {
+  fs::create_directories(scratch_dir());
+  return scratch_dir() / name;
+}
+
+/// The scratch folder is removed when the program's tests have passed (kept after a failure, for
+/// its pictures and logs).
+class ScratchCleanup : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    if (!::testing::UnitTest::GetInstance()->Passed()) return;
+    std::error_code ec;
+    fs::remove_all(scratch_dir(), ec);
+  }
+};
+[[maybe_unused]] ::testing::Environment* const kScratchCleanup =
+    ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
 
 Image load_png(const fs::path& path) {
   Image image;
