@@ -89,7 +89,7 @@ int frames(const std::uint8_t* data, std::size_t size) {
 void write_frame_seeds(const fs::path& dir) {
   fs::create_directories(dir);
   // Two boxes of 2 x 2 x 2 particles falling onto a rope: 20 particles, 3 frames.
-  constexpr const char* kScene = R"({
+  constexpr const char* kFramesScene = R"({
     "settings": {"dt": 2e-5, "contact": {"stiffness": 1000, "damping": 20}},
     "planes": [{"normal": [0, 1, 0]}],
     "bodies": [
@@ -99,7 +99,7 @@ void write_frame_seeds(const fs::path& dir) {
        "particles": 4}}
     ]
   })";
-  Result<Scene> scene = load_scene_text(kScene, "fuzz_frames.json", "");
+  Result<Scene> scene = load_scene_text(kFramesScene, "fuzz_frames.json", "");
   if (!scene) broken("frames", "the seed scene does not load:", scene.message());
   DeviceOptions options;
   options.cpu_threads = 1;

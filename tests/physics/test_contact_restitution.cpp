@@ -189,11 +189,12 @@ TEST_P(HeadOnContact, MatchesDiscreteAndClosedForm) {
   const double zeta = gamma_f / (2.0 * w0);
   const Expected expect = closed_form(zeta, w0, clamped);
 
-  auto separation = [&](const motes::Snapshot& s) {
+  // wall is copied into the lambdas: clang 14 cannot capture a structured binding by reference.
+  auto separation = [&, wall = wall](const motes::Snapshot& s) {
     if (wall) return (to_vec3(s.particle_pos[0]) - scene.planes[0].point).dot(n);
     return (to_vec3(s.particle_pos[1]) - to_vec3(s.particle_pos[0])).norm();
   };
-  auto separation_rate = [&](const motes::Snapshot& s) {
+  auto separation_rate = [&, wall = wall](const motes::Snapshot& s) {
     if (wall) return to_vec3(s.body_vel[0]).dot(n);
     return (to_vec3(s.body_vel[1]) - to_vec3(s.body_vel[0])).dot(n);
   };

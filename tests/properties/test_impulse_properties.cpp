@@ -337,7 +337,7 @@ std::vector<Outcome> run_batch(const std::string& backend, const std::vector<Cas
               if (rest_pos[k][i - lo].y > rest_pos[k][top - lo].y) top = i;
               if (rest_pos[k][i - lo].y < rest_pos[k][bottom - lo].y) bottom = i;
             }
-            const auto moved = [&](std::size_t i) {
+            const auto moved = [&, lo = lo](std::size_t i) {  // clang 14: a binding is copied
               return (v3(snap->particle_pos[i]) - v3(rest_pos[k][i - lo])).norm();
             };
             if (moved(top) > 2.0 * moved(bottom)) continue;

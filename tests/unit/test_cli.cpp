@@ -20,6 +20,7 @@
 #include "motes/devices.h"
 #include "motes/scene.h"
 #include "motes/simulation.h"
+#include "sanitized_build.h"
 #include "unit/cli_support.h"
 #include "unit/test_support.h"
 
@@ -550,15 +551,10 @@ TEST(Cli, BenchSkinSetsW1sListSkin) {
 // to 3.64 GB, and on the GPU machine W1 at 268,435,456 spheres past the machine's memory: killed,
 // not refused.
 TEST(Cli, BenchW1HostMemoryStaysWithinItsEstimate) {
-#if defined(__SANITIZE_ADDRESS__)
   // AddressSanitizer's shadow memory is not the program's: the sanitizer stage runs the same
   // path at 262,144 spheres for memory errors and leaves the peak to the first stage.
-  constexpr std::uint64_t kSpheres = 262144;
-  constexpr bool kCheckPeak = false;
-#else
-  constexpr std::uint64_t kSpheres = 4194304;
-  constexpr bool kCheckPeak = true;
-#endif
+  constexpr std::uint64_t kSpheres = motes_test::sanitized_or<std::uint64_t>(4194304, 262144);
+  constexpr bool kCheckPeak = !motes_test::kSanitized;
   TempDir tmp;
   const Outcome o = run_motes(tmp, {"bench", "--workload", "settle", "--phase", "falling",
                                     "--sizes", std::to_string(kSpheres), "--backend", "openmp",
