@@ -171,8 +171,9 @@ class Grab {
       std::vector<Eigen::Vector3d> velocity(frame.body_vel.size());
       for (std::size_t b = 0; b < velocity.size(); ++b) {
         const shared::vec4& u = frame.body_vel[b];
-        velocity[b] = sim.bodies()[b].kind == BodyKind::Static ? Eigen::Vector3d::Zero()
-                                                               : Eigen::Vector3d(u.x, u.y, u.z);
+        velocity[b] = sim.bodies()[b].kind == BodyKind::Static
+                          ? Eigen::Vector3d::Zero()
+                          : Eigen::Vector3d(Eigen::Vector3f(u.x, u.y, u.z).cast<double>());
       }
       velocity[body_] = v.cast<double>();
       if (Status s = sim.set_body_velocities(velocity); !s) fail(s.message());

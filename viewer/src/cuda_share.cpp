@@ -15,10 +15,6 @@
 
 namespace motes::viewer {
 
-namespace {
-constexpr VkDeviceSize kVec4 = 16;
-}  // namespace
-
 struct CudaShare::Imported {
 #ifdef MOTES_VIEWER_CUDA
   std::unique_ptr<CudaImportedMemory> memory;
@@ -46,6 +42,7 @@ std::string CudaShare::why_not(const Gpu& gpu, Simulation& sim) {
 CudaShare::CudaShare(const Gpu& gpu, Simulation& sim, bool velocities)
     : gpu_(gpu), velocities_(velocities), imported_(std::make_unique<Imported>()) {
 #ifdef MOTES_VIEWER_CUDA
+  constexpr VkDeviceSize kVec4 = 16;
   const VkDeviceSize particles = std::max<VkDeviceSize>(sim.particle_count(), 1);
   velocities_offset_ = kVec4 * particles;
   const VkDeviceSize wanted = velocities ? 2 * velocities_offset_ : velocities_offset_;

@@ -44,7 +44,7 @@ class CudaShare {
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
   VkDeviceSize size_ = 0;
   VkDeviceSize velocities_offset_ = 0;
-  bool velocities_ = false;
+  [[maybe_unused]] bool velocities_ = false;  // read only in a build with CUDA
   std::unique_ptr<Imported> imported_;
 };
 

@@ -43,7 +43,7 @@ bool finite(const shared::vec4& p) {
 Segments grid_cell_segments(const Snapshot& frame, float inv_cell_size, std::size_t max_cells) {
   Segments out;
   if (!(inv_cell_size > 0.0f)) return out;
-  const double inv = inv_cell_size;
+  const double inv = static_cast<double>(inv_cell_size);
   const Eigen::Vector3f color(0.25f, 0.65f, 1.0f);
   std::unordered_set<Cell, CellHash> seen;
   for (const shared::vec4& p : frame.particle_pos) {
