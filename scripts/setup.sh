@@ -10,7 +10,7 @@ shift || true
 packages=(build-essential cmake ninja-build pkg-config git
   libeigen3-dev libassimp-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev python3 python3-meshio clang-format
-  clang libclang-rt-14-dev
+  clang libclang-rt-14-dev libomp-dev
   glslang-tools spirv-tools libvulkan-dev libvulkan-volk-dev libvulkan1 mesa-vulkan-drivers
   vulkan-validationlayers libstb-dev ffmpeg python3-dev python3-pybind11 python3-numpy python3-scipy
   libglfw3-dev xvfb xdotool

@@ -62,9 +62,13 @@ MOTES_SKIP_INSTALL=1 "$root/scripts/check-package.sh" "$build"
 # code is still reported. Afterwards every test that passed above must have passed here too.
 # CUDA is left out of this build: its kernels run only on a GPU, where compute-sanitizer's
 # memcheck and racecheck check them (scripts/gpu/run-suite.sh sanitize).
+# It is built with clang (its OpenMP from libomp-dev), the release build above with GCC: two
+# compilers' warnings, and clang builds it in half the time (this 2-core VM: 273 s and 839 CPU-s
+# against GCC's 568 s and 1,151).
 if [ "${MOTES_SANITIZER_STAGE:-1}" = 1 ]; then
   stage "sanitizer build"
   MOTES_COMPILER_LAUNCHER= MOTES_SKIP_INSTALL=1 "$root/scripts/setup.sh" "$build-sanitize" \
+    -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DMOTES_WITH_OPENMP=ON \
     -DMOTES_WERROR=ON -DMOTES_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DMOTES_TEST_VULKAN_VALIDATION=OFF -DMOTES_WITH_CUDA=OFF
   cd "$build-sanitize"
