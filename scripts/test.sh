@@ -63,8 +63,8 @@ MOTES_SKIP_INSTALL=1 "$root/scripts/check-package.sh" "$build"
 # CUDA is left out of this build: its kernels run only on a GPU, where compute-sanitizer's
 # memcheck and racecheck check them (scripts/gpu/run-suite.sh sanitize).
 # It is built with clang (its OpenMP from libomp-dev), the release build above with GCC: two
-# compilers' warnings, and clang builds it in half the time (this 2-core VM: 273 s and 839 CPU-s
-# against GCC's 568 s and 1,151).
+# compilers' warnings, and clang builds it in about half the time (this 2-core VM: 273 to 306 s,
+# 839 CPU-s, against GCC's 568 s and 1,151).
 if [ "${MOTES_SANITIZER_STAGE:-1}" = 1 ]; then
   stage "sanitizer build"
   MOTES_COMPILER_LAUNCHER= MOTES_SKIP_INSTALL=1 "$root/scripts/setup.sh" "$build-sanitize" \
