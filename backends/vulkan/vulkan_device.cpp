@@ -176,20 +176,27 @@ Status VulkanDevice::init(std::shared_ptr<Instance> instance, int physical) {
   std::vector<VkExtensionProperties> extensions(extension_count);
   vkEnumerateDeviceExtensionProperties(physical_.handle, nullptr, &extension_count,
                                        extensions.data());
+  bool executable_properties = false;
   for (const VkExtensionProperties& e : extensions) {
     if (std::strcmp(e.extensionName, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME) == 0) {
       memory_budget_ = true;
     }
+    if (std::strcmp(e.extensionName, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME) == 0) {
+      executable_properties = true;
+    }
   }
-  const char* budget_extension = VK_EXT_MEMORY_BUDGET_EXTENSION_NAME;
+  std::vector<const char*> enabled;
+  if (memory_budget_) enabled.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
   VkDeviceCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue;
-  if (memory_budget_) {
-    info.enabledExtensionCount = 1;
-    info.ppEnabledExtensionNames = &budget_extension;
-  }
+  shader_stats_ = ShaderStats::from_environment();
+  VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR stats_feature{};
+  shader_stats_.request(executable_properties, info_.name.c_str(), enabled, stats_feature,
+                        info.pNext);
+  info.enabledExtensionCount = static_cast<std::uint32_t>(enabled.size());
+  info.ppEnabledExtensionNames = enabled.data();
   if (Status s =
           check(vkCreateDevice(physical_.handle, &info, nullptr, &device_), "vkCreateDevice");
       !s) {
@@ -359,7 +366,9 @@ VkPipeline VulkanDevice::pipeline_at(std::size_t i) const {
     pipe.stage.module = module;
     pipe.stage.pName = "main";
     pipe.layout = pipeline_layouts_[i];
+    pipe.flags = shader_stats_.create_flags();
     r = vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipe, nullptr, &pipelines_[i]);
+    if (r == VK_SUCCESS) shader_stats_.report(device_, pipelines_[i], shader->name);
     vkDestroyShaderModule(device_, module, nullptr);
     what = "vkCreateComputePipelines";
   }

@@ -15,6 +15,7 @@
 
 #include "motes/backend/device.h"
 #include "motes/backend/kernel_queue.h"
+#include "shader_stats.h"
 #include "shared/common.h"
 #include "vulkan_bindings.h"
 #include "vulkan_context.h"
@@ -227,6 +228,8 @@ class VulkanDevice final : public Device {
   VkPhysicalDeviceMemoryProperties memory_{};
   /// VK_EXT_memory_budget is enabled: available_bytes() reads the heaps' budgets and usage.
   bool memory_budget_ = false;
+  /// MOTES_VULKAN_SHADER_STATS: each pipeline's statistics as it is made (shader_stats.h).
+  ShaderStats shader_stats_;
 
   Sizes sizes_;
   bool allocated_ = false;
