@@ -130,9 +130,9 @@ void ShaderStats::report(VkDevice device, VkPipeline pipeline, const char* name)
           fmt::format("{}.{}{}.{}", name, executables > 1 ? fmt::format("{}.", e) : "",
                       file_part(ir[k].name), ir[k].isText ? "txt" : "bin");
       std::ofstream out(path, std::ios::binary);
-      const std::size_t bytes =
-          ir[k].isText && !data[k].empty() && data[k].back() == '\0' ? data[k].size() - 1
-                                                                      : data[k].size();
+      const std::size_t bytes = ir[k].isText && !data[k].empty() && data[k].back() == '\0'
+                                    ? data[k].size() - 1
+                                    : data[k].size();
       out.write(data[k].data(), static_cast<std::streamsize>(bytes));
       if (!out) fmt::print(stderr, "vulkan shader statistics: cannot write {}\n", path.string());
     }

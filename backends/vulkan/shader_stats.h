@@ -14,9 +14,9 @@
 namespace motes::vulkan {
 
 struct ShaderStats {
-  bool wanted = false;  ///< MOTES_VULKAN_SHADER_STATS is set and not "0"
-  std::string folder;   ///< its value when that is a folder: where representations go
-  bool enabled = false; ///< the device has the extension and it was enabled
+  bool wanted = false;   ///< MOTES_VULKAN_SHADER_STATS is set and not "0"
+  std::string folder;    ///< its value when that is a folder: where representations go
+  bool enabled = false;  ///< the device has the extension and it was enabled
 
   /// Reads MOTES_VULKAN_SHADER_STATS.
   static ShaderStats from_environment();
@@ -24,8 +24,7 @@ struct ShaderStats {
   /// Adds the extension and its feature to a device's creation (`feature` must outlive the
   /// vkCreateDevice call), where wanted and available; says on stderr when the device lacks it.
   void request(bool available, const char* device_name, std::vector<const char*>& extensions,
-               VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR& feature,
-               const void*& next);
+               VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR& feature, const void*& next);
 
   /// The pipeline-creation flags that capture what report() reads (0 when not enabled).
   [[nodiscard]] VkPipelineCreateFlags create_flags() const;
