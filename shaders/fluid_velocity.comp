@@ -63,11 +63,10 @@ vec3 adhesion_reaction(uint b) {
     return sum;
   }
   uint body_b = particle_body[b];
-  uint lo[27];
-  uint hi[27];
-  int ranges = grid_walk(neighbour_ref_pos[b], lo, hi);
-  for (int r = 0; r < ranges; ++r) {
-    for (uint t = lo[r]; t < hi[r]; ++t) {
+  GridWalk walk = grid_walk_begin(neighbour_ref_pos[b]);
+  uint lo, hi;
+  while (grid_walk_next(walk, lo, hi)) {
+    for (uint t = lo; t < hi; ++t) {
       uint j = grid_order[t];
       if (!contact_skipped(body_b, sorted_body[t], b, j)) sum += reaction_term(j, xb, rb);
     }
@@ -103,11 +102,10 @@ void main() {
     }
   } else {
     uint body_i = particle_body[i];
-    uint lo[27];
-    uint hi[27];
-    int ranges = grid_walk(neighbour_ref_pos[i], lo, hi);
-    for (int r = 0; r < ranges; ++r) {
-      for (uint t = lo[r]; t < hi[r]; ++t) {
+    GridWalk walk = grid_walk_begin(neighbour_ref_pos[i]);
+    uint lo, hi;
+    while (grid_walk_next(walk, lo, hi)) {
+      for (uint t = lo; t < hi; ++t) {
         uint j = grid_order[t];
         if (!contact_skipped(body_i, sorted_body[t], i, j)) {
           add_neighbour(j, xi, vi, omega_i.w, ni, rhoi, f, g);

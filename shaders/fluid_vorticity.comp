@@ -37,11 +37,10 @@ void main() {
     }
   } else {
     uint body_i = particle_body[i];
-    uint lo[27];
-    uint hi[27];
-    int ranges = grid_walk(neighbour_ref_pos[i], lo, hi);
-    for (int r = 0; r < ranges; ++r) {
-      for (uint t = lo[r]; t < hi[r]; ++t) {
+    GridWalk walk = grid_walk_begin(neighbour_ref_pos[i]);
+    uint lo, hi;
+    while (grid_walk_next(walk, lo, hi)) {
+      for (uint t = lo; t < hi; ++t) {
         uint j = grid_order[t];
         if (!contact_skipped(body_i, sorted_body[t], i, j)) add_neighbour(j, xi, vi, h, omega, ni);
       }

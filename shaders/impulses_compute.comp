@@ -77,11 +77,10 @@ void main() {
       impulse_add(sum, moment_sum, r, arm, p.flags);
     }
   } else {
-    uint lo[27];
-    uint hi[27];
-    int ranges = grid_walk(neighbour_ref_pos[i], lo, hi);
-    for (int r = 0; r < ranges; ++r) {
-      for (uint t = lo[r]; t < hi[r]; ++t) {
+    GridWalk walk = grid_walk_begin(neighbour_ref_pos[i]);
+    uint lo, hi;
+    while (grid_walk_next(walk, lo, hi)) {
+      for (uint t = lo; t < hi; ++t) {
         if (contact_excluded(sorted_body[t], bi)) continue;
         uint j = grid_order[t];
         if (j >= p.rigid_particle_count) continue;

@@ -40,11 +40,10 @@ void main() {
       uint old_count = tracked ? neighbour_count[i] : 0u;
       bool same = true;
       float support_i = neighbour_fluid_support(pi, i, p.fluid_first, p.fluid_count);
-      uint lo[27];
-      uint hi[27];
-      int ranges = grid_walk(pi, lo, hi);
-      for (int r = 0; r < ranges; ++r) {
-        for (uint t = lo[r]; t < hi[r]; ++t) {
+      GridWalk walk = grid_walk_begin(pi);
+      uint lo, hi;
+      while (grid_walk_next(walk, lo, hi)) {
+        for (uint t = lo; t < hi; ++t) {
           uint j = grid_order[t];
           if (contact_skipped(body_i, sorted_body[t], i, j) ||
               !neighbour_within(pi, sorted_pos[t], p.neighbour_skin,

@@ -2,7 +2,7 @@
 // sorted ranges a particle visits, in order. Used by neighbours_build and by the grid fallback of
 // contacts_compute and impulses_compute for particles with more neighbours than their list holds,
 // so all visit the same pairs in the same order. GLSL has the same walk in shaders/grid_walk.glsl
-// (it reads the grid's buffer by name and fills arrays: GLSL has no callbacks).
+// (it reads the grid's buffer by name and hands out one range at a time: GLSL has no callbacks).
 #ifndef MOTES_SHARED_GRID_WALK_H
 #define MOTES_SHARED_GRID_WALK_H
 
