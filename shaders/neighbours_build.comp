@@ -1,9 +1,9 @@
 #version 450
-// neighbours_build (after neighbours_build_begin.comp or neighbours_update.comp): every dynamic
-// particle (one thread per particle, in grid order) lists the
-// particles of other bodies closer than r_i + r_j + skin (shared/neighbours.h) in the canonical
-// order of the 27-cell walk, keeps the first K (entry k at k * N + i) and writes its full count;
-// as backends/openmp/neighbours_build.cpp. The figures of the build (particles over capacity,
+// neighbours_build (after neighbours_build_begin.comp, neighbours_update.comp or
+// neighbours_update_small.comp): every dynamic particle (one thread per particle, in grid order)
+// lists the particles of other bodies closer than r_i + r_j + skin (shared/neighbours.h) in the
+// canonical order of the 27-cell walk, keeps the first K (entry k at k * N + i) and writes its full
+// count; as backends/openmp/neighbours_build.cpp. The figures of the build (particles over capacity,
 // largest count) are reduced per workgroup, then added with integer atomics.
 #extension GL_GOOGLE_include_directive : require
 #include "kernel_common.glsl"
@@ -16,6 +16,9 @@ shared uint group_over;
 shared uint group_most;
 
 void main() {
+  // Gated (args.y != 0: after neighbours_update_small.comp, dispatched directly): built only when
+  // word args.x of IndirectArgs says so, the same for every invocation.
+  if (args.y != 0u && indirect_args[args.x] == 0u) return;
   uint k = thread_index();
   if (gl_LocalInvocationID.x == 0u) {
     group_over = 0u;

@@ -2,6 +2,10 @@
 // indirect arguments of every rebuild pass from their template (written at allocate) when
 // NeighbourState asks for a rebuild, or zeroes them; the grid_build and neighbours_build passes are
 // then dispatched indirectly, so a recorded step replays without the host deciding anything.
+// With MOTES_VULKAN_SMALL_REBUILD, a small grid (at most small_rebuild_table_ buckets) is rebuilt
+// by one workgroup instead (shaders/neighbours_update_small.comp), which gates a directly
+// dispatched neighbours_build: two dispatches a step where the indirect rebuild has ten, most of
+// them empty.
 #include "vulkan_device.h"
 
 namespace motes::vulkan {
@@ -15,6 +19,28 @@ void VulkanDevice::record_neighbours_update(VkCommandBuffer cb, const shared::St
     vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, queries_, query++);
     if (begin) spans->push_back(k);
   };
+  if (std::uint64_t{p.table_mask} + 1 <= small_rebuild_table_) {
+    // A small grid: one workgroup decides and builds the grid, then the gated list build, both
+    // dispatched directly (timed: the decision with the grid as grid_build's span).
+    const std::uint32_t gate = rebuild_gate_word();
+    const std::uint32_t decide[4] = {gate, 0, 0, 0};
+    stamp(true, Kernel::NeighboursUpdate);
+    stamp(false, Kernel::NeighboursUpdate);
+    stamp(true, Kernel::GridBuild);
+    dispatch_groups(cb, Pipeline::NeighboursUpdateSmall, p, 1, decide);
+    barrier(cb);
+    stamp(false, Kernel::GridBuild);
+    stamp(true, Kernel::NeighboursBuild);
+    std::vector<Pass> build = neighbours_build_passes(p);
+    for (Pass& pass : build) {
+      pass.args[0] = gate;
+      pass.args[1] = 1;  // gated
+    }
+    record_passes(cb, build, p);
+    barrier(cb);
+    stamp(false, Kernel::NeighboursBuild);
+    return;
+  }
   const std::uint32_t words = rebuild_passes_ * 4;
   const std::uint32_t args[4] = {words, words, 0, 0};
   stamp(true, Kernel::NeighboursUpdate);

@@ -238,6 +238,10 @@ Status VulkanDevice::init_queue(std::uint32_t queue_index) {
     const long v = std::strtol(env, nullptr, 10);
     if (v >= 1 && v < 65536) list_columns_cap_ = static_cast<std::uint32_t>(v);
   }
+  if (const char* env = std::getenv("MOTES_VULKAN_SMALL_REBUILD"); env != nullptr && *env != '\0') {
+    const long v = std::strtol(env, nullptr, 10);
+    if (v >= 0 && v <= (1L << 31)) small_rebuild_table_ = static_cast<std::uint32_t>(v);
+  }
   vkGetDeviceQueue(device_, physical_.compute_family, queue_index, &queue_);
   vkGetPhysicalDeviceMemoryProperties(physical_.handle, &memory_);
 
@@ -551,7 +555,7 @@ Status VulkanDevice::allocate(const Sizes& sizes) {
     } else if (i == B_SCAN_SCRATCH) {
       bytes = VkDeviceSize{scratch_words} * 4;
     } else if (i == B_INDIRECT_ARGS) {
-      bytes = VkDeviceSize{rebuild_passes_} * 2 * 16;
+      bytes = VkDeviceSize{rebuild_passes_} * 2 * 16 + 16;  // live, template, the gate word
     } else {
       bytes = VkDeviceSize{sizes.particles} * 4;
     }

@@ -25,14 +25,15 @@ namespace motes::vulkan {
 
 /// The passes of families that need more than one pipeline, each a shader of its own
 /// (shaders/FAMILY_PASS.comp), before the family's own shader (shaders/FAMILY.comp).
-#define MOTES_VULKAN_PASSES(X)                    \
-  X(GridBuildClear, grid_build_clear)             \
-  X(GridBuildCount, grid_build_count)             \
-  X(GridBuildScanBlock, grid_build_scan_block)    \
-  X(GridBuildScanAdd, grid_build_scan_add)        \
-  X(GridBuildScatter, grid_build_scatter)         \
-  X(NeighboursBuildBegin, neighbours_build_begin) \
-  X(ImpulsesApplyWide, impulses_apply_wide)       \
+#define MOTES_VULKAN_PASSES(X)                      \
+  X(GridBuildClear, grid_build_clear)               \
+  X(GridBuildCount, grid_build_count)               \
+  X(GridBuildScanBlock, grid_build_scan_block)      \
+  X(GridBuildScanAdd, grid_build_scan_add)          \
+  X(GridBuildScatter, grid_build_scatter)           \
+  X(NeighboursBuildBegin, neighbours_build_begin)   \
+  X(NeighboursUpdateSmall, neighbours_update_small) \
+  X(ImpulsesApplyWide, impulses_apply_wide)         \
   X(ContactsComputeShift, contacts_compute_shift)
 
 /// The compute pipelines: one per kernel family (motes/backend/kernels.h), whose shader is
@@ -249,6 +250,13 @@ class VulkanDevice final : public Device {
   /// Passes of a conditional rebuild (grid_build then neighbours_build, for the allocated sizes):
   /// slots of B_INDIRECT_ARGS, whose template follows them.
   std::uint32_t rebuild_passes_ = 0;
+  /// The largest grid table (buckets) whose conditional rebuild is neighbours_update_small.comp's
+  /// one workgroup and a gated neighbours_build (MOTES_VULKAN_SMALL_REBUILD; 0, the default:
+  /// never, since its one workgroup takes about 200 us a build at 16,384 particles on an H200
+  /// where the indirect passes take 20 to 40: docs/benchmarks.md).
+  std::uint32_t small_rebuild_table_ = 0;
+  /// The word of B_INDIRECT_ARGS that gates that neighbours_build: after the template.
+  [[nodiscard]] std::uint32_t rebuild_gate_word() const { return rebuild_passes_ * 8; }
 
   /// Workgroups per dispatch dimension: 65,535 (Vulkan's guaranteed minimum), or less when
   /// MOTES_VULKAN_MAX_GROUPS_X says so (tests use it to exercise the 2D dispatch on small sizes).
