@@ -1,9 +1,9 @@
 #version 450
 // neighbours_update for small grids (a pass of the neighbours_update family, one workgroup): when
 // NeighbourState asks for a rebuild, this workgroup builds the whole grid itself (the six passes
-// of grid_build_*.comp as phases separated by workgroup barriers: clear, count, exclusive scan,
-// scatter, canonical placement; the same GridCellStart and the same stable order by (bucket,
-// particle id)) and starts the list build; it writes the gate word args.x of IndirectArgs (1: build,
+// of grid_build_*.comp as phases separated by workgroup barriers, with their steps from
+// grid_build.glsl: clear, count, exclusive scan, scatter, canonical placement; the same
+// GridCellStart and the same stable order by (bucket, particle id)) and starts the list build; it writes the gate word args.x of IndirectArgs (1: build,
 // 0: not), which neighbours_build, dispatched directly after it, reads before anything else. A
 // step without a rebuild then costs two dispatches (this one and the gated build, which ends at
 // once) instead of neighbours_update.comp's ten indirect ones and their barriers. Used while the
@@ -14,6 +14,7 @@
 #include "kernel_common.glsl"
 #include "shared/grid_hash.h"
 #include "shared/neighbours.h"
+#include "grid_build.glsl"
 #include "neighbours_start.glsl"
 
 shared bool rebuild_now;
@@ -39,14 +40,7 @@ void main() {
   for (uint b = lid; b < values; b += threads) grid_cell_start[b] = 0u;
   phase();
   // grid_build_count: each particle's bucket and arrival rank within it.
-  for (uint i = lid; i < p.particle_count; i += threads) {
-    vec4 x = particle_pos[i];
-    uint b = grid_bucket(grid_cell_coord(x.x, p.inv_cell_size),
-                         grid_cell_coord(x.y, p.inv_cell_size),
-                         grid_cell_coord(x.z, p.inv_cell_size), p.table_mask);
-    grid_bucket_of[i] = b;
-    grid_arrival[i] = atomicAdd(grid_cell_start[b], 1u);
-  }
+  for (uint i = lid; i < p.particle_count; i += threads) grid_build_count(i);
   phase();
   // The exclusive scan of the counts: each invocation sums a segment, the segments' sums are
   // scanned in shared memory, then each invocation writes its segment's starts.
@@ -71,22 +65,9 @@ void main() {
   }
   phase();
   // grid_build_scatter: by arrival rank.
-  for (uint i = lid; i < p.particle_count; i += threads) {
-    grid_unsorted[grid_cell_start[grid_bucket_of[i]] + grid_arrival[i]] = i;
-  }
+  for (uint i = lid; i < p.particle_count; i += threads) grid_build_scatter(i);
   phase();
   // grid_build: each particle at its canonical slot (its rank by id within its bucket).
-  for (uint i = lid; i < p.particle_count; i += threads) {
-    uint b = grid_bucket_of[i];
-    uint first = grid_cell_start[b];
-    uint last = grid_cell_start[b + 1u];
-    uint s = first;
-    for (uint t = first; t < last; ++t) {
-      if (grid_unsorted[t] < i) ++s;
-    }
-    grid_order[s] = i;
-    sorted_pos[s] = particle_pos[i];
-    sorted_body[s] = particle_body[i];
-  }
+  for (uint i = lid; i < p.particle_count; i += threads) grid_build_place(i);
   if (lid == 0u) neighbours_start();
 }
