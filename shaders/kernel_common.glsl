@@ -11,7 +11,14 @@
 #include "shared/fluid.h"
 #include "vulkan_bindings.h"
 
+// A shader whose workgroup size is set when its pipeline is made (specialization constant 0:
+// neighbours_update_small.glsl) defines MOTES_LOCAL_SIZE_SPECIALIZED first; WORKGROUP_SIZE is
+// then only the default.
+#ifdef MOTES_LOCAL_SIZE_SPECIALIZED
+layout(local_size_x = WORKGROUP_SIZE, local_size_x_id = 0) in;
+#else
 layout(local_size_x = WORKGROUP_SIZE) in;
+#endif
 
 // StepParams travels with every dispatch; args are the pass's own values (scan levels).
 layout(push_constant) uniform Push {

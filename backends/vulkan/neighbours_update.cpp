@@ -2,10 +2,10 @@
 // indirect arguments of every rebuild pass from their template (written at allocate) when
 // NeighbourState asks for a rebuild, or zeroes them; the grid_build and neighbours_build passes are
 // then dispatched indirectly, so a recorded step replays without the host deciding anything.
-// With MOTES_VULKAN_SMALL_REBUILD, a small grid (at most small_rebuild_table_ buckets) is rebuilt
-// by one workgroup instead (shaders/neighbours_update_small.comp), which gates a directly
-// dispatched neighbours_build: two dispatches a step where the indirect rebuild has ten, most of
-// them empty.
+// A small grid (at most small_rebuild_table_ buckets: 65,536 on a GPU by default, or
+// MOTES_VULKAN_SMALL_REBUILD) is rebuilt by one workgroup instead
+// (shaders/neighbours_update_small.glsl), which gates a directly dispatched neighbours_build: two
+// dispatches a step where the indirect rebuild has ten, most of them empty.
 #include "vulkan_device.h"
 
 namespace motes::vulkan {

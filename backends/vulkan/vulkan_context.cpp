@@ -126,6 +126,8 @@ PhysicalDevice describe(VkPhysicalDevice handle, int index) {
       (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 &&
       (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) != 0 &&
       (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_BASIC_BIT) != 0;
+  d.max_workgroup_x =
+      std::min(p.limits.maxComputeWorkGroupInvocations, p.limits.maxComputeWorkGroupSize[0]);
   d.max_storage_range = p.limits.maxStorageBufferRange;
   d.timestamp_period_ns = p.limits.timestampPeriod;
 

@@ -34,6 +34,7 @@ struct PhysicalDevice {
   float timestamp_period_ns = 0.0f;
   std::uint32_t subgroup_size = 0;
   bool subgroup_arithmetic = false;     ///< subgroupAdd and friends in compute shaders
+  std::uint32_t max_workgroup_x = 0;    ///< invocations of a 1D workgroup: the lower of the limits
   std::uint64_t max_storage_range = 0;  ///< maxStorageBufferRange
   std::uint64_t max_allocation = 0;     ///< maxMemoryAllocationSize
 };

@@ -238,6 +238,7 @@ Status VulkanDevice::init_queue(std::uint32_t queue_index) {
     const long v = std::strtol(env, nullptr, 10);
     if (v >= 1 && v < 65536) list_columns_cap_ = static_cast<std::uint32_t>(v);
   }
+  small_rebuild_table_ = physical_.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0 : kSmallRebuildTable;
   if (const char* env = std::getenv("MOTES_VULKAN_SMALL_REBUILD"); env != nullptr && *env != '\0') {
     const long v = std::strtol(env, nullptr, 10);
     if (v >= 0 && v <= (1L << 31)) small_rebuild_table_ = static_cast<std::uint32_t>(v);
@@ -262,15 +263,17 @@ Status VulkanDevice::init_queue(std::uint32_t queue_index) {
 }
 
 Status VulkanDevice::create_pipelines() {
-  // The block scan uses subgroup arithmetic where the device has it (MOTES_VULKAN_NO_SUBGROUPS=1
-  // forces the shared-memory version, so that tests cover both).
+  // The block scan and the one-workgroup rebuild's scan use subgroup arithmetic where the device
+  // has it (MOTES_VULKAN_NO_SUBGROUPS=1 forces the shared-memory versions, so that tests cover
+  // both).
   const char* no_subgroups = std::getenv("MOTES_VULKAN_NO_SUBGROUPS");
   use_subgroups_ = physical_.subgroup_arithmetic &&
                    (no_subgroups == nullptr || std::strcmp(no_subgroups, "1") != 0);
   std::uint32_t descriptors = 0;
   for (std::size_t i = 0; i < kPipelineCount; ++i) {
     std::string name = kPipelineShaders[i];
-    if (use_subgroups_ && static_cast<Pipeline>(i) == Pipeline::GridBuildScanBlock) {
+    if (use_subgroups_ && (static_cast<Pipeline>(i) == Pipeline::GridBuildScanBlock ||
+                           static_cast<Pipeline>(i) == Pipeline::NeighboursUpdateSmall)) {
       name += "_subgroup";
     }
     shaders_[i] = find_shader(name);
@@ -370,6 +373,13 @@ VkPipeline VulkanDevice::pipeline_at(std::size_t i) const {
     pipe.stage.module = module;
     pipe.stage.pName = "main";
     pipe.layout = pipeline_layouts_[i];
+    // neighbours_update_small.glsl's workgroup size is specialization constant 0.
+    const std::uint32_t small_threads = small_rebuild_threads();
+    const VkSpecializationMapEntry entry{0, 0, sizeof(small_threads)};
+    VkSpecializationInfo special{1, &entry, sizeof(small_threads), &small_threads};
+    if (static_cast<Pipeline>(i) == Pipeline::NeighboursUpdateSmall) {
+      pipe.stage.pSpecializationInfo = &special;
+    }
     pipe.flags = shader_stats_.create_flags();
     r = vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipe, nullptr, &pipelines_[i]);
     if (r == VK_SUCCESS) shader_stats_.report(device_, pipelines_[i], shader->name);

@@ -6,6 +6,7 @@
 
 #include <volk.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -250,11 +251,17 @@ class VulkanDevice final : public Device {
   /// Passes of a conditional rebuild (grid_build then neighbours_build, for the allocated sizes):
   /// slots of B_INDIRECT_ARGS, whose template follows them.
   std::uint32_t rebuild_passes_ = 0;
-  /// The largest grid table (buckets) whose conditional rebuild is neighbours_update_small.comp's
-  /// one workgroup and a gated neighbours_build (MOTES_VULKAN_SMALL_REBUILD; 0, the default:
-  /// never, since its one workgroup takes about 200 us a build at 16,384 particles on an H200
-  /// where the indirect passes take 20 to 40: docs/benchmarks.md).
+  /// The largest grid table (buckets) whose conditional rebuild is neighbours_update_small.glsl's
+  /// one workgroup and a gated neighbours_build (MOTES_VULKAN_SMALL_REBUILD). By default
+  /// kSmallRebuildTable on a GPU (16,384 particles: on an H200 a step without a build takes 24
+  /// against 33 us, a build about 80 against 30: docs/benchmarks.md), never on a CPU device
+  /// (lavapipe runs a workgroup on one thread).
+  static constexpr std::uint32_t kSmallRebuildTable = 65536;
   std::uint32_t small_rebuild_table_ = 0;
+  /// That workgroup's size: 1,024 invocations, or the device's most if it allows fewer.
+  [[nodiscard]] std::uint32_t small_rebuild_threads() const {
+    return std::max<std::uint32_t>(WORKGROUP_SIZE, std::min(1024u, physical_.max_workgroup_x));
+  }
   /// The word of B_INDIRECT_ARGS that gates that neighbours_build: after the template.
   [[nodiscard]] std::uint32_t rebuild_gate_word() const { return rebuild_passes_ * 8; }
 

@@ -1,6 +1,6 @@
 #!/bin/sh
 # Vulkan's two conditional rebuilds give the same run: each scene's first steps with the indirect
-# passes (MOTES_VULKAN_SMALL_REBUILD=0) and with neighbours_update_small.comp's one workgroup
+# passes (MOTES_VULKAN_SMALL_REBUILD=0) and with neighbours_update_small.glsl's one workgroup
 # (a table of up to 1,048,576 buckets) must end in the same state hash, with no guard warning.
 # Usage: small_rebuild_same_state.sh MOTES_CLI SCENES_DIR OUT_DIR
 set -u
