@@ -1,5 +1,6 @@
-// neighbours_update_small.comp and neighbours_update_small_subgroup.comp: the whole shader, its
-// scan chosen by MOTES_SMALL_SUBGROUP_SCAN.
+// The whole of neighbours_update_small.comp and neighbours_update_small_subgroup.comp, whose scan
+// MOTES_SMALL_SUBGROUP_SCAN chooses.
+//
 // neighbours_update for small grids (a pass of the neighbours_update family, one workgroup): when
 // NeighbourState asks for a rebuild, this workgroup builds the whole grid itself (the six passes
 // of grid_build_*.comp as phases separated by workgroup barriers, with their steps from
@@ -41,10 +42,12 @@ void phase() {
 #ifdef MOTES_SMALL_SUBGROUP_SCAN
 // Each subgroup owns a contiguous range, which its lanes read side by side (FLIGHT rows of the
 // subgroup's width at a time): the subgroups' totals are scanned by the first invocation, then each
-// subgroup walks its range again with subgroupInclusiveAdd.
+// subgroup walks its range again with subgroupInclusiveAdd. The width and each lane's place are
+// counted over the active invocations, as in grid_build_scan_block_subgroup.comp, so that a
+// partial subgroup works too.
 void small_scan(uint lid, uint threads, uint values) {
-  uint width = gl_SubgroupSize;
-  uint lane = gl_SubgroupInvocationID;
+  uint width = subgroupAdd(1u);
+  uint lane = subgroupExclusiveAdd(1u);
   uint groups = gl_NumSubgroups;
   uint per = (values + groups - 1u) / groups;
   uint lo = min(gl_SubgroupID * per, values);
