@@ -1,11 +1,16 @@
-// neighbours_update on Vulkan (shaders/neighbours_update.comp): it copies the
-// indirect arguments of every rebuild pass from their template (written at allocate) when
-// NeighbourState asks for a rebuild, or zeroes them; the grid_build and neighbours_build passes are
-// then dispatched indirectly, so a recorded step replays without the host deciding anything.
+// neighbours_update on Vulkan (shaders/neighbours_update.comp): it sets the rebuild's gate word
+// (B_INDIRECT_ARGS, after the template) when NeighbourState asks for a rebuild, and starts the
+// build. Where the device has VK_EXT_conditional_rendering, the grid_build and neighbours_build
+// passes are recorded between a begin and an end of conditional rendering on that word, so a step
+// without a rebuild skips them; otherwise the decision also copies the indirect arguments of every
+// pass from their template (written at allocate), or zeroes them, and the passes are dispatched
+// indirectly. Either way a recorded step replays without the host deciding anything.
 // A small grid (at most small_rebuild_table_ buckets: 65,536 on a GPU by default, or
 // MOTES_VULKAN_SMALL_REBUILD) is rebuilt by one workgroup instead
-// (shaders/neighbours_update_small.glsl), which gates a directly dispatched neighbours_build: two
-// dispatches a step where the indirect rebuild has ten, most of them empty.
+// (shaders/neighbours_update_small.glsl), which sets the same gate word for a neighbours_build
+// that reads it: two dispatches a step where the indirect rebuild has ten, most of them empty (not
+// skipped by conditional rendering: on an H200 its begin cost more than the gated dispatch,
+// docs/benchmarks.md).
 #include "vulkan_device.h"
 
 namespace motes::vulkan {
@@ -41,20 +46,27 @@ void VulkanDevice::record_neighbours_update(VkCommandBuffer cb, const shared::St
     stamp(false, Kernel::NeighboursBuild);
     return;
   }
+  // The decision: the gate word (args.z), and with indirect passes their arguments (args.x words
+  // from args.y).
   const std::uint32_t words = rebuild_passes_ * 4;
-  const std::uint32_t args[4] = {words, words, 0, 0};
+  const std::uint32_t args[4] = {conditional_ ? 0u : words, words, rebuild_gate_word(), 0};
   stamp(true, Kernel::NeighboursUpdate);
   dispatch_groups(cb, Pipeline::NeighboursUpdate, p, 1, args);
-  barrier(cb, Sync::Indirect);
+  barrier(cb, conditional_ ? Sync::Predicate : Sync::Indirect);
   stamp(false, Kernel::NeighboursUpdate);
+  // Conditional passes are dispatched directly (-1), the others from their slots.
   const std::vector<Pass> grid = grid_build_passes(p);
+  const int grid_first = conditional_ ? -1 : 0;
+  const int build_first = conditional_ ? -1 : static_cast<int>(grid.size());
+  if (conditional_) gated(cb, true);
   stamp(true, Kernel::GridBuild);
-  record_passes(cb, grid, p, 0);
+  record_passes(cb, grid, p, grid_first);
   barrier(cb);
   stamp(false, Kernel::GridBuild);
   stamp(true, Kernel::NeighboursBuild);
-  record_passes(cb, neighbours_build_passes(p), p, static_cast<int>(grid.size()));
-  barrier(cb);
+  record_passes(cb, neighbours_build_passes(p), p, build_first);
+  if (conditional_) gated(cb, false);
+  barrier(cb, conditional_ ? Sync::AfterPredicate : Sync::Compute);
   stamp(false, Kernel::NeighboursBuild);
 }
 

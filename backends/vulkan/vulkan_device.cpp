@@ -184,6 +184,22 @@ Status VulkanDevice::init(std::shared_ptr<Instance> instance, int physical) {
     if (std::strcmp(e.extensionName, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME) == 0) {
       executable_properties = true;
     }
+    if (std::strcmp(e.extensionName, VK_EXT_CONDITIONAL_RENDERING_EXTENSION_NAME) == 0) {
+      conditional_ = true;
+    }
+  }
+  // VK_EXT_conditional_rendering, where the device has it (MOTES_VULKAN_NO_CONDITIONAL=1: never,
+  // so that tests cover the empty indirect dispatches too).
+  VkPhysicalDeviceConditionalRenderingFeaturesEXT conditional{};
+  conditional.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_CONDITIONAL_RENDERING_FEATURES_EXT;
+  if (conditional_) {
+    VkPhysicalDeviceFeatures2 features{};
+    features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    features.pNext = &conditional;
+    vkGetPhysicalDeviceFeatures2(physical_.handle, &features);
+    const char* off = std::getenv("MOTES_VULKAN_NO_CONDITIONAL");
+    conditional_ = conditional.conditionalRendering == VK_TRUE &&
+                   (off == nullptr || std::strcmp(off, "1") != 0);
   }
   std::vector<const char*> enabled;
   if (memory_budget_) enabled.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
@@ -191,6 +207,13 @@ Status VulkanDevice::init(std::shared_ptr<Instance> instance, int physical) {
   info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue;
+  if (conditional_) {
+    enabled.push_back(VK_EXT_CONDITIONAL_RENDERING_EXTENSION_NAME);
+    conditional = {};
+    conditional.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_CONDITIONAL_RENDERING_FEATURES_EXT;
+    conditional.conditionalRendering = VK_TRUE;
+    info.pNext = &conditional;
+  }
   shader_stats_ = ShaderStats::from_environment();
   VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR stats_feature{};
   shader_stats_.request(executable_properties, info_.name.c_str(), enabled, stats_feature,
@@ -237,6 +260,10 @@ Status VulkanDevice::init_queue(std::uint32_t queue_index) {
   if (const char* env = std::getenv("MOTES_VULKAN_LIST_COLUMNS"); env != nullptr && *env != '\0') {
     const long v = std::strtol(env, nullptr, 10);
     if (v >= 1 && v < 65536) list_columns_cap_ = static_cast<std::uint32_t>(v);
+  }
+  if (const char* env = std::getenv("MOTES_VULKAN_CYCLES"); env != nullptr && *env != '\0') {
+    const long v = std::strtol(env, nullptr, 10);
+    if (v >= 1 && v <= 4096) cycles_per_buffer_ = static_cast<std::size_t>(v);
   }
   small_rebuild_table_ = physical_.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0 : kSmallRebuildTable;
   if (const char* env = std::getenv("MOTES_VULKAN_SMALL_REBUILD"); env != nullptr && *env != '\0') {
@@ -431,6 +458,7 @@ Status VulkanDevice::create_buffer(GpuBuffer& out, VkDeviceSize data_bytes, bool
     // Vertex buffers too: a program drawing on the same device binds them (vulkan_interop.h).
     info.usage |= VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
                   VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
+    if (conditional_) info.usage |= VK_BUFFER_USAGE_CONDITIONAL_RENDERING_BIT_EXT;
   }
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   if (info.size > physical_.max_allocation && physical_.max_allocation != 0) {

@@ -162,8 +162,10 @@ class VulkanDevice final : public Device {
   /// What a barrier makes visible: compute writes to the next dispatch (between passes), also to
   /// the indirect arguments read by the next dispatches (after neighbours_update.comp), or
   /// everything to everything, transfers and the host included (where a command buffer ends);
-  /// Begin is All after begin_stages_ (where a command buffer starts).
-  enum class Sync { Compute, Indirect, All, Begin };
+  /// Begin is All after begin_stages_ (where a command buffer starts); Predicate also to the
+  /// conditional rendering that reads the rebuild's gate word (after a rebuild's decision), and
+  /// AfterPredicate waits for that read too (after the passes it gated).
+  enum class Sync { Compute, Indirect, All, Begin, Predicate, AfterPredicate };
   void barrier(VkCommandBuffer cb, Sync sync = Sync::Compute) const;
   /// Binds a pipeline, its descriptor set and the push constants.
   void bind(VkCommandBuffer cb, Pipeline pipeline, const PushConstants& push) const;
@@ -230,6 +232,13 @@ class VulkanDevice final : public Device {
   VkPhysicalDeviceMemoryProperties memory_{};
   /// VK_EXT_memory_budget is enabled: available_bytes() reads the heaps' budgets and usage.
   bool memory_budget_ = false;
+  /// VK_EXT_conditional_rendering is on (the device has it and MOTES_VULKAN_NO_CONDITIONAL is not
+  /// 1): a step without a rebuild skips the rebuild's dispatches instead of dispatching them empty
+  /// (neighbours_update.cpp).
+  bool conditional_ = false;
+  /// Begins (vkCmdBeginConditionalRenderingEXT on the rebuild's gate word) or ends the part of a
+  /// command buffer whose dispatches run only when the step rebuilds.
+  void gated(VkCommandBuffer cb, bool begin) const;
   /// MOTES_VULKAN_SHADER_STATS: each pipeline's statistics as it is made (shader_stats.h).
   ShaderStats shader_stats_;
 
@@ -253,8 +262,8 @@ class VulkanDevice final : public Device {
   std::uint32_t rebuild_passes_ = 0;
   /// The largest grid table (buckets) whose conditional rebuild is neighbours_update_small.glsl's
   /// one workgroup and a gated neighbours_build (MOTES_VULKAN_SMALL_REBUILD). By default
-  /// kSmallRebuildTable on a GPU (16,384 particles: on an H200 a step without a build takes 24
-  /// against 33 us, a build about 80 against 30: docs/benchmarks.md), never on a CPU device
+  /// kSmallRebuildTable on a GPU (16,384 particles: on an H200 a step without a build takes 16
+  /// against 27 us, a build about 80 against 30: docs/benchmarks.md), never on a CPU device
   /// (lavapipe runs a workgroup on one thread).
   static constexpr std::uint32_t kSmallRebuildTable = 65536;
   std::uint32_t small_rebuild_table_ = 0;
@@ -292,6 +301,15 @@ class VulkanDevice final : public Device {
   bool use_subgroups_ = false;  ///< the subgroup-arithmetic variant of the block scan
   std::vector<Op> pending_;
   std::vector<Recording> recordings_;
+  /// Runs `times` times the recording of `cycles` copies of `cycle` (made at the first call, then
+  /// cached in recordings_).
+  Status replay(const std::vector<Op>& cycle, std::size_t cycles, std::size_t times);
+  /// Cycles (steps) recorded back to back in one replayed command buffer, so that a command
+  /// buffer's start and end (its barriers order everything, the host included) come once per this
+  /// many: on an H200 they cost about 8 us, a third of a 16,384-sphere step (docs/benchmarks.md).
+  /// MOTES_VULKAN_CYCLES sets another count (1: a step a command buffer).
+  static constexpr std::size_t kCyclesPerBuffer = 16;
+  std::size_t cycles_per_buffer_ = kCyclesPerBuffer;
   Status error_;  ///< sticky: the first failure (device lost, out of memory...)
   bool timing_ = false;
   KernelTimes times_;

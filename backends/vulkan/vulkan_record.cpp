@@ -1,8 +1,9 @@
 // Queueing, recording and replay. Kernel calls are queued; flush() finds the shortest cycle of
-// calls that the queue repeats (a step: the five families, once per substep), records it once into
-// a command buffer, caches it, and submits that command buffer as many times as the cycle repeats.
-// A barrier starts and ends every command buffer and separates every dispatch, so each kernel
-// sees all earlier writes. Timing records timestamps around every kernel family instead.
+// calls that the queue repeats (a step: the five families, once per substep), records it
+// kCyclesPerBuffer times back to back into a command buffer (and the remainder into another),
+// caches them, and submits them as many times as the cycle repeats. A barrier starts and ends
+// every command buffer and separates every dispatch, so each kernel sees all earlier writes.
+// Timing records timestamps around every kernel family instead.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -18,7 +19,7 @@ namespace {
 constexpr std::size_t kMaxRecordings = 8;
 /// Timed runs record this many cycles per command buffer (two timestamps per kernel call each).
 constexpr std::size_t kTimedCycles = 256;
-/// Command buffers per vkQueueSubmit when a cycle is replayed many times.
+/// Cycles per vkQueueSubmit (at least one command buffer) when a cycle is replayed many times.
 constexpr std::size_t kSubmitBatch = 512;
 
 }  // namespace
@@ -66,6 +67,11 @@ void VulkanDevice::barrier(VkCommandBuffer cb, Sync sync) const {
   if (sync == Sync::Indirect) {
     b.dstAccessMask |= VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
     dst |= VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT;
+  } else if (sync == Sync::Predicate) {
+    b.dstAccessMask |= VK_ACCESS_CONDITIONAL_RENDERING_READ_BIT_EXT;
+    dst |= VK_PIPELINE_STAGE_CONDITIONAL_RENDERING_BIT_EXT;
+  } else if (sync == Sync::AfterPredicate) {
+    src |= VK_PIPELINE_STAGE_CONDITIONAL_RENDERING_BIT_EXT;
   } else if (sync == Sync::All || sync == Sync::Begin) {
     if (sync == Sync::Begin) src = begin_stages_;
     b.srcAccessMask |= VK_ACCESS_TRANSFER_WRITE_BIT;
@@ -101,6 +107,18 @@ void VulkanDevice::record_passes(VkCommandBuffer cb, const std::vector<Pass>& pa
       vkCmdDispatchIndirect(cb, buffer(B_INDIRECT_ARGS), slot * 16);
     }
   }
+}
+
+void VulkanDevice::gated(VkCommandBuffer cb, bool begin) const {
+  if (!begin) {
+    vkCmdEndConditionalRenderingEXT(cb);
+    return;
+  }
+  VkConditionalRenderingBeginInfoEXT info{};
+  info.sType = VK_STRUCTURE_TYPE_CONDITIONAL_RENDERING_BEGIN_INFO_EXT;
+  info.buffer = buffer(B_INDIRECT_ARGS);
+  info.offset = VkDeviceSize{rebuild_gate_word()} * 4;
+  vkCmdBeginConditionalRenderingEXT(cb, &info);
 }
 
 void VulkanDevice::bind(VkCommandBuffer cb, Pipeline pipeline, const PushConstants& push) const {
@@ -298,24 +316,36 @@ Status VulkanDevice::flush() {
     return Status::ok();
   }
 
-  // Replay: the recording of this cycle, made once.
+  // Replay: the cycle recorded cycles_per_buffer_ times back to back, made once, then the
+  // remainder's recording.
+  const std::size_t per = std::min(reps, cycles_per_buffer_);
+  if (Status s = replay(cycle, per, reps / per); !s) return s;
+  if (reps % per != 0) return replay(cycle, reps % per, 1);
+  return Status::ok();
+}
+
+Status VulkanDevice::replay(const std::vector<Op>& cycle, std::size_t cycles, std::size_t times) {
+  std::vector<Op> ops;
+  ops.reserve(cycle.size() * cycles);
+  for (std::size_t r = 0; r < cycles; ++r) ops.insert(ops.end(), cycle.begin(), cycle.end());
   auto found = std::find_if(recordings_.begin(), recordings_.end(),
-                            [&](const Recording& r) { return same_calls(r.ops, cycle); });
+                            [&](const Recording& r) { return same_calls(r.ops, ops); });
   if (found == recordings_.end()) {
     if (recordings_.size() >= kMaxRecordings) {  // nothing is in flight between flushes
       vkFreeCommandBuffers(device_, pool_, 1, &recordings_.front().commands);
       recordings_.erase(recordings_.begin());
     }
-    Result<VkCommandBuffer> cb = record(cycle, false);
+    Result<VkCommandBuffer> cb = record(ops, false);
     if (!cb) return cb.status();
-    recordings_.push_back({cycle, cb.value()});
+    recordings_.push_back({std::move(ops), cb.value()});
     found = recordings_.end() - 1;
   }
-  const std::vector<VkCommandBuffer> list(std::min(reps, kSubmitBatch), found->commands);
-  while (reps > 0) {
-    const std::size_t k = std::min(reps, kSubmitBatch);
+  const std::size_t batch = std::max<std::size_t>(1, kSubmitBatch / cycles);
+  const std::vector<VkCommandBuffer> list(std::min(times, batch), found->commands);
+  while (times > 0) {
+    const std::size_t k = std::min(times, batch);
     if (Status s = submit_and_wait(list.data(), static_cast<std::uint32_t>(k)); !s) return s;
-    reps -= k;
+    times -= k;
   }
   return Status::ok();
 }

@@ -68,8 +68,9 @@ if want conformance; then
     part "${LIMIT_CONFORMANCE:-240}" conformance motes_conformance_tests --gtest_brief=1 || status=1
   # Again with at most 3 workgroups per dimension (every shader through the 2D-dispatch path), the
   # scans without subgroup arithmetic, the neighbour list in blocks of at most 3 columns and the
-  # conditional rebuild through the indirect passes at every size (the first run takes
-  # neighbours_update_small.glsl's one workgroup up to 65,536 buckets, the GPU's default).
+  # conditional rebuild through its passes in conditional rendering at every size (the first run
+  # takes neighbours_update_small.glsl's one workgroup up to 65,536 buckets, the GPU's default; CI
+  # runs the passes without conditional rendering, MOTES_VULKAN_NO_CONDITIONAL=1, on lavapipe).
   MOTES_VULKAN_VALIDATION=1 MOTES_VULKAN_MAX_GROUPS_X=3 MOTES_VULKAN_NO_SUBGROUPS=1 \
     MOTES_VULKAN_LIST_COLUMNS=3 MOTES_VULKAN_SMALL_REBUILD=0 \
     MOTES_CONFORMANCE_BACKENDS=vulkan \
