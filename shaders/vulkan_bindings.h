@@ -62,8 +62,10 @@
 #define B_GRID_UNSORTED 54  // uint (N): particle ids grouped by bucket, in arrival order
 #define B_SCAN_SCRATCH 55   // uint: block sums of every level of the bucket-count scan
 // uint: VkDispatchIndirectCommand (4 words each) of every pass of a conditional rebuild, then the
-// same for when it runs (written once at allocate); neighbours_update.comp copies or zeroes the
-// first.
+// same for when it runs (written once at allocate), then the rebuild's gate word (1: this step
+// rebuilds). neighbours_update.comp sets the gate word, and copies or zeroes the first where the
+// passes are dispatched indirectly (a device without conditional rendering, which reads the gate
+// word; neighbours_update.cpp); neighbours_update_small.glsl sets the gate word only.
 #define B_INDIRECT_ARGS 56
 // uint: the neighbour list's column blocks after the first (B_NEIGHBOUR_LIST), when one buffer
 // cannot hold every column (maxStorageBufferRange): block b holds columns [b C, (b + 1) C) with

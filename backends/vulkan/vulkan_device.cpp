@@ -263,7 +263,7 @@ Status VulkanDevice::init_queue(std::uint32_t queue_index) {
   }
   if (const char* env = std::getenv("MOTES_VULKAN_CYCLES"); env != nullptr && *env != '\0') {
     const long v = std::strtol(env, nullptr, 10);
-    if (v >= 1 && v <= 4096) cycles_per_buffer_ = static_cast<std::size_t>(v);
+    if (v >= 1 && v <= 512) cycles_per_buffer_ = static_cast<std::size_t>(v);
   }
   small_rebuild_table_ = physical_.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0 : kSmallRebuildTable;
   if (const char* env = std::getenv("MOTES_VULKAN_SMALL_REBUILD"); env != nullptr && *env != '\0') {

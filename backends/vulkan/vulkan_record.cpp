@@ -15,7 +15,7 @@ namespace motes::vulkan {
 
 namespace {
 
-/// Recordings kept for replay; more than this and the oldest is freed.
+/// Recordings kept for replay; more than this and the least recently used is freed.
 constexpr std::size_t kMaxRecordings = 8;
 /// Timed runs record this many cycles per command buffer (two timestamps per kernel call each).
 constexpr std::size_t kTimedCycles = 256;
@@ -338,6 +338,9 @@ Status VulkanDevice::replay(const std::vector<Op>& cycle, std::size_t cycles, st
     Result<VkCommandBuffer> cb = record(ops, false);
     if (!cb) return cb.status();
     recordings_.push_back({std::move(ops), cb.value()});
+    found = recordings_.end() - 1;
+  } else if (found + 1 != recordings_.end()) {  // the last used goes last: evicted last
+    std::rotate(found, found + 1, recordings_.end());
     found = recordings_.end() - 1;
   }
   const std::size_t batch = std::max<std::size_t>(1, kSubmitBatch / cycles);

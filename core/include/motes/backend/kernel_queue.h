@@ -1,6 +1,7 @@
 // Kernel calls queued by a GPU backend until the host must wait, and the shortest cycle they
-// repeat (a step: the five families once per substep). The Vulkan backend records that cycle once
-// into a command buffer, the CUDA backend captures it once into a CUDA graph; both replay it.
+// repeat (a step: the five families once per substep). The Vulkan backend records that cycle up to
+// 16 times back to back into a command buffer, the CUDA backend captures it once into a CUDA
+// graph; both replay it.
 #pragma once
 
 #include <cstddef>
