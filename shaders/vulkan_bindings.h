@@ -63,9 +63,10 @@
 #define B_SCAN_SCRATCH 55   // uint: block sums of every level of the bucket-count scan
 // uint: VkDispatchIndirectCommand (4 words each) of every pass of a conditional rebuild, then the
 // same for when it runs (written once at allocate), then the rebuild's gate word (1: this step
-// rebuilds). neighbours_update.comp sets the gate word, and copies or zeroes the first where the
-// passes are dispatched indirectly (a device without conditional rendering, which reads the gate
-// word; neighbours_update.cpp); neighbours_update_small.glsl sets the gate word only.
+// rebuilds). neighbours_update.comp sets the gate word (which conditional rendering reads), and
+// where the passes are dispatched indirectly (a device without conditional rendering:
+// neighbours_update.cpp) copies or zeroes the first; neighbours_update_small.glsl sets the gate
+// word only (its neighbours_build reads it).
 #define B_INDIRECT_ARGS 56
 // uint: the neighbour list's column blocks after the first (B_NEIGHBOUR_LIST), when one buffer
 // cannot hold every column (maxStorageBufferRange): block b holds columns [b C, (b + 1) C) with

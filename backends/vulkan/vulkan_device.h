@@ -1,8 +1,7 @@
 // The Vulkan compute backend: every kernel family as GLSL compute shaders over the shared physics
 // headers. State stays on the GPU; kernel calls are queued and recorded into command buffers that
 // are cached and replayed (a step's families are recorded once, 16 steps back to back in a command
-// buffer), and the host waits only in
-// read(), write(), synchronize() and check_guards().
+// buffer), and the host waits only in read(), write(), synchronize() and check_guards().
 #pragma once
 
 #include <volk.h>
