@@ -7,6 +7,7 @@
 // its own: no atomics, a fixed summation order. A particle with more neighbours than its list
 // holds walks the grid of the last build from the cell of its position then: the same pairs in the
 // same order. As backends/openmp/contacts_compute.cpp and contacts_shift.cpp.
+#define MOTES_STATE_READONLY  // writes particle_force only
 #include "kernel_common.glsl"
 #include "shared/contact_force.h"
 #include "shared/grid_hash.h"

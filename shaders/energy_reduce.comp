@@ -5,6 +5,7 @@
 // s = 128, ..., 1, a barrier between levels), and invocation 0 writes the block's four words. No
 // atomics: the same sums in the same order on every run and on every backend.
 #extension GL_GOOGLE_include_directive : require
+#define MOTES_STATE_READONLY
 #include "kernel_common.glsl"
 #include "shared/energy.h"
 

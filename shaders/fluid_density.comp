@@ -4,6 +4,7 @@
 // particles beyond h add zeros), then the planes in order (shared/fluid.h). Each thread writes
 // only its own FluidState entry. As backends/openmp/fluid_density.cpp.
 #extension GL_GOOGLE_include_directive : require
+#define MOTES_STATE_READONLY
 #include "kernel_common.glsl"
 #include "shared/fluid.h"
 #include "shared/grid_hash.h"

@@ -7,6 +7,7 @@
 // ParticleForce 0 (shared/fluid.h).
 // As backends/openmp/fluid_update.cpp.
 #extension GL_GOOGLE_include_directive : require
+#define MOTES_STATE_READONLY
 #include "kernel_common.glsl"
 #include "shared/fluid.h"
 #include "shared/grid_hash.h"

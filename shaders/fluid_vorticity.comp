@@ -5,6 +5,7 @@
 // velocity pass (shared/fluid.h). Each thread writes only its own entries. As
 // backends/openmp/fluid_vorticity.cpp.
 #extension GL_GOOGLE_include_directive : require
+#define MOTES_STATE_READONLY
 #include "kernel_common.glsl"
 #include "shared/fluid.h"
 #include "shared/grid_hash.h"

@@ -9,6 +9,7 @@
 // impulses, MOTES_FLAG_IMPULSE_SPLIT, in ContactImpulseSplit, which the last relaxing sweep,
 // MOTES_FLAG_IMPULSE_PUSH, fills too). As backends/openmp/impulses_compute.cpp.
 #extension GL_GOOGLE_include_directive : require
+#define MOTES_STATE_READONLY
 #include "kernel_common.glsl"
 #include "shared/grid_hash.h"
 #include "shared/neighbours.h"

@@ -5,6 +5,7 @@
 // rate, and its |v|^2 (one thread). Max and min of integers: the result does not depend on the
 // order the workgroups run in.
 #extension GL_GOOGLE_include_directive : require
+#define MOTES_STATE_READONLY
 #include "kernel_common.glsl"
 #include "shared/motion_check.h"
 

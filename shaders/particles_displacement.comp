@@ -4,6 +4,7 @@
 // then the reduction (a workgroup max in shared memory, then one atomicMax per workgroup). An
 // integer max of float bits: the result does not depend on the order the workgroups run in.
 #extension GL_GOOGLE_include_directive : require
+#define MOTES_STATE_READONLY
 #include "kernel_common.glsl"
 #include "shared/halo.h"
 
