@@ -29,8 +29,8 @@ layout(push_constant) uniform Push {
 // Every binding is a buffer of its own (VulkanDevice::allocate), so every buffer is declared
 // restrict: a store through one changes nothing another reads, and the driver may keep loads in
 // flight across stores. A shader that writes none of the particles' positions and velocities, the
-// grid and the neighbour lists (the force law, shaders/contacts_compute.glsl; the liquid's sums)
-// defines MOTES_STATE_READONLY first: those buffers are then readonly too, which lets NVIDIA's
+// grid and the neighbour lists (the force law, shaders/contacts_compute.glsl; the liquid's sums,
+// impulses_compute, the displacement, energy and motion checks) defines MOTES_STATE_READONLY first: those buffers are then readonly too, which lets NVIDIA's
 // driver load them through the read-only data cache, as CUDA's const __restrict__ pointers.
 // A shader whose threads read, after a barrier, particles that other threads of its workgroup
 // wrote (constraints_relax.comp) defines MOTES_PARTICLES_COHERENT first.
