@@ -33,9 +33,11 @@ layout(push_constant) uniform Push {
 // impulses_compute, the displacement, energy and motion checks) defines MOTES_STATE_READONLY first: those buffers are then readonly too, which lets NVIDIA's
 // driver load them through the read-only data cache, as CUDA's const __restrict__ pointers.
 // A shader whose threads read, after a barrier, particles that other threads of its workgroup
-// wrote (constraints_relax.comp) defines MOTES_PARTICLES_COHERENT first.
-#if defined(MOTES_STATE_READONLY) && defined(MOTES_PARTICLES_COHERENT)
-#error "MOTES_STATE_READONLY and MOTES_PARTICLES_COHERENT exclude each other"
+// wrote (constraints_relax.comp) defines MOTES_PARTICLES_COHERENT first; one whose threads so
+// read the grid's bucket starts and unsorted slots (the one-workgroup grid build,
+// neighbours_update_small.glsl) defines MOTES_GRID_COHERENT.
+#if defined(MOTES_STATE_READONLY) && (defined(MOTES_PARTICLES_COHERENT) || defined(MOTES_GRID_COHERENT))
+#error "MOTES_STATE_READONLY excludes MOTES_PARTICLES_COHERENT and MOTES_GRID_COHERENT"
 #endif
 #ifdef MOTES_STATE_READONLY
 #define MOTES_STATE_ACCESS readonly
@@ -46,6 +48,13 @@ layout(push_constant) uniform Push {
 #define MOTES_PARTICLES_ACCESS coherent
 #else
 #define MOTES_PARTICLES_ACCESS MOTES_STATE_ACCESS
+#endif
+#ifdef MOTES_GRID_COHERENT
+#define MOTES_GRID_ACCESS coherent
+#define MOTES_GRID_SLOTS_ACCESS coherent
+#else
+#define MOTES_GRID_ACCESS MOTES_STATE_ACCESS
+#define MOTES_GRID_SLOTS_ACCESS
 #endif
 layout(std430, binding = B_PARTICLE_POS) MOTES_PARTICLES_ACCESS restrict buffer ParticlePosBuf {
   vec4 particle_pos[];
@@ -68,7 +77,7 @@ layout(std430, binding = B_BODY_TORQUE) restrict buffer BodyTorqueBuf { vec4 bod
 layout(std430, binding = B_BODY_FIRST) readonly restrict buffer BodyFirstBuf { uint body_first[]; };
 layout(std430, binding = B_GRID_BUCKET) MOTES_STATE_ACCESS restrict buffer GridBucketBuf { uint grid_bucket_of[]; };
 layout(std430, binding = B_GRID_ORDER) MOTES_STATE_ACCESS restrict buffer GridOrderBuf { uint grid_order[]; };
-layout(std430, binding = B_GRID_CELL_START) MOTES_STATE_ACCESS restrict buffer GridCellStartBuf { uint grid_cell_start[]; };
+layout(std430, binding = B_GRID_CELL_START) MOTES_GRID_ACCESS restrict buffer GridCellStartBuf { uint grid_cell_start[]; };
 layout(std430, binding = B_SORTED_POS) MOTES_STATE_ACCESS restrict buffer SortedPosBuf { vec4 sorted_pos[]; };
 layout(std430, binding = B_SORTED_BODY) MOTES_STATE_ACCESS restrict buffer SortedBodyBuf { uint sorted_body[]; };
 layout(std430, binding = B_NEIGHBOUR_LIST) MOTES_STATE_ACCESS restrict buffer NeighbourListBuf { uint neighbour_list[]; };
@@ -114,7 +123,7 @@ layout(std430, binding = B_FLUID_VEL_OLD) restrict buffer FluidVelOldBuf { vec4 
 layout(std430, binding = B_FLUID_AUX) restrict buffer FluidAuxBuf { vec4 fluid_aux[]; };
 layout(std430, binding = B_FLUID_NORMAL) restrict buffer FluidNormalBuf { vec4 fluid_normal[]; };
 layout(std430, binding = B_GRID_ARRIVAL) restrict buffer GridArrivalBuf { uint grid_arrival[]; };
-layout(std430, binding = B_GRID_UNSORTED) restrict buffer GridUnsortedBuf { uint grid_unsorted[]; };
+layout(std430, binding = B_GRID_UNSORTED) MOTES_GRID_SLOTS_ACCESS restrict buffer GridUnsortedBuf { uint grid_unsorted[]; };
 layout(std430, binding = B_SCAN_SCRATCH) restrict buffer ScanScratchBuf { uint scan_scratch[]; };
 layout(std430, binding = B_INDIRECT_ARGS) restrict buffer IndirectArgsBuf { uint indirect_args[]; };
 

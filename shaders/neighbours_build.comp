@@ -27,7 +27,9 @@ void main() {
   barrier();
   if (k < p.particle_count) {
     // Threads in grid order: a subgroup's particles share their cells, whose candidates it then
-    // reads together (each list is the same whichever thread builds it).
+    // reads together (each list is the same whichever thread builds it). Particle order, which
+    // CUDA's build takes without fluid, made this one slower on an H200 (W1 dense 1 M: 0.017 ->
+    // 0.021 ms a step; docs/benchmarks.md, session 44).
     uint i = grid_order[k];
     vec4 pi = particle_pos[i];
     neighbour_ref_pos[i] = pi;

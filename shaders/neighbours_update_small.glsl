@@ -21,6 +21,8 @@
 #ifndef MOTES_NEIGHBOURS_UPDATE_SMALL_GLSL
 #define MOTES_NEIGHBOURS_UPDATE_SMALL_GLSL
 #define MOTES_LOCAL_SIZE_SPECIALIZED
+// Its invocations read bucket starts and slots that others of the workgroup wrote (after phase()).
+#define MOTES_GRID_COHERENT
 #include "kernel_common.glsl"
 #include "shared/grid_hash.h"
 #include "shared/neighbours.h"
@@ -32,7 +34,8 @@
 shared bool rebuild_now;
 shared uint sums[gl_WorkGroupSize.x];
 
-// Makes this workgroup's buffer writes visible to its own later reads.
+// Makes this workgroup's buffer writes visible to its own later reads (with the buffers read
+// across invocations declared coherent: MOTES_GRID_COHERENT).
 void phase() {
   memoryBarrierBuffer();
   barrier();
