@@ -8,10 +8,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cli_util.h"
@@ -145,21 +147,49 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+/// W1 sizes from which bench says on stderr how long the host took to build each simulation, and
+/// from which its kernel-timing run is the warm-up (measure): at 33,554,432 spheres and more the
+/// host's build of a simulation (the scene's layout, its upload) takes tens of seconds to minutes.
+constexpr std::uint64_t kW1HugeSpheres = 33'554'432;
+
 /// Runs `steps` steps `repeats` times, each from a fresh simulation prepared by `prepare`, with
 /// kernel timing off (timing may synchronize per kernel and keeps GPU backends from replaying a
-/// captured step); then once more with timing on, for the time of every kernel family.
+/// captured step); then once more with timing on, for the time of every kernel family. Before the
+/// repeats a warm-up of 50 steps (first touch of memory, thread pool start, graph capture); with
+/// `huge` the timing run comes first and is the warm-up instead, so that a size whose simulation
+/// takes minutes to build is built twice rather than three times. `huge` also reports each
+/// simulation's build time on stderr.
 template <typename Prepare>
 Measurement measure(const motes::Scene& scene, const BenchOptions& o, std::uint64_t steps,
-                    Prepare prepare) {
+                    Prepare prepare, bool huge = false) {
   Measurement m;
-  {  // Warm-up: first touch of memory, thread pool start, graph capture.
+  const auto fresh = [&](const char* what) {
+    const auto t0 = std::chrono::steady_clock::now();
     auto sim = make_sim(scene, o);
     prepare(*sim);
+    if (huge) {
+      fmt::print(stderr, "  {} simulation of {} particles built in {:.1f} s\n", what,
+                 sim->particle_count(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+    return sim;
+  };
+  const auto time_kernels = [&] {
+    auto sim = fresh("the kernel-timing");
+    m.kernel_steps = std::min<std::uint64_t>(steps, 500);
+    sim->device().set_timing(true);
+    sim->device().reset_kernel_times();
+    must(sim->step(m.kernel_steps));
+    m.kernels = sim->device().kernel_times();
+  };
+  if (huge) {
+    time_kernels();
+  } else {  // Warm-up: first touch of memory, thread pool start, graph capture.
+    auto sim = fresh("the warm-up");
     must(sim->step(std::min<std::uint64_t>(steps, 50)));
   }
   for (int r = 0; r < o.repeats; ++r) {
-    auto sim = make_sim(scene, o);
-    prepare(*sim);
+    auto sim = fresh("a timed");
     // A start state loaded from a checkpoint carries the list builds of the run that made it
     // (the W1 dense phase: the settle's); the column counts this repeat's own.
     const std::uint32_t builds_before = r == 0 ? must(sim->neighbour_stats()).builds : 0;
@@ -195,13 +225,7 @@ Measurement measure(const motes::Scene& scene, const BenchOptions& o, std::uint6
       m.capacity = sim->step_params().neighbour_capacity;
     }
   }
-  auto sim = make_sim(scene, o);
-  prepare(*sim);
-  m.kernel_steps = std::min<std::uint64_t>(steps, 500);
-  sim->device().set_timing(true);
-  sim->device().reset_kernel_times();
-  must(sim->step(m.kernel_steps));
-  m.kernels = sim->device().kernel_times();
+  if (!huge) time_kernels();
   m.steps = steps;
   return m;
 }
@@ -602,13 +626,28 @@ void run_bench(const BenchOptions& o) {
       // scene's own (so that every skin starts the dense phase from the same pile). Set in
       // place: at 268,435,456 spheres a copy of the scene (about 280 B a sphere) does not fit
       // beside it on the GPU machine.
+      const auto built = std::chrono::steady_clock::now();
       motes::Scene scene = motes::settle_workload(nx, ny, nz);
+      const bool huge = n >= kW1HugeSpheres;
+      if (huge) {
+        fmt::print(stderr, "W1 at {} spheres: the scene built in {:.1f} s\n", n,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - built).count());
+        const char* tunables = std::getenv("GLIBC_TUNABLES");
+        if (tunables == nullptr ||
+            std::string_view(tunables).find("hugetlb") == std::string::npos) {
+          fmt::print(stderr,
+                     "  (GLIBC_TUNABLES=glibc.malloc.hugetlb=1 lets transparent huge pages back "
+                     "the host's build where the kernel gives them on request: about twice as "
+                     "fast, docs/benchmarks.md)\n");
+        }
+      }
       const double own_skin = scene.settings.neighbour_skin;
       const double timed_skin = o.skin > 0.0 ? o.skin : own_skin;
       scene.settings.neighbour_skin = timed_skin;
       if (o.phase != "dense") {
         attempt([&] {
-          Measurement m = measure(scene, o, o.falling_steps, [](motes::Simulation&) {});
+          Measurement m = measure(
+              scene, o, o.falling_steps, [](motes::Simulation&) {}, huge);
           m.workload = "settle";
           m.phase = "falling";
           print_row(m);

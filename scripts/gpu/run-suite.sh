@@ -34,7 +34,8 @@
 #     134 M on 2; HALO auto or host, motes_mpi_bench --halo), MOTES_SCALING_STEPS,
 #     LIMIT_SCALING_RUN seconds each
 #   MOTES_BENCH_RUNS="cuda:falling cuda:dominoes cuda:dense vulkan:falling ..."   what is measured
-#     (also BACKEND:huge: W1 at 67 M and 134 M particles, one short repeat; BACKEND:dominoes-1m:
+#     (also BACKEND:huge: W1 at 67 M and 134 M particles, one short repeat, the host's build on
+#     transparent huge pages (GLIBC_TUNABLES=glibc.malloc.hugetlb=1); BACKEND:dominoes-1m:
 #     W2 with 1,000,000 dominoes; BACKEND:cloth: W3 at 256 x 256 and 1024 x 1024;
 #     BACKEND:soft: W4 with 1,000 and 10,000 soft cubes; BACKEND:impulse-dominoes: W2's chain
 #     with impulse contacts, 100,000 dominoes;
@@ -227,7 +228,8 @@ if want bench; then
         part "${LIMIT_DOMINOES:-60}" bench motes bench --backend "$backend" --workload dominoes \
           --dominoes 1000000 --domino-rows 1000 --json "$j" ;;
       huge)
-        part "${LIMIT_HUGE:-300}" bench motes bench --backend "$backend" --workload settle \
+        part "${LIMIT_HUGE:-300}" bench env GLIBC_TUNABLES=glibc.malloc.hugetlb=1 \
+          motes bench --backend "$backend" --workload settle \
           --phase falling --sizes 67108864,134217728 --repeats 1 --falling-steps 200 --json "$j" ;;
       scaling)
         for t in 1 2 4 8 16; do
