@@ -148,8 +148,9 @@ double median(std::vector<double> v) {
 }
 
 /// W1 sizes from which bench says on stderr how long the host took to build each simulation, and
-/// from which its kernel-timing run is the warm-up (measure): at 33,554,432 spheres and more the
-/// host's build of a simulation (the scene's layout, its upload) takes tens of seconds to minutes.
+/// from which the falling phase's kernel-timing run is the warm-up (measure; the dense phase keeps
+/// its warm-up): at 33,554,432 spheres and more the host's build of a simulation (the scene's
+/// layout, its upload) takes tens of seconds to minutes.
 constexpr std::uint64_t kW1HugeSpheres = 33'554'432;
 
 /// Runs `steps` steps `repeats` times, each from a fresh simulation prepared by `prepare`, with
@@ -634,7 +635,7 @@ void run_bench(const BenchOptions& o) {
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - built).count());
         const char* tunables = std::getenv("GLIBC_TUNABLES");
         if (tunables == nullptr ||
-            std::string_view(tunables).find("hugetlb") == std::string::npos) {
+            std::string_view(tunables).find("hugetlb") == std::string_view::npos) {
           fmt::print(stderr,
                      "  (GLIBC_TUNABLES=glibc.malloc.hugetlb=1 lets transparent huge pages back "
                      "the host's build where the kernel gives them on request: about twice as "
