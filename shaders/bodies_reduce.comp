@@ -6,6 +6,7 @@
 // thread reading its particles straight from memory, without strided reads (15-particle dominoes
 // ran at a fraction of the memory bandwidth that way). As backends/cuda/bodies_reduce.cu.
 #extension GL_GOOGLE_include_directive : require
+#define MOTES_STATE_READONLY  // writes no particle position, velocity, grid or list
 #include "kernel_common.glsl"
 #include "shared/body_math.h"
 

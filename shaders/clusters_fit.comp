@@ -8,6 +8,7 @@
 // conformance tolerances. Every thread reaches every barrier: threads of clusters beyond the count
 // sum nothing and write nothing.
 #extension GL_GOOGLE_include_directive : require
+#define MOTES_STATE_READONLY  // writes no particle position, velocity, grid or list
 #include "kernel_common.glsl"
 
 #define LANES 32u

@@ -3,6 +3,7 @@
 // one thread per entry, the particle entries first, then the rigid body entries. Plain copies of
 // whole vec4s, so the bits are those of every other backend.
 #extension GL_GOOGLE_include_directive : require
+#define MOTES_STATE_READONLY  // writes no particle position, velocity, grid or list
 #include "kernel_common.glsl"
 #include "shared/halo.h"
 

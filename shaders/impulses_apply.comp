@@ -8,6 +8,7 @@
 // backends/openmp/impulses_apply.cpp. Bodies of args.x particles or more (0: none) are
 // impulses_apply_wide.comp's (the same sums, a workgroup per body).
 #extension GL_GOOGLE_include_directive : require
+#define MOTES_STATE_READONLY  // writes no particle position, velocity, grid or list
 #include "kernel_common.glsl"
 #include "shared/neighbours.h"
 #include "impulses_apply_body.glsl"

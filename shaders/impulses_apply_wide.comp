@@ -5,6 +5,7 @@
 // order: impulses_apply.comp's order, and bits, without one thread adding a rigid bunny's 3,000
 // particles in turn.
 #extension GL_GOOGLE_include_directive : require
+#define MOTES_STATE_READONLY  // writes no particle position, velocity, grid or list
 #include "kernel_common.glsl"
 #include "shared/neighbours.h"
 #include "impulses_apply_body.glsl"

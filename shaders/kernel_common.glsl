@@ -30,11 +30,13 @@ layout(push_constant) uniform Push {
 // restrict: a store through one changes nothing another reads, and the driver may keep loads in
 // flight across stores. A shader that writes none of the particles' positions and velocities, the
 // grid and the neighbour lists (the force law, shaders/contacts_compute.glsl; the liquid's sums,
-// impulses_compute, the displacement, energy and motion checks) defines MOTES_STATE_READONLY first: those buffers are then readonly too, which lets NVIDIA's
-// driver load them through the read-only data cache, as CUDA's const __restrict__ pointers.
+// impulses_compute and impulses_apply, the bodies' sums, the clusters' fits, the halo's packing,
+// the displacement, energy and motion checks) defines MOTES_STATE_READONLY first: those buffers
+// are then readonly too, which lets NVIDIA's driver load them through the read-only data cache,
+// as CUDA's const __restrict__ pointers.
 // A shader whose threads read, after a barrier, particles that other threads of its workgroup
 // wrote (constraints_relax.comp) defines MOTES_PARTICLES_COHERENT first; one whose threads so
-// read the grid's bucket starts and unsorted slots (the one-workgroup grid build,
+// read the grid's buckets, bucket starts and unsorted slots (the one-workgroup grid build,
 // neighbours_update_small.glsl) defines MOTES_GRID_COHERENT.
 #if defined(MOTES_STATE_READONLY) && (defined(MOTES_PARTICLES_COHERENT) || defined(MOTES_GRID_COHERENT))
 #error "MOTES_STATE_READONLY excludes MOTES_PARTICLES_COHERENT and MOTES_GRID_COHERENT"
@@ -75,7 +77,7 @@ layout(std430, binding = B_BODY_INV_INERTIA) readonly restrict buffer BodyInvIne
 layout(std430, binding = B_BODY_FORCE) restrict buffer BodyForceBuf { vec4 body_force[]; };
 layout(std430, binding = B_BODY_TORQUE) restrict buffer BodyTorqueBuf { vec4 body_torque[]; };
 layout(std430, binding = B_BODY_FIRST) readonly restrict buffer BodyFirstBuf { uint body_first[]; };
-layout(std430, binding = B_GRID_BUCKET) MOTES_STATE_ACCESS restrict buffer GridBucketBuf { uint grid_bucket_of[]; };
+layout(std430, binding = B_GRID_BUCKET) MOTES_GRID_ACCESS restrict buffer GridBucketBuf { uint grid_bucket_of[]; };
 layout(std430, binding = B_GRID_ORDER) MOTES_STATE_ACCESS restrict buffer GridOrderBuf { uint grid_order[]; };
 layout(std430, binding = B_GRID_CELL_START) MOTES_GRID_ACCESS restrict buffer GridCellStartBuf { uint grid_cell_start[]; };
 layout(std430, binding = B_SORTED_POS) MOTES_STATE_ACCESS restrict buffer SortedPosBuf { vec4 sorted_pos[]; };

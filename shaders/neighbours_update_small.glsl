@@ -21,7 +21,8 @@
 #ifndef MOTES_NEIGHBOURS_UPDATE_SMALL_GLSL
 #define MOTES_NEIGHBOURS_UPDATE_SMALL_GLSL
 #define MOTES_LOCAL_SIZE_SPECIALIZED
-// Its invocations read bucket starts and slots that others of the workgroup wrote (after phase()).
+// Its invocations read buckets, bucket starts and slots that others of the workgroup wrote (after
+// phase()).
 #define MOTES_GRID_COHERENT
 #include "kernel_common.glsl"
 #include "shared/grid_hash.h"
