@@ -77,7 +77,9 @@ motes::FluidSpec water_of(const Case& c) {
     hi = hi.cwiseMax(b.position + Eigen::Vector3d::Constant(reach));
   }
   const int nx = rng.integer(3, 7), ny = rng.integer(3, 7), nz = rng.integer(3, 7);
-  const Eigen::Vector3d over(rng.uniform(lo.x(), hi.x()), 0.0, rng.uniform(lo.z(), hi.z()));
+  // Draws that fill one vector: last component first (random_scenes.cpp says why).
+  const double over_z = rng.uniform(lo.z(), hi.z()), over_x = rng.uniform(lo.x(), hi.x());
+  const Eigen::Vector3d over(over_x, 0.0, over_z);
   const Eigen::Vector3d corner(over.x() - 0.5 * nx * d, hi.y() + d + rng.uniform(0.0, 0.1),
                                over.z() - 0.5 * nz * d);
   motes::FluidSpec water;
@@ -88,8 +90,9 @@ motes::FluidSpec water_of(const Case& c) {
       for (int x = 0; x < nx; ++x) water.points.push_back(corner + s * Eigen::Vector3d(x, y, z));
     }
   }
-  water.velocity =
-      Eigen::Vector3d(rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.0), rng.uniform(-0.5, 0.5));
+  const double vz = rng.uniform(-0.5, 0.5), vy = rng.uniform(-0.5, 0.0),
+               vx = rng.uniform(-0.5, 0.5);
+  water.velocity = Eigen::Vector3d(vx, vy, vz);
   return water;
 }
 
@@ -366,28 +369,30 @@ TEST_P(RandomAdhesionSplashes, KeepMomentum) {
         }
       }
       const double mid = 0.5 * (n - 1) * s;
-      ball.velocity =
-          Eigen::Vector3d(rng.uniform(0.6, 1.2), rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2));
+      const double vz = rng.uniform(-0.2, 0.2), vy = rng.uniform(-0.2, 0.2),
+                   vx = rng.uniform(0.6, 1.2);
+      ball.velocity = Eigen::Vector3d(vx, vy, vz);
       scene.fluids.push_back(ball);
-      const Eigen::Vector3i dims(rng.integer(2, 5), rng.integer(2, 5), rng.integer(2, 5));
+      const int nz = rng.integer(2, 5), ny = rng.integer(2, 5), nx = rng.integer(2, 5);
+      const Eigen::Vector3i dims(nx, ny, nz);
       motes::BodySpec box;
       box.name = fmt::format("box {}", k);
       box.shape = std::make_shared<motes::ParticleSet>(motes::box_lattice(dims, d).value());
-      box.position =
-          origin + Eigen::Vector3d(mid + rng.uniform(0.07, 0.1), mid + rng.uniform(-0.02, 0.0),
-                                   mid + rng.uniform(-0.03, -0.01));
-      box.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(
-          rng.uniform(0.0, 6.283),
-          Eigen::Vector3d(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1))
-              .normalized()));
+      const double bz = rng.uniform(-0.03, -0.01), by = rng.uniform(-0.02, 0.0),
+                   bx = rng.uniform(0.07, 0.1);
+      box.position = origin + Eigen::Vector3d(mid + bx, mid + by, mid + bz);
+      const double az = rng.uniform(-1, 1), ay = rng.uniform(-1, 1), ax = rng.uniform(-1, 1);
+      const double angle = rng.uniform(0.0, 6.283);
+      box.rotation =
+          Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d(ax, ay, az).normalized()));
       scene.bodies.push_back(box);
       motes::BodySpec cube;
       cube.name = fmt::format("jelly {}", k);
       cube.shape = std::make_shared<motes::ParticleSet>(
           motes::box_lattice(Eigen::Vector3i(3, 3, 3), d).value());
-      cube.position =
-          origin + Eigen::Vector3d(mid + rng.uniform(0.07, 0.1), mid + rng.uniform(0.0, 0.02),
-                                   mid + rng.uniform(0.02, 0.04));
+      const double cz = rng.uniform(0.02, 0.04), cy = rng.uniform(0.0, 0.02),
+                   cx = rng.uniform(0.07, 0.1);
+      cube.position = origin + Eigen::Vector3d(mid + cx, mid + cy, mid + cz);
       motes::SoftSpec soft;
       soft.frequency = 15.0;
       soft.damping = 10.0;
